@@ -6,4 +6,7 @@ namespace cdcr::model {
 
 inline constexpr int kMaxSegments = 8;
 
+// Largest GP training set a model image may hold (the paper uses up to 700).
+inline constexpr unsigned kMaxTrainingPoints = 1024;
+
 }  // namespace cdcr::model
