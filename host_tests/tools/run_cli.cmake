@@ -1,0 +1,54 @@
+# Runs the cdcr executable once and checks its exit code and output.
+#
+#   cmake -DCDCR_CLI=<path> -DCLI_ARGS=<args separated by |> -DEXPECT_EXIT=<code>
+#         [-DEXPECT_STDOUT=<regex>] [-DEXPECT_STDERR=<regex>] -P run_cli.cmake
+#
+# EXPECT_STDOUT unset: stdout must be empty (an error leaves nothing partial).
+# EXPECT_STDERR unset: stderr must be empty; set: stderr must be exactly one
+# line, and that line (without its newline) must match the regex.
+# Arguments are joined with | because a CMake list would be split apart on
+# its way through add_test().
+
+foreach(required CDCR_CLI EXPECT_EXIT)
+  if(NOT DEFINED ${required})
+    message(FATAL_ERROR "run_cli.cmake: ${required} is not set")
+  endif()
+endforeach()
+
+string(REPLACE "|" ";" arguments "${CLI_ARGS}")
+execute_process(
+  COMMAND "${CDCR_CLI}" ${arguments}
+  RESULT_VARIABLE exit_code
+  OUTPUT_VARIABLE stdout
+  ERROR_VARIABLE stderr)
+
+set(failures "")
+if(NOT exit_code STREQUAL EXPECT_EXIT)
+  string(APPEND failures "exit code ${exit_code}, expected ${EXPECT_EXIT}\n")
+endif()
+
+if(DEFINED EXPECT_STDOUT)
+  if(NOT stdout MATCHES "${EXPECT_STDOUT}")
+    string(APPEND failures "stdout does not match: ${EXPECT_STDOUT}\n")
+  endif()
+elseif(NOT stdout STREQUAL "")
+  string(APPEND failures "stdout should be empty\n")
+endif()
+
+if(DEFINED EXPECT_STDERR)
+  if(NOT stderr MATCHES "^[^\n]*\n$")
+    string(APPEND failures "stderr should be exactly one line\n")
+  else()
+    string(REGEX REPLACE "\n$" "" stderr_line "${stderr}")
+    if(NOT stderr_line MATCHES "${EXPECT_STDERR}")
+      string(APPEND failures "stderr does not match: ${EXPECT_STDERR}\n")
+    endif()
+  endif()
+elseif(NOT stderr STREQUAL "")
+  string(APPEND failures "stderr should be empty\n")
+endif()
+
+if(NOT failures STREQUAL "")
+  list(JOIN arguments " " command_line)
+  message(FATAL_ERROR "cdcr ${command_line}\n${failures}--- stdout ---\n${stdout}--- stderr ---\n${stderr}")
+endif()

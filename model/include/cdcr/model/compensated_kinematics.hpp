@@ -1,0 +1,51 @@
+#pragma once
+// The forward path that the firmware runs each cycle, and that the host tools
+// run to measure it: cable lengths -> joints -> nominal pose -> GP error twist
+// -> compensated pose (eqs. 5, 13, 16, 19).
+
+#include "cdcr/model/chain.hpp"
+#include "cdcr/model/compensation.hpp"
+#include "cdcr/model/flash_image.hpp"
+#include "cdcr/model/gp_correction.hpp"
+#include "cdcr/model/status.hpp"
+
+namespace cdcr::model {
+
+// The nominal geometry that an image was trained against.
+template <typename S, int Max>
+Status geometry_from_image(const ImageView& image, RobotGeometry<S, Max>& geometry) {
+  if (image.segment_count < 1 || image.segment_count > Max) return Status::invalid_segment_count;
+  RobotGeometry<S, Max> g;
+  g.segment_count = image.segment_count;
+  for (int i = 0; i < image.segment_count; ++i) {
+    g.segments[i] = SegmentGeometry<S>{S(image.geometry[3 * i]), S(image.geometry[3 * i + 1]),
+                                       S(image.geometry[3 * i + 2])};
+  }
+  if (const Status s = g.validate(); s != Status::ok) return s;
+  geometry = g;
+  return Status::ok;
+}
+
+template <typename S, int Max = kMaxSegments>
+struct ForwardResult {
+  JointVector<S, Max> joints;
+  Pose<S> nominal;
+  Twist<S> error_twist = Twist<S>::Zero();
+  Pose<S> compensated;
+};
+
+// Outputs are written only when the cables are valid.
+template <typename S, typename Accumulator, int Max>
+Status compensated_forward(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
+                           const GpCorrection<S, Accumulator, Max>& correction, ForwardResult<S, Max>& result) {
+  JointVector<S, Max> joints;
+  if (const Status s = joints_from_cables(cables_mm, geometry, joints); s != Status::ok) return s;
+  const JointVector<S, Max> bend = bend_from_joints(joints);
+  result.joints = joints;
+  result.nominal = forward_kinematics_bend(bend, geometry);
+  result.error_twist = correction.predict(bend);
+  result.compensated = compensate(result.error_twist, result.nominal);
+  return Status::ok;
+}
+
+}  // namespace cdcr::model

@@ -1,0 +1,46 @@
+#pragma once
+// Reading and writing the dataset CSV (layout in the README, "Dataset format").
+//
+//   l1_1,l1_2,l1_3,l1_4,...,ln_4[,x,y,z,qw,qx,qy,qz]
+//
+// Cable columns first (li_j: cable j of segment i, mm), then optionally the
+// measured end-platform pose in the base frame (mm; unit quaternion,
+// Hamilton, w first). Lines starting with '#' are comments.
+
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <string_view>
+
+#include "dataset/dataset.hpp"
+
+namespace cdcr::dataset {
+
+// Every rejection names the file line (1-based) it happened on, or 0 when it
+// concerns the whole file; what() is a single line ready to print.
+class DatasetError : public std::runtime_error {
+ public:
+  DatasetError(int line, const std::string& message);
+  int line() const { return line_; }
+
+ private:
+  int line_;
+};
+
+enum class PoseColumns { optional, required };
+
+// Parses CSV text. Quaternions whose norm is within 1e-3 of 1 are
+// renormalised; beyond that the row is rejected.
+Dataset parse_dataset_csv(std::string_view text, PoseColumns poses = PoseColumns::optional);
+
+// Reads a file (errors are prefixed with the path).
+Dataset read_dataset_csv(const std::string& path, PoseColumns poses = PoseColumns::optional);
+
+// Writes with full round-trip precision; poses are written when has_poses.
+std::string format_dataset_csv(const Dataset& data, const std::string& comment = {});
+void write_dataset_csv(const std::string& path, const Dataset& data, const std::string& comment = {});
+
+// 64-bit FNV-1a, the dataset hash recorded in model images.
+std::uint64_t fnv1a64(std::string_view bytes);
+
+}  // namespace cdcr::dataset

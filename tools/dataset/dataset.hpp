@@ -1,0 +1,27 @@
+#pragma once
+// A dataset of the robot: commanded cable lengths and, when measured, the
+// end-platform pose in the base frame. The CSV layout is documented in the
+// README ("Dataset format").
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+#include "cdcr/model/se3.hpp"
+
+namespace cdcr::dataset {
+
+struct Dataset {
+  int segment_count = 0;
+  Eigen::MatrixXd cables_mm;                   // samples x 4n, columns l1_1, l1_2, ..., ln_4
+  std::vector<model::Pose<double>> poses;      // one per sample when has_poses
+  bool has_poses = false;
+  std::uint64_t content_hash = 0;              // 64-bit FNV-1a of the file's bytes
+
+  int sample_count() const { return static_cast<int>(cables_mm.rows()); }
+};
+
+}  // namespace cdcr::dataset

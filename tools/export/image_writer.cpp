@@ -1,0 +1,127 @@
+#include "image_writer.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <stdexcept>
+#include <string>
+
+#include "cdcr/model/crc32.hpp"
+#include "cdcr/model/flash_image.hpp"
+
+namespace cdcr::exporting {
+
+namespace {
+
+class ImageBuffer {
+ public:
+  explicit ImageBuffer(std::uint32_t size) : bytes_(size, 0) {}
+
+  template <typename T>
+  void put(std::size_t offset, T value) {
+    std::memcpy(bytes_.data() + offset, &value, sizeof(T));
+  }
+
+  void put_float(std::size_t offset, double value) {
+    const auto f = static_cast<float>(value);
+    if (!std::isfinite(f)) throw std::invalid_argument("model value does not fit in float32: " + std::to_string(value));
+    put(offset, f);
+  }
+
+  std::vector<std::uint8_t> take() { return std::move(bytes_); }
+  std::uint8_t* data() { return bytes_.data(); }
+
+ private:
+  std::vector<std::uint8_t> bytes_;
+};
+
+}  // namespace
+
+std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
+  using namespace model::image_field;
+  const int n = model.training_points();
+  const int d = model.input_dims();
+  const int segments = model.geometry.segment_count;
+  if (n < 1 || d != 2 * segments || model.alpha.rows() != n || model.alpha.cols() != model::kImageOutputs ||
+      model.input_mean.size() != d || model.input_scale.size() != d || model.length_scales.size() != d) {
+    throw std::invalid_argument("trained model has inconsistent dimensions");
+  }
+  const model::ImageLayout layout =
+      model::image_layout(static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(d),
+                          static_cast<std::uint32_t>(segments));
+  ImageBuffer image(layout.total_size);
+
+  image.put<std::uint32_t>(magic, model::kImageMagic);
+  image.put<std::uint16_t>(version_major, model::kImageVersionMajor);
+  image.put<std::uint16_t>(version_minor, model::kImageVersionMinor);
+  image.put<std::uint32_t>(header_size, model::kImageHeaderSize);
+  image.put<std::uint32_t>(total_size, layout.total_size);
+  image.put<std::uint32_t>(training_points, static_cast<std::uint32_t>(n));
+  image.put<std::uint16_t>(input_dims, static_cast<std::uint16_t>(d));
+  image.put<std::uint16_t>(output_dims, static_cast<std::uint16_t>(model::kImageOutputs));
+  image.put<std::uint16_t>(segment_count, static_cast<std::uint16_t>(segments));
+  image.put<std::uint8_t>(scalar_type, static_cast<std::uint8_t>(model::ImageScalar::float32));
+  image.put<std::uint8_t>(kernel_kind, static_cast<std::uint8_t>(model::ImageKernel::squared_exponential_ard));
+  image.put<std::uint8_t>(input_encoding, static_cast<std::uint8_t>(model.encoding));
+  image.put<std::uint32_t>(geometry_offset, layout.geometry_offset);
+  image.put<std::uint32_t>(parameters_offset, layout.parameters_offset);
+  image.put<std::uint32_t>(inputs_offset, layout.inputs_offset);
+  image.put<std::uint32_t>(alpha_offset, layout.alpha_offset);
+  image.put<std::uint32_t>(metadata_offset, layout.metadata_offset);
+  image.put<std::uint32_t>(metadata_size, model::kImageMetadataSize);
+
+  std::size_t at = layout.geometry_offset;
+  for (int i = 0; i < segments; ++i) {
+    const auto& s = model.geometry.segments[i];
+    for (double v : {s.backbone_length_mm, s.anchor_radius_mm, s.theta_max_rad}) {
+      image.put_float(at, v);
+      at += 4;
+    }
+  }
+
+  at = layout.parameters_offset;
+  const auto put_all = [&](const auto& values) {
+    for (Eigen::Index i = 0; i < values.size(); ++i) {
+      image.put_float(at, values[i]);
+      at += 4;
+    }
+  };
+  put_all(model.input_mean);
+  put_all(model.input_scale);
+  put_all(model.length_scales);
+  put_all(model.output_mean);
+  put_all(model.output_scale);
+  put_all(model.signal_variance);
+  put_all(model.noise_variance);
+
+  // Training inputs go in as kernel coordinates, computed in double and
+  // rounded once.
+  at = layout.inputs_offset;
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < d; ++k) {
+      image.put_float(at, (model.inputs(i, k) - model.input_mean[k]) / (model.input_scale[k] * model.length_scales[k]));
+      at += 4;
+    }
+  }
+  at = layout.alpha_offset;
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < model::kImageOutputs; ++k) {
+      image.put_float(at, model.alpha(i, k));
+      at += 4;
+    }
+  }
+
+  using namespace model::image_metadata_field;
+  const std::size_t meta = layout.metadata_offset;
+  image.put<std::uint64_t>(meta + dataset_hash, model.dataset_hash);
+  image.put<std::int64_t>(meta + created_unix_s, model.created_unix_s);
+  image.put<std::uint32_t>(meta + validation_samples, model.validation_samples);
+  image.put<model::ImageMetrics>(meta + metrics, model.metrics);
+  std::memcpy(image.data() + meta + trainer, model.trainer.data(), std::min<std::size_t>(model.trainer.size(), 32));
+
+  const std::uint32_t checksum = model::crc32(image.data(), layout.total_size - model::kImageTrailerSize);
+  image.put<std::uint32_t>(layout.total_size - model::kImageTrailerSize, checksum);
+  return image.take();
+}
+
+}  // namespace cdcr::exporting

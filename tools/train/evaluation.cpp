@@ -1,0 +1,77 @@
+#include "evaluation.hpp"
+
+#include <algorithm>
+#include <stdexcept>
+#include <string>
+
+#include "cdcr/model/compensated_kinematics.hpp"
+
+namespace cdcr::training {
+
+namespace {
+constexpr double kDegreesPerRadian = 57.295779513082320876;
+}
+
+MeanErrors mean_errors(const std::vector<model::Pose<double>>& reference, const std::vector<model::Pose<double>>& poses) {
+  const Fidelity f = compare_poses(reference, poses);
+  return MeanErrors{f.mean_position_mm, f.mean_orientation_deg};
+}
+
+Fidelity compare_poses(const std::vector<model::Pose<double>>& reference, const std::vector<model::Pose<double>>& poses) {
+  if (reference.size() != poses.size() || reference.empty()) throw std::invalid_argument("pose lists differ in size");
+  Fidelity f;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const model::PoseError<double> e = model::pose_error(reference[i], poses[i]);
+    const double orientation_deg = e.orientation_rad * kDegreesPerRadian;
+    f.mean_position_mm += e.position_mm;
+    f.mean_orientation_deg += orientation_deg;
+    f.max_position_mm = std::max(f.max_position_mm, e.position_mm);
+    f.max_orientation_deg = std::max(f.max_orientation_deg, orientation_deg);
+  }
+  f.mean_position_mm /= static_cast<double>(poses.size());
+  f.mean_orientation_deg /= static_cast<double>(poses.size());
+  return f;
+}
+
+std::vector<model::Pose<double>> compensated_poses(const TrainingSet& set, const Eigen::MatrixXd& error_twists) {
+  std::vector<model::Pose<double>> poses;
+  poses.reserve(set.nominal.size());
+  for (std::size_t i = 0; i < set.nominal.size(); ++i) {
+    const model::Twist<double> eps = error_twists.row(static_cast<Eigen::Index>(i)).transpose();
+    poses.push_back(model::compensate(eps, set.nominal[i]));
+  }
+  return poses;
+}
+
+Evaluation evaluate(const TrainingSet& set, const Eigen::MatrixXd& predicted_error_twists) {
+  Evaluation e;
+  e.samples = set.size();
+  e.initial = mean_errors(set.measured, set.nominal);
+  e.compensated = mean_errors(set.measured, compensated_poses(set, predicted_error_twists));
+  return e;
+}
+
+std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
+  model::RobotGeometry<float> geometry;
+  if (const model::Status s = model::geometry_from_image(image, geometry); s != model::Status::ok) {
+    throw std::invalid_argument(std::string("image geometry: ") + model::to_string(s));
+  }
+  model::GpCorrection<float> correction;
+  if (const model::Status s = correction.bind(image); s != model::Status::ok) {
+    throw std::invalid_argument(std::string("image: ") + model::to_string(s));
+  }
+  std::vector<model::Pose<double>> poses;
+  poses.reserve(static_cast<std::size_t>(cables_mm.rows()));
+  for (Eigen::Index i = 0; i < cables_mm.rows(); ++i) {
+    const model::CableVector<float> cables = cables_mm.row(i).transpose().cast<float>();
+    model::ForwardResult<float> result;
+    if (const model::Status s = model::compensated_forward(cables, geometry, correction, result);
+        s != model::Status::ok) {
+      throw std::invalid_argument("sample " + std::to_string(i + 1) + ": " + model::to_string(s));
+    }
+    poses.push_back(result.compensated.cast<double>());
+  }
+  return poses;
+}
+
+}  // namespace cdcr::training

@@ -1,0 +1,47 @@
+#pragma once
+// Accuracy before and after compensation (Section V): position error
+// |p_measured - p| in mm, orientation error the rotation angle of
+// R_measured R^T in degrees, averaged over samples.
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "cdcr/model/flash_image.hpp"
+#include "cdcr/model/se3.hpp"
+#include "training_set.hpp"
+
+namespace cdcr::training {
+
+struct MeanErrors {
+  double position_mm = 0.0;
+  double orientation_deg = 0.0;
+};
+
+struct Evaluation {
+  int samples = 0;
+  MeanErrors initial;      // nominal model
+  MeanErrors compensated;  // nominal model plus GP correction
+};
+
+MeanErrors mean_errors(const std::vector<model::Pose<double>>& reference, const std::vector<model::Pose<double>>& poses);
+
+// Compensated poses exp(eps_i) T_nominal,i for predicted error twists (rows).
+std::vector<model::Pose<double>> compensated_poses(const TrainingSet& set, const Eigen::MatrixXd& error_twists);
+
+Evaluation evaluate(const TrainingSet& set, const Eigen::MatrixXd& predicted_error_twists);
+
+// The firmware's forward path in float32 (model::compensated_forward on the
+// parsed image) over the samples' commanded cables.
+std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm);
+
+struct Fidelity {
+  double max_position_mm = 0.0;
+  double mean_position_mm = 0.0;
+  double max_orientation_deg = 0.0;
+  double mean_orientation_deg = 0.0;
+};
+
+Fidelity compare_poses(const std::vector<model::Pose<double>>& reference, const std::vector<model::Pose<double>>& poses);
+
+}  // namespace cdcr::training

@@ -1,0 +1,136 @@
+#include "hyperparameter_search.hpp"
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <stdexcept>
+
+#include <LBFGSB.h>
+
+namespace cdcr::training {
+
+KernelHyperparameters default_initial_hyperparameters(int input_dims) {
+  KernelHyperparameters h;
+  h.length_scales = Eigen::VectorXd::Ones(input_dims);
+  h.signal_variance = 1.0;
+  h.noise_variance = 0.1;
+  return h;
+}
+
+namespace {
+
+// The optimiser's parameter vector: ARD uses the full log-parameter vector;
+// the isotropic kernel ties every length scale to its first entry.
+struct ParameterMap {
+  int input_dims;
+  bool isotropic;
+
+  int size() const { return isotropic ? 3 : input_dims + 2; }
+
+  Eigen::VectorXd expand(const Eigen::VectorXd& p) const {
+    if (!isotropic) return p;
+    Eigen::VectorXd full(input_dims + 2);
+    full.head(input_dims).setConstant(p[0]);
+    full.tail<2>() = p.tail<2>();
+    return full;
+  }
+
+  Eigen::VectorXd reduce_gradient(const Eigen::VectorXd& g) const {
+    if (!isotropic) return g;
+    Eigen::VectorXd r(3);
+    r << g.head(input_dims).sum(), g.tail<2>();
+    return r;
+  }
+};
+
+struct NegativeLikelihood {
+  const Eigen::MatrixXd& x;
+  const Eigen::MatrixXd& y;
+  ParameterMap map;
+  int evaluations = 0;
+
+  double operator()(const Eigen::VectorXd& p, Eigen::VectorXd& gradient) {
+    ++evaluations;
+    const LikelihoodResult r = log_marginal_likelihood(x, y, KernelHyperparameters::from_log(map.expand(p)));
+    gradient = -map.reduce_gradient(r.gradient);
+    return -r.log_marginal_likelihood;
+  }
+};
+
+}  // namespace
+
+SearchResult maximise_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
+                                 const KernelHyperparameters& initial, const SearchOptions& options) {
+  const ParameterMap map{static_cast<int>(x.cols()), options.isotropic};
+  const int d = map.size() - 2;  // length-scale entries in the optimiser's vector
+  const SearchBounds& b = options.bounds;
+  Eigen::VectorXd lower(d + 2);
+  Eigen::VectorXd upper(d + 2);
+  lower.head(d).setConstant(std::log(b.length_scale_min));
+  upper.head(d).setConstant(std::log(b.length_scale_max));
+  lower[d] = std::log(b.signal_variance_min);
+  upper[d] = std::log(b.signal_variance_max);
+  lower[d + 1] = std::log(b.noise_variance_min);
+  upper[d + 1] = std::log(b.noise_variance_max);
+
+  LBFGSpp::LBFGSBParam<double> param;
+  param.epsilon = options.gradient_tolerance;
+  param.max_iterations = options.max_iterations;
+  param.max_linesearch = 40;
+  LBFGSpp::LBFGSBSolver<double> solver(param);
+
+  // Restarts are drawn log-uniformly from a box of plausible values for
+  // normalised data rather than from the whole search bounds, most of which
+  // are degenerate (every point its own cluster, or one flat function).
+  std::mt19937_64 rng(options.seed);
+  std::uniform_real_distribution<double> length_draw(std::log(0.1), std::log(10.0));
+  std::uniform_real_distribution<double> signal_draw(std::log(0.1), std::log(10.0));
+  std::uniform_real_distribution<double> noise_draw(std::log(1e-4), std::log(1.0));
+
+  SearchResult best;
+  best.log_marginal_likelihood = -std::numeric_limits<double>::infinity();
+  NegativeLikelihood objective{x, y, map};
+  for (int start = 0; start <= options.restarts; ++start) {
+    Eigen::VectorXd p(d + 2);
+    if (start == 0) {
+      const Eigen::VectorXd full = initial.to_log();
+      if (options.isotropic) {
+        p << full.head(map.input_dims).mean(), full.tail<2>();
+      } else {
+        p = full;
+      }
+    } else {
+      for (int i = 0; i < d; ++i) p[i] = length_draw(rng);
+      p[d] = signal_draw(rng);
+      p[d + 1] = noise_draw(rng);
+    }
+    p = p.cwiseMax(lower).cwiseMin(upper);
+    double negative_lml = 0.0;
+    try {
+      solver.minimize(objective, p, negative_lml, lower, upper);
+    } catch (const std::exception&) {
+      // A line search that cannot progress leaves p at its last accepted
+      // point, which is still a valid candidate; a factorisation failure is
+      // re-raised below by the evaluation.
+    }
+    double lml = 0.0;
+    try {
+      lml = log_marginal_likelihood(x, y, KernelHyperparameters::from_log(map.expand(p)), false)
+                .log_marginal_likelihood;
+    } catch (const std::exception&) {
+      continue;
+    }
+    ++best.optimisations_completed;
+    if (lml > best.log_marginal_likelihood) {
+      best.log_marginal_likelihood = lml;
+      best.hyperparameters = KernelHyperparameters::from_log(map.expand(p));
+    }
+  }
+  best.likelihood_evaluations = objective.evaluations;
+  if (best.optimisations_completed == 0) {
+    throw std::runtime_error("hyperparameter search failed from every start");
+  }
+  return best;
+}
+
+}  // namespace cdcr::training

@@ -1,0 +1,59 @@
+#pragma once
+// Training: normalise, search hyperparameters, fit, and package the result
+// as a TrainedModel ready for export.
+
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "cdcr/model/geometry.hpp"
+#include "cdcr/model/input_encoding.hpp"
+#include "gaussian_process.hpp"
+#include "hyperparameter_search.hpp"
+#include "trained_model.hpp"
+#include "training_set.hpp"
+
+namespace cdcr::training {
+
+// How the six outputs share hyperparameters.
+//  * shared: one kernel for all six normalised outputs, one factorisation,
+//    and the only form flash image v1 holds (one kernel row per query on the
+//    board instead of six).
+//  * per_output: six independent GPs; kept to measure what sharing costs.
+enum class HyperparameterSharing { shared, per_output };
+
+struct TrainingOptions {
+  model::InputEncoding encoding = model::InputEncoding::bend_vector;
+  HyperparameterSharing sharing = HyperparameterSharing::shared;
+  SearchOptions search;
+};
+
+struct TrainingReport {
+  double log_marginal_likelihood = 0.0;  // summed over outputs, normalised units
+  int likelihood_evaluations = 0;
+  int optimisations_completed = 0;
+  double jitter = 0.0;
+};
+
+// Shared hyperparameters only (throws std::invalid_argument otherwise).
+TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
+                   const TrainingOptions& options, TrainingReport* report = nullptr);
+
+// Double-precision error twists (rows, (v, omega)) for stacked bend vectors.
+Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends);
+
+// A fitted compensator of either sharing mode, for measurements that compare
+// them; only the shared one can be exported.
+struct Compensator {
+  HyperparameterSharing sharing = HyperparameterSharing::shared;
+  TrainedModel shared;
+  // per_output: the normalisation is in `shared`, the six GPs here.
+  std::vector<GaussianProcess> per_output;
+
+  Eigen::MatrixXd predict(const Eigen::MatrixXd& bends) const;
+};
+
+Compensator fit_compensator(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
+                            const TrainingOptions& options);
+
+}  // namespace cdcr::training

@@ -1,0 +1,67 @@
+#include "training_set.hpp"
+
+#include <stdexcept>
+#include <string>
+
+#include "cdcr/model/chain.hpp"
+#include "cdcr/model/compensation.hpp"
+
+namespace cdcr::training {
+
+TrainingSet TrainingSet::subset(const std::vector<int>& rows) const {
+  TrainingSet s;
+  const auto n = static_cast<Eigen::Index>(rows.size());
+  s.bends.resize(n, bends.cols());
+  s.inputs.resize(n, inputs.cols());
+  s.error_twists.resize(n, 6);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    s.bends.row(i) = bends.row(rows[i]);
+    s.inputs.row(i) = inputs.row(rows[i]);
+    s.error_twists.row(i) = error_twists.row(rows[i]);
+    s.nominal.push_back(nominal[rows[i]]);
+    s.measured.push_back(measured[rows[i]]);
+  }
+  return s;
+}
+
+Eigen::MatrixXd encode_rows(const Eigen::MatrixXd& bends, model::InputEncoding encoding) {
+  Eigen::MatrixXd inputs(bends.rows(), bends.cols());
+  for (Eigen::Index i = 0; i < bends.rows(); ++i) {
+    const model::JointVector<double> bend = bends.row(i).transpose();
+    model::JointVector<double> x(bend.size());
+    model::encode_inputs(encoding, bend, x);
+    inputs.row(i) = x.transpose();
+  }
+  return inputs;
+}
+
+TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGeometry<double>& geometry,
+                              model::InputEncoding encoding) {
+  if (!data.has_poses) throw std::invalid_argument("dataset has no measured poses (x,y,z,qw,qx,qy,qz columns)");
+  if (data.segment_count != geometry.segment_count) {
+    throw std::invalid_argument("dataset has " + std::to_string(data.segment_count) + " segments, geometry has " +
+                                std::to_string(geometry.segment_count));
+  }
+  const int n = data.sample_count();
+  const int dims = 2 * geometry.segment_count;
+  TrainingSet s;
+  s.bends.resize(n, dims);
+  s.error_twists.resize(n, 6);
+  for (int i = 0; i < n; ++i) {
+    const model::CableVector<double> cables = data.cables_mm.row(i).transpose();
+    model::JointVector<double> joints;
+    if (const model::Status st = model::joints_from_cables(cables, geometry, joints); st != model::Status::ok) {
+      throw std::invalid_argument("sample " + std::to_string(i + 1) + ": " + model::to_string(st));
+    }
+    const model::JointVector<double> bend = model::bend_from_joints(joints);
+    const model::Pose<double> nominal = model::forward_kinematics_bend(bend, geometry);
+    s.bends.row(i) = bend.transpose();
+    s.error_twists.row(i) = model::tip_error_twist(data.poses[i], nominal).transpose();
+    s.nominal.push_back(nominal);
+    s.measured.push_back(data.poses[i]);
+  }
+  s.inputs = encode_rows(s.bends, encoding);
+  return s;
+}
+
+}  // namespace cdcr::training
