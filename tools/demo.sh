@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# Kinematics round trip on the paper's Table 1, case 2 (L = 120 mm, r = 70 mm):
+# cable lengths -> tip pose (FK) -> cable lengths (IK) -> the same tip pose.
+set -euo pipefail
+cd "$(dirname "${BASH_SOURCE[0]}")/.."
+
+bash tools/install-deps.sh base
+
+build_log=build/demo-build.log
+mkdir -p build
+echo "Building cdcr (log: $build_log)"
+if ! { cmake -S . -B build -DCMAKE_BUILD_TYPE=Release --log-level=WARNING &&
+  cmake --build build -j"$(nproc)" --target cdcr; } >"$build_log" 2>&1; then
+  tail -n 30 "$build_log" >&2
+  echo "demo: build failed" >&2
+  exit 1
+fi
+
+cdcr=build/bin/cdcr
+geometry=(--length 120 --radius 70)
+table1_case2_cables_mm=118,123,124,115,124,115,118,121,110,117,125,123,124,105,112,128
+
+heading() {
+  printf '\n== %s ==\n' "$1"
+}
+
+run() {
+  echo "\$ $*"
+  "$@"
+}
+
+# Reads a cdcr --json object on stdin and prints one field as a flat
+# comma-separated list, the form the options take.
+json_field() {
+  python3 -c '
+import json, sys
+value = json.load(sys.stdin)[sys.argv[1]]
+print(",".join(repr(x) for row in value for x in row))
+' "$1"
+}
+
+heading "1. Forward kinematics of Table 1, case 2"
+run "$cdcr" fk "${geometry[@]}" --cables "$table1_case2_cables_mm"
+table1_pose=$("$cdcr" fk "${geometry[@]}" --cables "$table1_case2_cables_mm" --json | json_field pose)
+
+heading "2. Inverse kinematics back to that pose"
+echo "(8 joint variables for a 6-DOF pose: the joints may differ from step 1's)"
+run "$cdcr" ik "${geometry[@]}" --pose "$table1_pose"
+ik_cables_mm=$("$cdcr" ik "${geometry[@]}" --pose "$table1_pose" --json | json_field cables)
+
+heading "3. Forward kinematics of the IK cable lengths"
+run "$cdcr" fk "${geometry[@]}" --cables "$ik_cables_mm"
+round_trip_pose=$("$cdcr" fk "${geometry[@]}" --cables "$ik_cables_mm" --json | json_field pose)
+
+python3 - "$table1_pose" "$round_trip_pose" <<'PYTHON'
+import sys
+
+first, second = ([float(x) for x in arg.split(",")] for arg in sys.argv[1:3])
+difference = max(abs(a - b) for a, b in zip(first, second))
+tolerance = 1e-6
+print(f"\nLargest difference between the poses of steps 1 and 3: {difference:.1e} (tolerance {tolerance:.0e})")
+if difference > tolerance:
+    sys.exit("demo: the round trip did not reproduce the pose")
+PYTHON

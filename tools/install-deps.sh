@@ -1,0 +1,64 @@
+#!/usr/bin/env bash
+# Installs the Debian packages that a group of tasks needs, and touches nothing
+# when they are all present, so every other script can call it unconditionally.
+#
+#   bash tools/install-deps.sh [group...]     (default: base)
+#
+# Needs root only when something is missing.
+set -euo pipefail
+
+declare -A package_groups=(
+  [base]="build-essential cmake pkg-config libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev liblbfgspp-dev libgtest-dev libgmock-dev libbenchmark-dev python3"
+  # The reference implementation the GP trainer is tested and benchmarked against.
+  [sklearn]="python3-sklearn python3-numpy"
+)
+
+log_file=${CDCR_INSTALL_LOG:-/tmp/cdcr-install-deps.log}
+
+die() {
+  echo "install-deps: $*" >&2
+  exit 1
+}
+
+is_installed() {
+  [[ $(dpkg-query -W -f='${Status}' "$1" 2>/dev/null || true) == "install ok installed" ]]
+}
+
+show_log_tail_and_fail() {
+  echo "install-deps: $1 failed; last lines of $log_file:" >&2
+  tail -n 30 "$log_file" >&2
+  exit 1
+}
+
+groups=("$@")
+[[ ${#groups[@]} -gt 0 ]] || groups=(base)
+
+wanted=()
+for group in "${groups[@]}"; do
+  [[ -n ${package_groups[$group]+set} ]] ||
+    die "unknown group '$group' (known: ${!package_groups[*]})"
+  read -r -a packages <<<"${package_groups[$group]}"
+  wanted+=("${packages[@]}")
+done
+
+missing=()
+for package in "${wanted[@]}"; do
+  if ! is_installed "$package" && [[ " ${missing[*]} " != *" $package "* ]]; then
+    missing+=("$package")
+  fi
+done
+
+if [[ ${#missing[@]} -eq 0 ]]; then
+  echo "install-deps: ${groups[*]}: all packages present"
+  exit 0
+fi
+
+[[ $(id -u) -eq 0 ]] ||
+  die "missing ${missing[*]}; run as root: sudo bash tools/install-deps.sh ${groups[*]}"
+
+: >"$log_file"
+export DEBIAN_FRONTEND=noninteractive
+apt-get update >>"$log_file" 2>&1 </dev/null || show_log_tail_and_fail "apt-get update"
+apt-get install -y --no-install-recommends "${missing[@]}" >>"$log_file" 2>&1 </dev/null ||
+  show_log_tail_and_fail "apt-get install"
+echo "install-deps: ${groups[*]}: installed ${missing[*]} (log: $log_file)"
