@@ -95,10 +95,13 @@ LikelihoodResult log_marginal_likelihood(const Eigen::MatrixXd& x, const Eigen::
   if (!with_gradient) return result;
 
   // dLML/dp = 1/2 tr(W dK/dp), W = alpha alpha^T - m K^-1.
+  // K^-1 = L^-T L^-1 as a symmetric rank update on the lower triangle only,
+  // half the work of a general product; the dominant cost per evaluation.
   Eigen::MatrixXd l_inverse = Eigen::MatrixXd::Identity(n, n);
   l.triangularView<Eigen::Lower>().solveInPlace(l_inverse);
-  Eigen::MatrixXd w = -outputs * (l_inverse.transpose() * l_inverse);
-  w.noalias() += alpha * alpha.transpose();
+  Eigen::MatrixXd w = alpha * alpha.transpose();
+  w.selfadjointView<Eigen::Lower>().rankUpdate(l_inverse.transpose(), -outputs);
+  w.triangularView<Eigen::StrictlyUpper>() = w.transpose();
 
   result.gradient = Eigen::VectorXd::Zero(d + 2);
   // With a = scaled inputs and M = W .* K_signal (symmetric):

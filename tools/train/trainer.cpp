@@ -6,11 +6,6 @@ namespace cdcr::training {
 
 namespace {
 
-struct Normalisation {
-  Eigen::VectorXd input_mean, input_scale;
-  Vector6d output_mean, output_scale;
-};
-
 // A constant column (a segment never bent in the data) gets scale 1 so the
 // normalised value is simply zero.
 Eigen::VectorXd column_scale(const Eigen::MatrixXd& m, const Eigen::VectorXd& mean) {
@@ -19,20 +14,6 @@ Eigen::VectorXd column_scale(const Eigen::MatrixXd& m, const Eigen::VectorXd& me
     if (!(scale[i] > 1e-12)) scale[i] = 1.0;
   }
   return scale;
-}
-
-Normalisation normalisation_of(const TrainingSet& set) {
-  if (set.size() < 2) throw std::invalid_argument("training needs at least two samples");
-  Normalisation n;
-  n.input_mean = set.inputs.colwise().mean().transpose();
-  n.input_scale = column_scale(set.inputs, n.input_mean);
-  n.output_mean = set.error_twists.colwise().mean().transpose();
-  n.output_scale = column_scale(set.error_twists, n.output_mean);
-  return n;
-}
-
-Eigen::MatrixXd normalise(const Eigen::MatrixXd& m, const Eigen::VectorXd& mean, const Eigen::VectorXd& scale) {
-  return (m.rowwise() - mean.transpose()).array().rowwise() / scale.transpose().array();
 }
 
 TrainedModel packaged(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
@@ -49,6 +30,20 @@ TrainedModel packaged(const TrainingSet& set, const model::RobotGeometry<double>
 }
 
 }  // namespace
+
+Normalisation normalisation_of(const TrainingSet& set) {
+  if (set.size() < 2) throw std::invalid_argument("training needs at least two samples");
+  Normalisation n;
+  n.input_mean = set.inputs.colwise().mean().transpose();
+  n.input_scale = column_scale(set.inputs, n.input_mean);
+  n.output_mean = set.error_twists.colwise().mean().transpose();
+  n.output_scale = column_scale(set.error_twists, n.output_mean);
+  return n;
+}
+
+Eigen::MatrixXd normalise(const Eigen::MatrixXd& m, const Eigen::VectorXd& mean, const Eigen::VectorXd& scale) {
+  return (m.rowwise() - mean.transpose()).array().rowwise() / scale.transpose().array();
+}
 
 TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
                    const TrainingOptions& options, TrainingReport* report) {

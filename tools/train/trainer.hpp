@@ -35,6 +35,15 @@ struct TrainingReport {
   double jitter = 0.0;
 };
 
+// Inputs and outputs are standardised per column before the GP sees them.
+struct Normalisation {
+  Eigen::VectorXd input_mean, input_scale;
+  Vector6d output_mean, output_scale;
+};
+
+Normalisation normalisation_of(const TrainingSet& set);
+Eigen::MatrixXd normalise(const Eigen::MatrixXd& m, const Eigen::VectorXd& mean, const Eigen::VectorXd& scale);
+
 // Shared hyperparameters only (throws std::invalid_argument otherwise).
 TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
                    const TrainingOptions& options, TrainingReport* report = nullptr);

@@ -11,10 +11,12 @@ namespace cdcr::training {
 TrainingSet TrainingSet::subset(const std::vector<int>& rows) const {
   TrainingSet s;
   const auto n = static_cast<Eigen::Index>(rows.size());
+  s.cables_mm.resize(n, cables_mm.cols());
   s.bends.resize(n, bends.cols());
   s.inputs.resize(n, inputs.cols());
   s.error_twists.resize(n, 6);
   for (Eigen::Index i = 0; i < n; ++i) {
+    s.cables_mm.row(i) = cables_mm.row(rows[i]);
     s.bends.row(i) = bends.row(rows[i]);
     s.inputs.row(i) = inputs.row(rows[i]);
     s.error_twists.row(i) = error_twists.row(rows[i]);
@@ -45,6 +47,7 @@ TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGe
   const int n = data.sample_count();
   const int dims = 2 * geometry.segment_count;
   TrainingSet s;
+  s.cables_mm = data.cables_mm;
   s.bends.resize(n, dims);
   s.error_twists.resize(n, 6);
   for (int i = 0; i < n; ++i) {

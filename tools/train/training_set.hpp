@@ -15,6 +15,7 @@
 namespace cdcr::training {
 
 struct TrainingSet {
+  Eigen::MatrixXd cables_mm;     // samples x 4n, as commanded
   Eigen::MatrixXd bends;         // samples x 2n, stacked bend vectors
   Eigen::MatrixXd inputs;        // samples x D, encoded
   Eigen::MatrixXd error_twists;  // samples x 6

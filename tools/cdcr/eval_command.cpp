@@ -1,0 +1,76 @@
+#include "eval_command.hpp"
+
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "cdcr/model/compensated_kinematics.hpp"
+#include "cli_errors.hpp"
+#include "dataset_input.hpp"
+#include "image_input.hpp"
+#include "json_output.hpp"
+#include "train/evaluation.hpp"
+#include "train/training_set.hpp"
+
+namespace cdcr::cli {
+namespace {
+
+struct EvalCommandOptions {
+  std::string model_path;
+  std::string data_path;
+  bool json = false;
+};
+
+CommandOutput run_eval(const EvalCommandOptions& o) {
+  const LoadedImage image = load_image(o.model_path);
+  const dataset::Dataset data = load_dataset(o.data_path, true);
+  model::RobotGeometry<double> geometry;
+  if (const model::Status s = model::geometry_from_image(image.view, geometry); s != model::Status::ok) {
+    throw InputError(fmt::format("{}: geometry: {}", o.model_path, model::to_string(s)));
+  }
+  if (data.segment_count != geometry.segment_count) {
+    throw InputError(fmt::format("{} has {} segments but the model has {}", o.data_path, data.segment_count,
+                                 geometry.segment_count));
+  }
+  training::TrainingSet set;
+  std::vector<model::Pose<double>> compensated;
+  try {
+    set = training::make_training_set(data, geometry, image.view.encoding);
+    compensated = training::firmware_poses(image.view, set.cables_mm);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
+  }
+  const training::MeanErrors initial = training::mean_errors(set.measured, set.nominal);
+  const training::MeanErrors after = training::mean_errors(set.measured, compensated);
+
+  CommandOutput output;
+  if (o.json) {
+    Json j;
+    j["n"] = set.size();
+    j["initial"] = {{"position_mm", initial.position_mm}, {"orientation_deg", initial.orientation_deg}};
+    j["compensated"] = {{"position_mm", after.position_mm}, {"orientation_deg", after.orientation_deg}};
+    output.text = j.dump() + "\n";
+  } else {
+    output.text = fmt::format(
+        "{} samples                position (mm)   orientation (deg)\n"
+        "  initial (nominal)    {:13.4f}   {:17.4f}\n"
+        "  compensated          {:13.4f}   {:17.4f}\n",
+        set.size(), initial.position_mm, initial.orientation_deg, after.position_mm, after.orientation_deg);
+  }
+  return output;
+}
+
+}  // namespace
+
+void register_eval_command(CLI::App& app, CommandOutput& output) {
+  auto o = std::make_shared<EvalCommandOptions>();
+  CLI::App* command = app.add_subcommand("eval", "Mean tip errors before and after compensation by a model image");
+  command->add_option("--model", o->model_path, "Flash image written by cdcr train")->required();
+  command->add_option("--data", o->data_path, "Dataset CSV with measured poses")->required();
+  command->add_flag("--json", o->json, "Print one JSON object");
+  command->callback([o, &output] { output = run_eval(*o); });
+}
+
+}  // namespace cdcr::cli

@@ -1,0 +1,152 @@
+#include "train_command.hpp"
+
+#include <chrono>
+#include <fstream>
+#include <memory>
+#include <string>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "cli_errors.hpp"
+#include "dataset_input.hpp"
+#include "json_output.hpp"
+#include "train/pipeline.hpp"
+#include "training_options.hpp"
+
+namespace cdcr::cli {
+namespace {
+
+struct TrainCommandOptions {
+  std::string data_path;
+  std::string validation_path;
+  std::string out_path;
+  int holdout = 50;
+  GeometryOptions geometry;
+  TrainingFlags training;
+  bool json = false;
+};
+
+void write_file(const std::string& path, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream file(path, std::ios::binary | std::ios::trunc);
+  if (!file) throw InputError(fmt::format("{}: cannot open for writing", path));
+  file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+  if (!file) throw InputError(fmt::format("{}: write failed", path));
+}
+
+std::string check_mark(bool ok) { return ok ? "meets target" : "MISSES target"; }
+
+Json errors_json(const training::MeanErrors& e) {
+  Json j;
+  j["position_mm"] = e.position_mm;
+  j["orientation_deg"] = e.orientation_deg;
+  return j;
+}
+
+CommandOutput run_train(const TrainCommandOptions& o) {
+  const training::TrainingOptions options = make_training_options(o.training);
+  const dataset::Dataset data = load_dataset(o.data_path, true);
+  const model::RobotGeometry<double> geometry = geometry_for(data, o.geometry);
+
+  training::TrainingSet all;
+  training::TrainingSet train_set;
+  training::TrainingSet validation_set;
+  try {
+    all = training::make_training_set(data, geometry, options.encoding);
+    if (!o.validation_path.empty()) {
+      train_set = all;
+      validation_set = training::make_training_set(load_dataset(o.validation_path, true), geometry, options.encoding);
+    } else {
+      if (o.holdout < 1) throw InputError("--holdout must be at least 1 (or give --validation FILE)");
+      const training::Split split = training::random_split(all.size(), o.holdout, o.training.seed);
+      train_set = all.subset(split.train);
+      validation_set = all.subset(split.test);
+    }
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
+  }
+  if (train_set.size() > static_cast<int>(model::kMaxTrainingPoints)) {
+    throw InputError(fmt::format("{} training samples exceed the image capacity of {}", train_set.size(),
+                                 model::kMaxTrainingPoints));
+  }
+
+  const auto now = std::chrono::system_clock::now();
+  const auto start = std::chrono::steady_clock::now();
+  const training::ExportResult r = training::train_and_export(
+      train_set, validation_set, geometry, options, data.content_hash,
+      std::chrono::duration_cast<std::chrono::seconds>(now.time_since_epoch()).count());
+  const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+  write_file(o.out_path, r.image);
+
+  CommandOutput output;
+  const training::TrainedModel& m = r.model;
+  if (o.json) {
+    Json j;
+    j["training_samples"] = train_set.size();
+    j["validation_samples"] = validation_set.size();
+    j["encoding"] = model::to_string(m.encoding);
+    j["kernel"] = o.training.kernel;
+    j["length_scales"] = std::vector<double>(m.length_scales.data(), m.length_scales.data() + m.length_scales.size());
+    j["signal_variance"] = m.signal_variance[0];
+    j["noise_variance"] = m.noise_variance[0];
+    j["log_marginal_likelihood"] = r.report.log_marginal_likelihood;
+    j["likelihood_evaluations"] = r.report.likelihood_evaluations;
+    j["seconds"] = seconds;
+    j["validation"] = {{"initial", errors_json(r.validation.initial)},
+                       {"compensated", errors_json(r.validation.compensated)}};
+    j["float32_fidelity"] = {{"max_position_mm", r.fidelity.max_position_mm},
+                             {"mean_position_mm", r.fidelity.mean_position_mm},
+                             {"max_orientation_deg", r.fidelity.max_orientation_deg},
+                             {"mean_orientation_deg", r.fidelity.mean_orientation_deg},
+                             {"target_met", r.fidelity_met()}};
+    j["image"] = {{"path", o.out_path}, {"bytes", r.image.size()}};
+    output.text = j.dump() + "\n";
+  } else {
+    std::string t;
+    t += fmt::format("trained on {} samples, validated on {} held-out samples ({:.1f} s)\n", train_set.size(),
+                     validation_set.size(), seconds);
+    t += fmt::format("  encoding {}, kernel {} squared exponential, hyperparameters shared by the 6 outputs\n",
+                     model::to_string(m.encoding), o.training.kernel);
+    t += "  length scales (normalised inputs):";
+    for (Eigen::Index i = 0; i < m.length_scales.size(); ++i) t += fmt::format(" {:.4g}", m.length_scales[i]);
+    t += fmt::format("\n  signal variance {:.4g}, noise variance {:.4g} (normalised outputs)\n",
+                     m.signal_variance[0], m.noise_variance[0]);
+    t += fmt::format("  log marginal likelihood {:.6g} after {} evaluations\n", r.report.log_marginal_likelihood,
+                     r.report.likelihood_evaluations);
+    t += "held-out mean error          position (mm)   orientation (deg)\n";
+    t += fmt::format("  nominal model              {:13.4f}   {:17.4f}\n", r.validation.initial.position_mm,
+                     r.validation.initial.orientation_deg);
+    t += fmt::format("  compensated (double)       {:13.4f}   {:17.4f}\n", r.validation.compensated.position_mm,
+                     r.validation.compensated.orientation_deg);
+    t += fmt::format("  compensated (float32 image){:13.4f}   {:17.4f}\n", r.firmware.compensated.position_mm,
+                     r.firmware.compensated.orientation_deg);
+    t += fmt::format(
+        "float32 fidelity (image path vs double trainer, held-out): max {:.2e} mm, mean {:.2e} mm, max {:.2e} deg, "
+        "mean {:.2e} deg; target 0.01 mm / 0.001 deg: {}\n",
+        r.fidelity.max_position_mm, r.fidelity.mean_position_mm, r.fidelity.max_orientation_deg,
+        r.fidelity.mean_orientation_deg, check_mark(r.fidelity_met()));
+    t += fmt::format("wrote {} ({} bytes)\n", o.out_path, r.image.size());
+    output.text = t;
+  }
+  return output;
+}
+
+}  // namespace
+
+void register_train_command(CLI::App& app, CommandOutput& output) {
+  auto o = std::make_shared<TrainCommandOptions>();
+  CLI::App* command = app.add_subcommand("train", "Train the GP compensation model and export a flash image");
+  command->add_option("--data", o->data_path, "Training dataset CSV (cables and measured poses)")->required();
+  command->add_option("--out", o->out_path, "Flash image to write")->required();
+  command->add_option("--validation", o->validation_path,
+                      "Held-out dataset CSV for the accuracy and float32 figures (default: hold out --holdout "
+                      "samples of --data)");
+  command->add_option("--holdout", o->holdout, "Samples of --data held out when --validation is not given")
+      ->capture_default_str();
+  add_geometry_options(*command, o->geometry, "Number of segments (default: from the dataset's cable columns)");
+  add_training_flags(*command, o->training);
+  command->add_flag("--json", o->json, "Print one JSON object");
+  command->callback([o, &output] { output = run_train(*o); });
+}
+
+}  // namespace cdcr::cli

@@ -1,0 +1,80 @@
+#include "pipeline.hpp"
+
+#include <algorithm>
+#include <numeric>
+#include <random>
+#include <stdexcept>
+#include <string>
+
+#include "cdcr/model/flash_image.hpp"
+#include "export/image_writer.hpp"
+
+namespace cdcr::training {
+
+Split random_split(int samples, int test_count, std::uint64_t seed) {
+  if (test_count < 0 || test_count >= samples) {
+    throw std::invalid_argument("cannot hold out " + std::to_string(test_count) + " of " + std::to_string(samples) +
+                                " samples");
+  }
+  std::vector<int> order(static_cast<std::size_t>(samples));
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 rng(seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  Split split;
+  split.test.assign(order.begin(), order.begin() + test_count);
+  split.train.assign(order.begin() + test_count, order.end());
+  std::sort(split.test.begin(), split.test.end());
+  std::sort(split.train.begin(), split.train.end());
+  return split;
+}
+
+namespace {
+
+model::ImageMetrics metrics_of(const Evaluation& validation, const Fidelity& fidelity) {
+  model::ImageMetrics m{};
+  m.initial_position_mm = static_cast<float>(validation.initial.position_mm);
+  m.initial_orientation_deg = static_cast<float>(validation.initial.orientation_deg);
+  m.compensated_position_mm = static_cast<float>(validation.compensated.position_mm);
+  m.compensated_orientation_deg = static_cast<float>(validation.compensated.orientation_deg);
+  m.float32_max_position_diff_mm = static_cast<float>(fidelity.max_position_mm);
+  m.float32_mean_position_diff_mm = static_cast<float>(fidelity.mean_position_mm);
+  m.float32_max_orientation_diff_deg = static_cast<float>(fidelity.max_orientation_deg);
+  m.float32_mean_orientation_diff_deg = static_cast<float>(fidelity.mean_orientation_deg);
+  return m;
+}
+
+}  // namespace
+
+ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& validation_set,
+                              const model::RobotGeometry<double>& geometry, const TrainingOptions& options,
+                              std::uint64_t dataset_hash, std::int64_t created_unix_s) {
+  if (validation_set.size() < 1) throw std::invalid_argument("no held-out samples to validate the export on");
+  ExportResult r;
+  r.model = train(train_set, geometry, options, &r.report);
+  r.model.dataset_hash = dataset_hash;
+  r.model.created_unix_s = created_unix_s;
+  r.model.validation_samples = static_cast<std::uint32_t>(validation_set.size());
+
+  const Eigen::MatrixXd predicted = predict_error_twists(r.model, validation_set.bends);
+  r.validation = evaluate(validation_set, predicted);
+  const std::vector<model::Pose<double>> double_poses = compensated_poses(validation_set, predicted);
+
+  // The metrics live inside the image, so measure on a first image and
+  // write the final one with the figures; the payload is identical.
+  std::vector<std::uint8_t> image = exporting::write_image(r.model);
+  model::ImageView view{};
+  if (const model::ImageStatus s = model::parse_image(image.data(), image.size(), view); s != model::ImageStatus::ok) {
+    throw std::runtime_error(std::string("exported image does not parse: ") + model::to_string(s));
+  }
+  const std::vector<model::Pose<double>> float_poses = firmware_poses(view, validation_set.cables_mm);
+  r.fidelity = compare_poses(double_poses, float_poses);
+  r.firmware.samples = validation_set.size();
+  r.firmware.initial = r.validation.initial;
+  r.firmware.compensated = mean_errors(validation_set.measured, float_poses);
+
+  r.model.metrics = metrics_of(r.validation, r.fidelity);
+  r.image = exporting::write_image(r.model);
+  return r;
+}
+
+}  // namespace cdcr::training
