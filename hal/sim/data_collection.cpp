@@ -1,0 +1,78 @@
+#include "sim/data_collection.hpp"
+
+#include <stdexcept>
+#include <string>
+
+#include <cdcr/model/chain.hpp>
+#include <cdcr/model/compensation.hpp>
+
+namespace cdcr::sim {
+namespace {
+
+constexpr double kDegreesPerRadian = 57.295779513082320876798;
+
+model::Pose<double> nominal_pose(const model::CableVector<double>& cables_mm,
+                                 const model::RobotGeometry<double>& geometry) {
+  model::JointVector<double> joints;
+  model::Pose<double> pose;
+  model::Status status = model::joints_from_cables(cables_mm, geometry, joints);
+  if (status == model::Status::ok) status = model::forward_kinematics(joints, geometry, pose);
+  if (status != model::Status::ok) {
+    throw std::invalid_argument(std::string("nominal forward kinematics failed: ") + model::to_string(status));
+  }
+  return pose;
+}
+
+}  // namespace
+
+std::vector<CollectedSample> collect(SimulatedRobot& robot, WorkspaceSampler& sampler, int samples) {
+  if (samples < 0) throw std::invalid_argument("the sample count must not be negative");
+  std::vector<CollectedSample> result;
+  result.reserve(static_cast<std::size_t>(samples));
+  for (int i = 0; i < samples; ++i) {
+    const WorkspaceSample command = sampler.next();
+    CollectedSample sample;
+    sample.joints = command.joints;
+    sample.cables_mm = command.cables_mm;
+    sample.nominal_pose = nominal_pose(command.cables_mm, robot.nominal_geometry());
+    sample.measurement = robot.measure(command.cables_mm);
+    result.push_back(sample);
+  }
+  return result;
+}
+
+std::vector<CollectedSample> collect(SimulatedRobot& robot, int samples) {
+  WorkspaceSampler sampler(robot.nominal_geometry(), robot.config().workspace_theta_max_rad, robot.config().seed);
+  return collect(robot, sampler, samples);
+}
+
+MeanPoseError mean_pose_error(const std::vector<model::Pose<double>>& reference,
+                              const std::vector<model::Pose<double>>& poses) {
+  if (reference.size() != poses.size()) throw std::invalid_argument("pose lists differ in length");
+  MeanPoseError mean;
+  if (poses.empty()) return mean;
+  for (std::size_t i = 0; i < poses.size(); ++i) {
+    const model::PoseError<double> e = model::pose_error(reference[i], poses[i]);
+    mean.position_mm += e.position_mm;
+    mean.orientation_deg += e.orientation_rad * kDegreesPerRadian;
+  }
+  mean.position_mm /= static_cast<double>(poses.size());
+  mean.orientation_deg /= static_cast<double>(poses.size());
+  return mean;
+}
+
+CollectionSummary summarize(const std::vector<CollectedSample>& samples) {
+  std::vector<model::Pose<double>> nominal, truth, measured;
+  for (const CollectedSample& s : samples) {
+    nominal.push_back(s.nominal_pose);
+    truth.push_back(s.measurement.true_pose);
+    measured.push_back(s.measurement.measured_pose);
+  }
+  CollectionSummary summary;
+  summary.samples = static_cast<int>(samples.size());
+  summary.initial = mean_pose_error(measured, nominal);
+  summary.noise_floor = mean_pose_error(measured, truth);
+  return summary;
+}
+
+}  // namespace cdcr::sim

@@ -1,0 +1,175 @@
+#include "simulate_command.hpp"
+
+#include <algorithm>
+#include <charconv>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string_view>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <fmt/format.h>
+
+#include "cli_errors.hpp"
+#include "dataset/csv_dataset.hpp"
+#include "json_output.hpp"
+#include "sim/data_collection.hpp"
+
+namespace cdcr::cli {
+namespace {
+
+const char* on_off(bool enabled) { return enabled ? "on" : "off"; }
+
+std::uint64_t parse_seed(const std::string& text) {
+  const bool negative = !text.empty() && text.front() == '-';
+  const std::string_view digits = negative ? std::string_view(text).substr(1) : std::string_view(text);
+  std::uint64_t seed = 0;
+  const auto [stop, error] = std::from_chars(digits.data(), digits.data() + digits.size(), seed);
+  if (digits.empty() || stop != digits.data() + digits.size() ||
+      (error != std::errc() && error != std::errc::result_out_of_range)) {
+    throw UsageError(fmt::format("--seed: '{}' is not an integer", text));
+  }
+  if (negative) throw InputError(fmt::format("--seed must not be negative (got {})", text));
+  if (error == std::errc::result_out_of_range) {
+    throw InputError(
+        fmt::format("--seed must not exceed {} (got {})", std::numeric_limits<std::uint64_t>::max(), text));
+  }
+  return seed;
+}
+
+sim::SimulatorConfig make_config(const SimulateCommandOptions& options, const model::RobotGeometry<double>& geometry,
+                                std::uint64_t seed) {
+  sim::SimulatorConfig config;
+  config.seed = seed;
+  if (options.workspace_theta_max_rad) {
+    const double theta_max_rad = *options.workspace_theta_max_rad;
+    if (!std::isfinite(theta_max_rad)) {
+      throw InputError(fmt::format("--workspace-theta-max must be a finite number (got {})", theta_max_rad));
+    }
+    if (!(theta_max_rad > 0.0)) {
+      throw InputError(fmt::format("--workspace-theta-max must be positive (got {} rad)", theta_max_rad));
+    }
+    config.workspace_theta_max_rad = theta_max_rad;
+  }
+  const double design_theta_max_rad = geometry.segments[0].theta_max_rad;
+  if (!options.workspace_theta_max_rad) {
+    config.workspace_theta_max_rad = std::min(config.workspace_theta_max_rad, design_theta_max_rad);
+  } else if (config.workspace_theta_max_rad > design_theta_max_rad) {
+    throw InputError(fmt::format("--workspace-theta-max ({} rad) exceeds --theta-max ({} rad)",
+                                 config.workspace_theta_max_rad, design_theta_max_rad));
+  }
+  config.geometric.enabled = !options.no_geometric;
+  config.curvature.enabled = !options.no_curvature;
+  config.compliance.enabled = !options.no_compliance;
+  config.gravity.enabled = !options.no_gravity;
+  config.repeatability.enabled = !options.no_repeatability;
+  config.mocap_noise.enabled = !options.no_mocap_noise;
+  return config;
+}
+
+dataset::Dataset to_dataset(const std::vector<sim::CollectedSample>& samples, int segment_count) {
+  dataset::Dataset data;
+  data.segment_count = segment_count;
+  data.has_poses = true;
+  data.cables_mm.resize(static_cast<Eigen::Index>(samples.size()), 4 * segment_count);
+  data.poses.reserve(samples.size());
+  for (std::size_t i = 0; i < samples.size(); ++i) {
+    data.cables_mm.row(static_cast<Eigen::Index>(i)) = samples[i].cables_mm.transpose();
+    data.poses.push_back(samples[i].measurement.measured_pose);
+  }
+  return data;
+}
+
+std::string dataset_comment(const model::RobotGeometry<double>& geometry,
+                            const sim::SimulatorConfig& config, const sim::CollectionSummary& summary) {
+  const model::SegmentGeometry<double>& segment = geometry.segments[0];
+  return fmt::format(
+             "simulated robot (cdcr simulate): seed {}, {} samples\n"
+             "geometry: {} segments, L = {} mm, r = {} mm, theta_max = {} rad; workspace theta_max = {} rad\n"
+             "error sources: geometric {}, curvature {}, compliance {}, gravity {}, repeatability {}, mocap-noise {}\n",
+             config.seed, summary.samples, geometry.segment_count, segment.backbone_length_mm,
+             segment.anchor_radius_mm, segment.theta_max_rad, config.workspace_theta_max_rad,
+             on_off(config.geometric.enabled), on_off(config.curvature.enabled), on_off(config.compliance.enabled),
+             on_off(config.gravity.enabled), on_off(config.repeatability.enabled),
+             on_off(config.mocap_noise.enabled)) +
+         fmt::format("initial mean error (nominal model vs measured): {:.6g} mm, {:.6g} deg\n",
+                     summary.initial.position_mm, summary.initial.orientation_deg) +
+         fmt::format("noise floor (true vs measured pose): {:.6g} mm, {:.6g} deg", summary.noise_floor.position_mm,
+                     summary.noise_floor.orientation_deg);
+}
+
+}  // namespace
+
+void register_simulate_command(CLI::App& app, CommandOutput& output) {
+  auto options = std::make_shared<SimulateCommandOptions>();
+  CLI::App* command = app.add_subcommand(
+      "simulate", "Generate a dataset from the simulated robot (random workspace samples, measured poses)");
+  command->add_option("--samples", options->samples, "Number of samples")->capture_default_str();
+  command->add_option("--seed", options->seed, "Seed: a given seed is a given physical robot and data set")
+      ->type_name("UINT")
+      ->capture_default_str();
+  command->add_option("--out", options->out_path, "Write the dataset CSV to this file")->type_name("FILE");
+  command->add_option("--workspace-theta-max", options->workspace_theta_max_rad,
+                      fmt::format("Upper limit of the sampled bending angles (rad, default {} or --theta-max if smaller)",
+                                  sim::SimulatorConfig{}.workspace_theta_max_rad))
+      ->type_name("RAD");
+  add_geometry_options(*command, options->geometry, "Number of segments (default: 4)");
+  command->add_flag("--no-geometric", options->no_geometric, "Without geometric and mounting errors");
+  command->add_flag("--no-curvature", options->no_curvature, "Constant-curvature segments");
+  command->add_flag("--no-compliance", options->no_compliance, "Inextensible cables");
+  command->add_flag("--no-gravity", options->no_gravity, "Without gravity sag");
+  command->add_flag("--no-repeatability", options->no_repeatability, "Without repeatability noise");
+  command->add_flag("--no-mocap-noise", options->no_mocap_noise, "Without motion-capture noise");
+  command->add_flag("--json", options->json, "Print one JSON object instead of the summary");
+  command->callback([options, &output] { output = run_simulate(*options); });
+}
+
+CommandOutput run_simulate(const SimulateCommandOptions& options) {
+  const std::uint64_t seed = parse_seed(options.seed);
+  if (options.samples < 1 || options.samples > kMaxSimulateSampleCount) {
+    throw InputError(
+        fmt::format("--samples must be between 1 and {} (got {})", kMaxSimulateSampleCount, options.samples));
+  }
+  const model::RobotGeometry<double> geometry =
+      make_geometry(options.geometry, options.geometry.segment_count.value_or(model::kPrototypeSegmentCount));
+  const sim::SimulatorConfig config = make_config(options, geometry, seed);
+
+  std::vector<sim::CollectedSample> samples;
+  try {
+    sim::SimulatedRobot robot(geometry, config);
+    samples = sim::collect(robot, options.samples);
+  } catch (const std::invalid_argument& error) {
+    throw InputError(error.what());
+  }
+  const sim::CollectionSummary summary = sim::summarize(samples);
+
+  if (options.out_path) {
+    try {
+      dataset::write_dataset_csv(*options.out_path, to_dataset(samples, geometry.segment_count),
+                                 dataset_comment(geometry, config, summary));
+    } catch (const dataset::DatasetError& error) {
+      throw InputError(error.what());
+    }
+  }
+
+  CommandOutput output;
+  if (options.json) {
+    Json result;
+    result["samples"] = summary.samples;
+    result["initial"] = {{"position_mm", summary.initial.position_mm},
+                         {"orientation_deg", summary.initial.orientation_deg}};
+    result["noise_floor"] = {{"position_mm", summary.noise_floor.position_mm},
+                             {"orientation_deg", summary.noise_floor.orientation_deg}};
+    output.text = result.dump() + "\n";
+  } else {
+    output.text = fmt::format("samples: {}\ninitial mean error: {:.3f} mm, {:.3f} deg\nnoise floor: {:.3f} mm, {:.3f} deg\n",
+                              summary.samples, summary.initial.position_mm, summary.initial.orientation_deg,
+                              summary.noise_floor.position_mm, summary.noise_floor.orientation_deg);
+    if (options.out_path) output.text += fmt::format("dataset: {}\n", *options.out_path);
+  }
+  return output;
+}
+
+}  // namespace cdcr::cli

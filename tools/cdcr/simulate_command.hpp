@@ -1,0 +1,45 @@
+#pragma once
+// cdcr simulate: a dataset from the simulated robot, collected as in the
+// paper's experiment (Section V-B): random joint variables, cables commanded
+// through the nominal inverse, the end-platform pose as the motion-capture
+// system reports it.
+
+#include <cstdint>
+#include <optional>
+#include <string>
+
+#include "command_output.hpp"
+#include "geometry_options.hpp"
+
+namespace CLI {
+class App;
+}
+
+namespace cdcr::cli {
+
+inline constexpr int kDefaultSimulateSampleCount = 750;  // the paper's data set
+inline constexpr int kMaxSimulateSampleCount = 1000000;
+
+struct SimulateCommandOptions {
+  GeometryOptions geometry;
+  int samples = kDefaultSimulateSampleCount;
+  // Text until run_simulate parses it: the whole uint64 range is valid, and a
+  // negative or too large value must be refused rather than wrapped or clamped.
+  std::string seed = "1";
+  std::optional<double> workspace_theta_max_rad;  // unset: the simulator's default
+  std::optional<std::string> out_path;            // unset: summary only
+  bool no_geometric = false;
+  bool no_curvature = false;
+  bool no_compliance = false;
+  bool no_gravity = false;
+  bool no_repeatability = false;
+  bool no_mocap_noise = false;
+  bool json = false;
+};
+
+// Adds the `simulate` subcommand; when it is selected, parsing stores its result in `output`.
+void register_simulate_command(CLI::App& app, CommandOutput& output);
+
+CommandOutput run_simulate(const SimulateCommandOptions& options);
+
+}  // namespace cdcr::cli
