@@ -77,7 +77,8 @@ Mat4<S> hat(const Twist<S>& xi) {
 template <typename S>
 Twist<S> vee(const Mat4<S>& m) {
   Twist<S> xi;
-  xi << m.template topRightCorner<3, 1>(), vee3<S>(m.template topLeftCorner<3, 3>());
+  xi.template head<3>() = m.template topRightCorner<3, 1>();
+  xi.template tail<3>() = vee3<S>(m.template topLeftCorner<3, 3>());
   return xi;
 }
 
@@ -135,7 +136,8 @@ Twist<S> log(const Pose<S>& pose) {
   const Mat3<S> v_inverse =
       Mat3<S>::Identity() - S(0.5) * W + series::log_translation_coefficient(angle) * (W * W);
   Twist<S> xi;
-  xi << v_inverse * pose.position_mm, w;
+  xi.template head<3>() = v_inverse * pose.position_mm;
+  xi.template tail<3>() = w;
   return xi;
 }
 

@@ -10,7 +10,9 @@
 //     kinematics and Jacobians below are evaluated in b and never divide by
 //     theta.
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "cdcr/model/geometry.hpp"
 #include "cdcr/model/se3.hpp"
@@ -50,8 +52,12 @@ Status joints_from_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& ge
   const S chord = std::hypot(d31, d24);
   if (chord > reach) return Status::cable_difference_out_of_range;
   const S theta = S(2) * std::asin(chord / reach);
-  if (theta > geometry.theta_max_rad) return Status::theta_beyond_limit;
-  joints = SegmentJoints<S>{std::atan2(d24, d31), theta};
+  // Cables that cables_from_joints computed at theta = theta_max read back up
+  // to about eps * l / r above the limit (one rounding of each cable length,
+  // divided by the lever arm). That is the limit itself, not beyond it.
+  const S rounding_rad = S(16) * std::numeric_limits<S>::epsilon() * cables_mm.maxCoeff() / geometry.anchor_radius_mm;
+  if (theta > geometry.theta_max_rad + rounding_rad) return Status::theta_beyond_limit;
+  joints = SegmentJoints<S>{std::atan2(d24, d31), std::min(theta, geometry.theta_max_rad)};
   return Status::ok;
 }
 
@@ -73,8 +79,9 @@ Status cables_from_joints(const SegmentJoints<S>& joints, const SegmentGeometry<
   const S s = series::sinc(joints.theta_rad / S(2));
   const S mean = geometry.backbone_length_mm * s;
   const S r = geometry.anchor_radius_mm * s;
-  cables_mm = Vec4<S>(mean - r * b.x(), mean + r * b.y(), mean + r * b.x(), mean - r * b.y());
-  if (!(cables_mm.minCoeff() > S(0))) return Status::cable_length_not_positive;
+  const Vec4<S> cables(mean - r * b.x(), mean + r * b.y(), mean + r * b.x(), mean - r * b.y());
+  if (!(cables.minCoeff() > S(0))) return Status::cable_length_not_positive;
+  cables_mm = cables;
   return Status::ok;
 }
 
@@ -122,7 +129,8 @@ Twist<S> segment_screw_axis(const SegmentJoints<S>& joints, S backbone_length_mm
   // 1/theta - cot(theta/2)/2 = theta * log_translation_coefficient(theta)
   const S axial = t * series::log_translation_coefficient(t);
   Twist<S> xi;
-  xi << backbone_length_mm * Vec3<S>(-ca / S(2), -sa / S(2), axial), Vec3<S>(-sa, ca, S(0));
+  xi.template head<3>() = backbone_length_mm * Vec3<S>(-ca / S(2), -sa / S(2), axial);
+  xi.template tail<3>() = Vec3<S>(-sa, ca, S(0));
   return xi;
 }
 

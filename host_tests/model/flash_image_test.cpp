@@ -1,0 +1,540 @@
+// Flash image format v1 (model/flash-image-v1.md): an image written by the
+// exporter parses into a zero-copy view holding the model's values, and every
+// way an image can be wrong is refused with its own status, in the order the
+// specification's validation table gives. Damaged images are made by editing
+// a valid one; where a check sits behind the CRC, the CRC is recomputed so the
+// edit reaches that check.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <iostream>
+#include <limits>
+#include <random>
+#include <set>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cdcr/model/crc32.hpp"
+#include "cdcr/model/flash_image.hpp"
+#include "cdcr/model/gp_correction.hpp"
+#include "export/image_writer.hpp"
+#include "train/trainer.hpp"
+
+#include "../support/synthetic_trained_model.hpp"
+
+namespace cdcr::model {
+namespace {
+
+using Bytes = std::vector<std::uint8_t>;
+
+// CRC-32 computed one bit at a time straight from the polynomial, to check
+// the table-driven implementation against something that shares no code.
+std::uint32_t reference_crc32(const std::uint8_t* data, std::size_t size) {
+  std::uint32_t crc = 0xFFFFFFFFu;
+  for (std::size_t i = 0; i < size; ++i) {
+    crc ^= data[i];
+    for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ ((crc & 1u) != 0 ? 0xEDB88320u : 0u);
+  }
+  return ~crc;
+}
+
+template <typename T>
+T get(const Bytes& image, std::size_t offset) {
+  T value;
+  std::memcpy(&value, image.data() + offset, sizeof(T));
+  return value;
+}
+
+template <typename T>
+void put(Bytes& image, std::size_t offset, T value) {
+  std::memcpy(image.data() + offset, &value, sizeof(T));
+}
+
+// Recomputes the trailer for the total_size the header declares.
+void reseal(Bytes& image) {
+  const auto total = get<std::uint32_t>(image, image_field::total_size);
+  put<std::uint32_t>(image, total - kImageTrailerSize, reference_crc32(image.data(), total - kImageTrailerSize));
+}
+
+ImageStatus parse(const Bytes& image, const ImageCapacity& capacity = {}) {
+  ImageView view{};
+  return parse_image(image.data(), image.size(), view, capacity);
+}
+
+class FlashImage : public ::testing::Test {
+ protected:
+  training::TrainedModel model = test_support::synthetic_trained_model();
+  Bytes image = exporting::write_image(model);
+  ImageLayout layout = image_layout(5, 4, 2);
+
+  std::uint32_t geometry_floats() const { return 3 * 2; }
+  std::uint32_t parameter_floats() const { return image_parameter_floats(4); }
+  std::uint32_t input_floats() const { return 5 * 4; }
+  std::uint32_t alpha_floats() const { return 5 * kImageOutputs; }
+};
+
+// --- a valid image -----------------------------------------------------------
+
+TEST_F(FlashImage, LayoutIsTheOneTheDimsImply) {
+  ASSERT_EQ(image.size(), layout.total_size);
+  EXPECT_EQ(std::memcmp(image.data(), "CDGP", 4), 0);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::total_size), layout.total_size);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::geometry_offset), 64u);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::parameters_offset), layout.parameters_offset);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::inputs_offset), layout.inputs_offset);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::alpha_offset), layout.alpha_offset);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::metadata_offset), layout.metadata_offset);
+  // Each block at the next multiple of 8 after the previous one, padding zero.
+  const std::uint32_t ends[] = {64 + 4 * geometry_floats(), layout.parameters_offset + 4 * parameter_floats(),
+                                layout.inputs_offset + 4 * input_floats(), layout.alpha_offset + 4 * alpha_floats(),
+                                layout.metadata_offset + kImageMetadataSize};
+  const std::uint32_t next[] = {layout.parameters_offset, layout.inputs_offset, layout.alpha_offset,
+                                layout.metadata_offset, layout.total_size - kImageTrailerSize};
+  for (int b = 0; b < 5; ++b) {
+    EXPECT_EQ(next[b] % 8, 0u);
+    EXPECT_EQ(next[b], (ends[b] + 7) / 8 * 8) << "block " << b;
+    for (std::uint32_t i = ends[b]; i < next[b]; ++i) EXPECT_EQ(image[i], 0) << "padding byte " << i;
+  }
+}
+
+TEST_F(FlashImage, ParsesIntoAZeroCopyViewOfTheModel) {
+  ImageView view{};
+  ASSERT_EQ(parse_image(image.data(), image.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.version_minor, kImageVersionMinor);
+  EXPECT_EQ(view.total_size, image.size());
+  EXPECT_EQ(view.training_points, 5u);
+  EXPECT_EQ(view.input_dims, 4);
+  EXPECT_EQ(view.segment_count, 2);
+  EXPECT_EQ(view.encoding, InputEncoding::bend_vector);
+
+  // The arrays are the caller's bytes, not copies.
+  const auto at = [this](std::uint32_t offset) { return reinterpret_cast<const float*>(image.data() + offset); };
+  EXPECT_EQ(view.geometry, at(64));
+  EXPECT_EQ(view.input_mean, at(layout.parameters_offset));
+  EXPECT_EQ(view.inputs, at(layout.inputs_offset));
+  EXPECT_EQ(view.alpha, at(layout.alpha_offset));
+
+  for (int s = 0; s < 2; ++s) {
+    EXPECT_EQ(view.geometry[3 * s + 0], static_cast<float>(model.geometry.segments[s].backbone_length_mm));
+    EXPECT_EQ(view.geometry[3 * s + 1], static_cast<float>(model.geometry.segments[s].anchor_radius_mm));
+    EXPECT_EQ(view.geometry[3 * s + 2], static_cast<float>(model.geometry.segments[s].theta_max_rad));
+  }
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(view.input_mean[k], static_cast<float>(model.input_mean[k]));
+    EXPECT_EQ(view.input_scale[k], static_cast<float>(model.input_scale[k]));
+    EXPECT_EQ(view.length_scale[k], static_cast<float>(model.length_scales[k]));
+  }
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_EQ(view.output_mean[k], static_cast<float>(model.output_mean[k]));
+    EXPECT_EQ(view.output_scale[k], static_cast<float>(model.output_scale[k]));
+    EXPECT_EQ(view.signal_variance[k], static_cast<float>(model.signal_variance[k]));
+    EXPECT_EQ(view.noise_variance[k], static_cast<float>(model.noise_variance[k]));
+  }
+  // Inputs in kernel coordinates, computed in double and rounded once.
+  for (int i = 0; i < 5; ++i) {
+    for (int k = 0; k < 4; ++k) {
+      const double z = (model.inputs(i, k) - model.input_mean[k]) / (model.input_scale[k] * model.length_scales[k]);
+      EXPECT_EQ(view.inputs[i * 4 + k], static_cast<float>(z)) << i << "," << k;
+    }
+    for (int k = 0; k < 6; ++k) EXPECT_EQ(view.alpha[i * 6 + k], static_cast<float>(model.alpha(i, k)));
+  }
+
+  EXPECT_EQ(view.dataset_hash, model.dataset_hash);
+  EXPECT_EQ(view.created_unix_s, model.created_unix_s);
+  EXPECT_EQ(view.validation_samples, model.validation_samples);
+  EXPECT_EQ(std::memcmp(&view.metrics, &model.metrics, sizeof(ImageMetrics)), 0);
+  EXPECT_EQ(std::string(view.trainer, strnlen(view.trainer, 32)), model.trainer);
+}
+
+TEST_F(FlashImage, JointAngleEncodingIsCarried) {
+  test_support::SyntheticModelOptions options;
+  options.encoding = InputEncoding::joint_angles;
+  const Bytes joint_image = exporting::write_image(test_support::synthetic_trained_model(options));
+  ImageView view{};
+  ASSERT_EQ(parse_image(joint_image.data(), joint_image.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.encoding, InputEncoding::joint_angles);
+}
+
+TEST_F(FlashImage, TrainerNameMayFillAllThirtyTwoBytes) {
+  model.trainer = std::string(40, 'x');
+  const Bytes long_name = exporting::write_image(model);
+  ImageView view{};
+  ASSERT_EQ(parse_image(long_name.data(), long_name.size(), view), ImageStatus::ok);
+  EXPECT_EQ(std::string(view.trainer, strnlen(view.trainer, 32)), std::string(32, 'x'));
+}
+
+TEST_F(FlashImage, ChecksumIsZlibsCrc32) {
+  // The standard check value of CRC-32/ISO-HDLC, which zlib computes.
+  const std::string check = "123456789";
+  const auto* check_bytes = reinterpret_cast<const std::uint8_t*>(check.data());
+  EXPECT_EQ(reference_crc32(check_bytes, check.size()), 0xCBF43926u);
+  EXPECT_EQ(crc32(check_bytes, check.size()), 0xCBF43926u);
+  EXPECT_EQ(crc32(check_bytes + 4, 5, crc32(check_bytes, 4)), 0xCBF43926u);
+
+  const std::size_t covered = image.size() - kImageTrailerSize;
+  EXPECT_EQ(get<std::uint32_t>(image, covered), reference_crc32(image.data(), covered));
+}
+
+TEST_F(FlashImage, TrailingBytesInTheRegionAreIgnored) {
+  Bytes region = image;
+  region.resize(image.size() + 1000, 0xFF);  // erased flash
+  ImageView view{};
+  ASSERT_EQ(parse_image(region.data(), region.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.total_size, image.size());
+}
+
+TEST(FlashImageStatus, EveryStatusHasItsOwnMessage) {
+  std::set<std::string> messages;
+  for (int s = 0; s <= static_cast<int>(ImageStatus::invalid_parameters); ++s) {
+    messages.insert(to_string(static_cast<ImageStatus>(s)));
+  }
+  EXPECT_EQ(messages.size(), static_cast<std::size_t>(ImageStatus::invalid_parameters) + 1);
+}
+
+// --- rejections, in the order of the specification's table -------------------
+
+TEST_F(FlashImage, EveryPrefixIsTruncated) {
+  for (std::size_t length = 0; length < image.size(); ++length) {
+    // An exactly sized copy, so a read past the end is a read past the
+    // allocation (visible to sanitizers), not into the rest of the image.
+    const Bytes prefix(image.begin(), image.begin() + static_cast<std::ptrdiff_t>(length));
+    ASSERT_EQ(parse(prefix), ImageStatus::truncated) << "length " << length;
+  }
+  ImageView view{};
+  EXPECT_EQ(parse_image(nullptr, 0, view), ImageStatus::truncated);
+}
+
+TEST_F(FlashImage, BadMagic) {
+  for (std::size_t i = 0; i < 4; ++i) {
+    Bytes bad = image;
+    bad[i] ^= 0x20;  // "cDGP", ...: case matters
+    reseal(bad);
+    EXPECT_EQ(parse(bad), ImageStatus::bad_magic) << "byte " << i;
+  }
+}
+
+TEST_F(FlashImage, UnknownMajorVersion) {
+  for (std::uint16_t major : {0, 2, 0xFFFF}) {
+    Bytes bad = image;
+    put<std::uint16_t>(bad, image_field::version_major, major);
+    reseal(bad);
+    EXPECT_EQ(parse(bad), ImageStatus::unsupported_version) << major;
+  }
+}
+
+TEST_F(FlashImage, NewerMinorVersionIsAccepted) {
+  Bytes newer = image;
+  put<std::uint16_t>(newer, image_field::version_minor, 3);
+  reseal(newer);
+  ImageView view{};
+  ASSERT_EQ(parse_image(newer.data(), newer.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.version_minor, 3);
+}
+
+TEST_F(FlashImage, WrongHeaderSize) {
+  for (std::uint32_t size : {0u, 60u, 65u, 128u}) {
+    Bytes bad = image;
+    put<std::uint32_t>(bad, image_field::header_size, size);
+    reseal(bad);
+    EXPECT_EQ(parse(bad), ImageStatus::bad_header) << size;
+  }
+}
+
+TEST_F(FlashImage, TotalSizeTooSmallForHeaderAndTrailer) {
+  for (std::uint32_t total : {0u, 4u, 64u, 67u}) {
+    Bytes bad = image;
+    put<std::uint32_t>(bad, image_field::total_size, total);
+    EXPECT_EQ(parse(bad), ImageStatus::bad_header) << total;
+  }
+}
+
+TEST_F(FlashImage, TotalSizeBeyondTheBufferIsTruncated) {
+  Bytes bad = image;
+  put<std::uint32_t>(bad, image_field::total_size, static_cast<std::uint32_t>(image.size() + 8));
+  EXPECT_EQ(parse(bad), ImageStatus::truncated);
+}
+
+TEST_F(FlashImage, MisalignedBuffer) {
+  for (std::size_t shift = 1; shift < 8; ++shift) {
+    Bytes shifted(image.size() + shift);
+    std::memcpy(shifted.data() + shift, image.data(), image.size());
+    ImageView view{};
+    const ImageStatus status = parse_image(shifted.data() + shift, image.size(), view);
+    // 4-byte alignment is what float access needs; 8 is only preferred.
+    EXPECT_EQ(status, shift % 4 == 0 ? ImageStatus::ok : ImageStatus::misaligned) << "shift " << shift;
+  }
+}
+
+TEST_F(FlashImage, EveryDamagedByteIsRejected) {
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    for (std::uint8_t mask : {std::uint8_t{0x01}, std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
+      Bytes bad = image;
+      bad[i] ^= mask;
+      const ImageStatus status = parse(bad);
+      ASSERT_NE(status, ImageStatus::ok) << "byte " << i << " ^ " << int(mask);
+      // Beyond magic, version_major, header_size and total_size the CRC is
+      // the first check that can see the damage.
+      if (i >= 16) {
+        ASSERT_EQ(status, ImageStatus::checksum_mismatch) << "byte " << i << " ^ " << int(mask);
+      }
+    }
+  }
+}
+
+TEST_F(FlashImage, ReservedHeaderBytesMustBeZero) {
+  std::vector<std::size_t> reserved;
+  for (std::size_t i = 0; i < 3; ++i) reserved.push_back(image_field::reserved_a + i);
+  for (std::size_t i = 0; i < 8; ++i) reserved.push_back(image_field::reserved_b + i);
+  for (std::size_t offset : reserved) {
+    Bytes bad = image;
+    bad[offset] = 1;
+    EXPECT_EQ(parse(bad), ImageStatus::checksum_mismatch) << offset;
+    reseal(bad);
+    EXPECT_EQ(parse(bad), ImageStatus::bad_header) << offset;
+  }
+}
+
+TEST_F(FlashImage, UnsupportedScalarKernelOrEncoding) {
+  const std::pair<std::size_t, std::uint8_t> cases[] = {
+      {image_field::scalar_type, 0},    {image_field::scalar_type, 2},  {image_field::kernel_kind, 0},
+      {image_field::kernel_kind, 2},    {image_field::input_encoding, 0}, {image_field::input_encoding, 3},
+      {image_field::input_encoding, 0xFF}};
+  for (const auto& [offset, value] : cases) {
+    Bytes bad = image;
+    bad[offset] = value;
+    reseal(bad);
+    EXPECT_EQ(parse(bad), ImageStatus::unsupported_kind) << offset << " = " << int(value);
+  }
+}
+
+TEST_F(FlashImage, InconsistentDims) {
+  const auto edit = [this](std::size_t offset, std::uint32_t value, bool wide) {
+    Bytes bad = image;
+    if (wide) {
+      put<std::uint32_t>(bad, offset, value);
+    } else {
+      put<std::uint16_t>(bad, offset, static_cast<std::uint16_t>(value));
+    }
+    reseal(bad);
+    return parse(bad);
+  };
+  EXPECT_EQ(edit(image_field::training_points, 0, true), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::segment_count, 0, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::input_dims, 5, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::input_dims, 0, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::segment_count, 3, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::output_dims, 5, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::output_dims, 7, false), ImageStatus::bad_header);
+}
+
+TEST_F(FlashImage, OverCapacity) {
+  EXPECT_EQ(parse(image, ImageCapacity{5, 2}), ImageStatus::ok);
+  EXPECT_EQ(parse(image, ImageCapacity{4, 8}), ImageStatus::over_capacity);
+  EXPECT_EQ(parse(image, ImageCapacity{1024, 1}), ImageStatus::over_capacity);
+  EXPECT_EQ(parse(image, ImageCapacity{0, 0}), ImageStatus::over_capacity);
+}
+
+TEST_F(FlashImage, MisalignedBlockOffset) {
+  for (std::size_t field : {image_field::geometry_offset, image_field::parameters_offset, image_field::inputs_offset,
+                            image_field::alpha_offset, image_field::metadata_offset}) {
+    for (std::uint32_t shift : {1u, 4u}) {
+      Bytes bad = image;
+      put<std::uint32_t>(bad, field, get<std::uint32_t>(bad, field) + shift);
+      reseal(bad);
+      EXPECT_EQ(parse(bad), ImageStatus::misaligned) << "field " << field << " + " << shift;
+    }
+  }
+}
+
+TEST_F(FlashImage, OffsetOrSizeDisagreeingWithTheDims) {
+  for (std::size_t field : {image_field::geometry_offset, image_field::parameters_offset, image_field::inputs_offset,
+                            image_field::alpha_offset, image_field::metadata_offset}) {
+    for (std::int64_t shift : {-8, 8}) {
+      Bytes bad = image;
+      put<std::uint32_t>(bad, field, static_cast<std::uint32_t>(get<std::uint32_t>(bad, field) + shift));
+      reseal(bad);
+      EXPECT_EQ(parse(bad), ImageStatus::size_mismatch) << "field " << field << " " << shift;
+    }
+  }
+  {
+    Bytes bad = image;
+    put<std::uint32_t>(bad, image_field::metadata_size, kImageMetadataSize + 8);
+    reseal(bad);
+    EXPECT_EQ(parse(bad), ImageStatus::size_mismatch) << "metadata_size";
+  }
+  {
+    // A consistent-looking image eight bytes longer than its dims imply.
+    Bytes longer = image;
+    longer.insert(longer.end() - kImageTrailerSize, 8, 0);
+    put<std::uint32_t>(longer, image_field::total_size, static_cast<std::uint32_t>(longer.size()));
+    reseal(longer);
+    EXPECT_EQ(parse(longer), ImageStatus::size_mismatch) << "total_size";
+  }
+  {
+    // One training point fewer: the arrays no longer fill the blocks.
+    Bytes bad = image;
+    put<std::uint32_t>(bad, image_field::training_points, 4);
+    reseal(bad);
+    EXPECT_EQ(parse(bad), ImageStatus::size_mismatch) << "training_points";
+  }
+}
+
+TEST_F(FlashImage, DimsThatWrapTheLayoutArithmeticAreASizeMismatch) {
+  // N + 2^29 points of 4 inputs and 6 outputs add 2^29 * 40 bytes = 5 * 2^32:
+  // in 32-bit arithmetic the very same layout. A parser given room for such
+  // an N must not trust the wrapped sizes and read past the image.
+  Bytes bad = image;
+  put<std::uint32_t>(bad, image_field::training_points, 5u + (1u << 29));
+  reseal(bad);
+  const ImageCapacity unlimited{std::numeric_limits<std::uint32_t>::max(), std::numeric_limits<std::uint16_t>::max()};
+  EXPECT_EQ(parse(bad, unlimited), ImageStatus::size_mismatch);
+  EXPECT_EQ(parse(bad), ImageStatus::over_capacity);
+}
+
+TEST_F(FlashImage, NonFinitePayload) {
+  struct Block {
+    const char* name;
+    std::uint32_t offset;
+    std::uint32_t floats;
+  };
+  const Block blocks[] = {{"geometry", 64, geometry_floats()},
+                          {"parameters", layout.parameters_offset, parameter_floats()},
+                          {"inputs", layout.inputs_offset, input_floats()},
+                          {"alpha", layout.alpha_offset, alpha_floats()}};
+  const float poisons[] = {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity(),
+                           -std::numeric_limits<float>::infinity()};
+  for (const Block& block : blocks) {
+    for (std::uint32_t i = 0; i < block.floats; ++i) {
+      for (float poison : poisons) {
+        Bytes bad = image;
+        put<float>(bad, block.offset + 4 * i, poison);
+        reseal(bad);
+        ASSERT_EQ(parse(bad), ImageStatus::non_finite_payload) << block.name << "[" << i << "] = " << poison;
+      }
+    }
+  }
+}
+
+TEST_F(FlashImage, MetadataMetricsAreNotPayload) {
+  Bytes informational = image;
+  put<float>(informational, layout.metadata_offset + image_metadata_field::metrics,
+             std::numeric_limits<float>::quiet_NaN());
+  reseal(informational);
+  EXPECT_EQ(parse(informational), ImageStatus::ok);
+}
+
+TEST_F(FlashImage, NonPositiveParameters) {
+  const std::uint32_t p = layout.parameters_offset;
+  std::vector<std::pair<std::string, std::uint32_t>> must_be_positive;
+  for (std::uint32_t i = 0; i < geometry_floats(); ++i) must_be_positive.emplace_back("geometry", 64 + 4 * i);
+  for (std::uint32_t i = 0; i < 4; ++i) {
+    must_be_positive.emplace_back("input_scale", p + 4 * (4 + i));
+    must_be_positive.emplace_back("length_scale", p + 4 * (8 + i));
+  }
+  for (std::uint32_t k = 0; k < 6; ++k) {
+    must_be_positive.emplace_back("output_scale", p + 4 * (12 + 6 + k));
+    must_be_positive.emplace_back("signal_variance", p + 4 * (12 + 12 + k));
+    must_be_positive.emplace_back("noise_variance", p + 4 * (12 + 18 + k));
+  }
+  for (const auto& [name, offset] : must_be_positive) {
+    for (float value : {0.0f, -0.0f, -1.0f, -std::numeric_limits<float>::denorm_min()}) {
+      Bytes bad = image;
+      put<float>(bad, offset, value);
+      reseal(bad);
+      ASSERT_EQ(parse(bad), ImageStatus::invalid_parameters) << name << " at " << offset << " = " << value;
+    }
+  }
+  // Means and alpha carry a sign.
+  for (std::uint32_t offset : {p, p + 4 * 12, layout.alpha_offset}) {
+    Bytes negative = image;
+    put<float>(negative, offset, -get<float>(negative, offset) - 1.0f);
+    reseal(negative);
+    EXPECT_EQ(parse(negative), ImageStatus::ok) << offset;
+  }
+}
+
+TEST_F(FlashImage, WriterRefusesWhatTheParserWouldRefuse) {
+  training::TrainedModel bad = model;
+  bad.length_scales[1] = 0.0;
+  EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
+  bad = model;
+  bad.noise_variance[2] = 1e-50;  // positive in double, zero in float32
+  EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
+  bad = model;
+  bad.alpha(0, 0) = 1e39;  // beyond float32
+  EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
+  bad = model;
+  bad.alpha.conservativeResize(4, 6);
+  EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
+  bad = model;
+  bad.geometry.segment_count = 1;
+  EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
+}
+
+// --- the float32 run time against the double-precision trainer ----------------
+
+template <typename Accumulator>
+void expect_runtime_matches_trainer(InputEncoding encoding) {
+  test_support::SyntheticModelOptions options;
+  options.encoding = encoding;
+  options.training_points = 40;
+  const training::TrainedModel model = test_support::synthetic_trained_model(options);
+  const Bytes image = exporting::write_image(model);
+  ImageView view{};
+  ASSERT_EQ(parse_image(image.data(), image.size(), view), ImageStatus::ok);
+  GpCorrection<float, Accumulator> correction;
+  ASSERT_EQ(correction.bind(view), Status::ok);
+
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> alpha_rad(-3.0, 3.0);
+  std::uniform_real_distribution<double> theta_rad(0.05, 1.2);
+  constexpr int kQueries = 200;
+  Eigen::MatrixXd bends(kQueries, 4);
+  for (int q = 0; q < kQueries; ++q) {
+    for (int s = 0; s < 2; ++s) {
+      const double a = alpha_rad(rng);
+      const double t = theta_rad(rng);
+      bends(q, 2 * s) = t * std::cos(a);
+      bends(q, 2 * s + 1) = t * std::sin(a);
+    }
+  }
+  const Eigen::MatrixXd expected = training::predict_error_twists(model, bends);
+
+  double worst_relative = 0.0;
+  for (int q = 0; q < kQueries; ++q) {
+    const JointVector<float> bend = bends.row(q).transpose().cast<float>();
+    const Twist<float> eps = correction.predict(bend);
+    Twist<float> eps_with_gradient;
+    Jacobian<float> gradient;
+    ASSERT_EQ(correction(bend, eps_with_gradient, gradient), Status::ok);
+    for (int k = 0; k < 6; ++k) {
+      // The GP sum before output scaling is what float32 rounds; measure
+      // against its scale.
+      const double scale = model.output_scale[k] * model.signal_variance[k] + std::abs(model.output_mean[k]);
+      const double relative = std::abs(eps[k] - expected(q, k)) / scale;
+      worst_relative = std::max(worst_relative, relative);
+      EXPECT_EQ(eps[k], eps_with_gradient[k]);
+    }
+  }
+  // float32 inputs, kernel coordinates and alpha: a few ulps (6e-8) per term.
+  EXPECT_LT(worst_relative, 2e-6);
+  std::cout << "[          ] worst relative difference, " << to_string(encoding) << ": " << worst_relative << "\n";
+}
+
+TEST(FlashImageRuntime, FloatPredictionMatchesTrainerWithDoubleAccumulator) {
+  expect_runtime_matches_trainer<double>(InputEncoding::bend_vector);
+  expect_runtime_matches_trainer<double>(InputEncoding::joint_angles);
+}
+
+TEST(FlashImageRuntime, FloatPredictionMatchesTrainerWithCompensatedFloatAccumulator) {
+  expect_runtime_matches_trainer<CompensatedFloat>(InputEncoding::bend_vector);
+  expect_runtime_matches_trainer<CompensatedFloat>(InputEncoding::joint_angles);
+}
+
+}  // namespace
+}  // namespace cdcr::model
