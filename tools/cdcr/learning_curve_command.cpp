@@ -48,7 +48,11 @@ void write_text(const std::string& path, const std::string& text) {
 
 Chart make_chart(const std::vector<EncodingCurve>& curves, bool position, const std::vector<double>& noise_floor) {
   Chart chart;
-  chart.title = position ? "Residual position error vs training samples" : "Residual orientation error vs training samples";
+  // The nominal model's error is far above the curves; it goes in the title
+  // rather than on the axis, where it would flatten them.
+  const training::MeanErrors& initial = curves.front().curve.initial;
+  chart.title = position ? fmt::format("Residual position error (nominal model: {:.1f} mm)", initial.position_mm)
+                         : fmt::format("Residual orientation error (nominal model: {:.2f} deg)", initial.orientation_deg);
   chart.x_label = "Number of training samples";
   chart.y_label = position ? "Mean position error (mm)" : "Mean orientation error (deg)";
   std::vector<double> x;
@@ -63,11 +67,6 @@ Chart make_chart(const std::vector<EncodingCurve>& curves, bool position, const 
     }
     chart.series.push_back(s);
   }
-  const training::MeanErrors& initial = curves.front().curve.initial;
-  chart.series.push_back(ChartSeries{"initial (nominal)", {x.front(), x.back()},
-                                     {2, position ? initial.position_mm : initial.orientation_deg}, "#555555",
-                                     true, false});
-  chart.series.back().y[0] = chart.series.back().y[1];
   if (noise_floor.size() == 2) {
     const double v = position ? noise_floor[0] : noise_floor[1];
     chart.series.push_back(ChartSeries{"noise floor", {x.front(), x.back()}, {v, v}, "#ff7f0e", true, false});

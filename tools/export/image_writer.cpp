@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -45,6 +46,11 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   if (n < 1 || d != 2 * segments || model.alpha.rows() != n || model.alpha.cols() != model::kImageOutputs ||
       model.input_mean.size() != d || model.input_scale.size() != d || model.length_scales.size() != d) {
     throw std::invalid_argument("trained model has inconsistent dimensions");
+  }
+  // The format's offsets are 32-bit; far beyond any flash, but the layout
+  // arithmetic must not wrap.
+  if (static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(d + model::kImageOutputs) * 4 > (1ull << 31)) {
+    throw std::invalid_argument("trained model is too large for a flash image");
   }
   const model::ImageLayout layout =
       model::image_layout(static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(d),
@@ -121,6 +127,17 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
 
   const std::uint32_t checksum = model::crc32(image.data(), layout.total_size - model::kImageTrailerSize);
   image.put<std::uint32_t>(layout.total_size - model::kImageTrailerSize, checksum);
+
+  // Whatever is written must parse (a non-positive scale, for one, is only
+  // caught here). Capacity is a property of the firmware build, not of the
+  // image, so none is imposed.
+  model::ImageView view{};
+  const model::ImageCapacity any_capacity{std::numeric_limits<std::uint32_t>::max(),
+                                          std::numeric_limits<std::uint16_t>::max()};
+  if (const model::ImageStatus status = model::parse_image(image.data(), layout.total_size, view, any_capacity);
+      status != model::ImageStatus::ok) {
+    throw std::invalid_argument(std::string("trained model cannot be exported: ") + model::to_string(status));
+  }
   return image.take();
 }
 

@@ -11,7 +11,8 @@
 namespace cdcr::exporting {
 
 // Throws std::invalid_argument if the model cannot be represented (wrong
-// dims, non-finite values after conversion to float32).
+// dims, non-finite values after conversion to float32, or anything else
+// parse_image() would refuse, such as a non-positive scale).
 std::vector<std::uint8_t> write_image(const training::TrainedModel& model);
 
 }  // namespace cdcr::exporting

@@ -246,6 +246,9 @@ inline ImageStatus parse_image(const std::uint8_t* bytes, std::size_t size, Imag
   for (std::uint32_t offset : offsets) {
     if (offset % kImageBlockAlignment != 0) return ImageStatus::misaligned;
   }
+  // Under a generous capacity the 32-bit layout arithmetic below could wrap
+  // into a size that matches; dims whose arrays alone exceed the image cannot.
+  if (std::uint64_t{n} * (d + kImageOutputs) * 4 > declared_total) return ImageStatus::size_mismatch;
   const ImageLayout expected = image_layout(n, d, segments);
   if (declared_total != expected.total_size || read_u32(bytes + metadata_size) != kImageMetadataSize ||
       offsets[0] != expected.geometry_offset || offsets[1] != expected.parameters_offset ||

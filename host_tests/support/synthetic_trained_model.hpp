@@ -1,0 +1,75 @@
+#pragma once
+// A small TrainedModel with random but valid values, for the flash image,
+// exporter and CLI tests. The numbers mean nothing physically; every field
+// is distinct so a value landing in the wrong slot shows up.
+
+#include <cmath>
+#include <cstdint>
+#include <random>
+#include <string>
+
+#include <Eigen/Core>
+
+#include "train/trained_model.hpp"
+
+namespace cdcr::test_support {
+
+struct SyntheticModelOptions {
+  int training_points = 5;
+  int segments = 2;
+  model::InputEncoding encoding = model::InputEncoding::bend_vector;
+  std::uint32_t seed = 20200921;
+};
+
+inline training::TrainedModel synthetic_trained_model(const SyntheticModelOptions& options = {}) {
+  std::mt19937 rng(options.seed);
+  const auto uniform = [&rng](double low, double high) { return std::uniform_real_distribution<double>(low, high)(rng); };
+
+  training::TrainedModel m;
+  m.encoding = options.encoding;
+  m.geometry = model::RobotGeometry<double>::uniform(options.segments, 120.0, 67.0);
+  m.geometry.segments[options.segments - 1].backbone_length_mm = 95.5;  // not all segments alike
+
+  const int n = options.training_points;
+  const int d = 2 * options.segments;
+  m.inputs.resize(n, d);
+  for (int i = 0; i < n; ++i) {
+    for (int s = 0; s < options.segments; ++s) {
+      const double alpha_rad = uniform(-3.0, 3.0);
+      const double theta_rad = uniform(0.05, 1.2);
+      if (options.encoding == model::InputEncoding::bend_vector) {
+        m.inputs(i, 2 * s) = theta_rad * std::cos(alpha_rad);
+        m.inputs(i, 2 * s + 1) = theta_rad * std::sin(alpha_rad);
+      } else {
+        m.inputs(i, 2 * s) = alpha_rad;
+        m.inputs(i, 2 * s + 1) = theta_rad;
+      }
+    }
+  }
+  m.input_mean = m.inputs.colwise().mean().transpose();
+  m.input_scale.resize(d);
+  m.length_scales.resize(d);
+  for (int k = 0; k < d; ++k) {
+    m.input_scale[k] = uniform(0.3, 1.5);
+    m.length_scales[k] = uniform(0.5, 2.5);
+  }
+  for (int k = 0; k < 6; ++k) {
+    m.output_mean[k] = uniform(-2.0, 2.0);
+    m.output_scale[k] = uniform(0.1, 3.0);
+    m.signal_variance[k] = uniform(0.5, 2.0);
+    m.noise_variance[k] = uniform(1e-4, 1e-2);
+  }
+  m.alpha.resize(n, 6);
+  for (int i = 0; i < n; ++i) {
+    for (int k = 0; k < 6; ++k) m.alpha(i, k) = uniform(-1.0, 1.0);
+  }
+
+  m.dataset_hash = 0xcbf29ce484222325ull ^ options.seed;
+  m.created_unix_s = 1700000000;  // 2023-11-14T22:13:20Z
+  m.validation_samples = 70;
+  m.metrics = model::ImageMetrics{3.25f, 1.5f, 0.75f, 0.25f, 0.004f, 0.001f, 0.0005f, 0.0001f};
+  m.trainer = "cdcr-test 0.1.0";
+  return m;
+}
+
+}  // namespace cdcr::test_support

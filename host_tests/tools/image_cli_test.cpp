@@ -1,0 +1,477 @@
+// `cdcr inspect` and `cdcr export` on images written by the exporter: the
+// JSON report read back field by field against the model that made the
+// image, one damaged image per parser status with the check it must name,
+// and each export format checked against its library encoder and objcopy.
+
+#include <sys/wait.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <iterator>
+#include <ostream>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+#include <nlohmann/json.hpp>
+
+#include "cdcr/model/flash_image.hpp"
+#include "export/binary_file.hpp"
+#include "export/c_source.hpp"
+#include "export/image_writer.hpp"
+#include "image_report.hpp"
+
+#include "../support/synthetic_trained_model.hpp"
+
+namespace cdcr::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using Bytes = std::vector<std::uint8_t>;
+using nlohmann::json;
+using model::ImageStatus;
+
+std::string read_text(const fs::path& path) {
+  std::ifstream file(path, std::ios::binary);
+  return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+}
+
+template <typename T>
+void put(Bytes& image, std::size_t offset, T value) {
+  std::memcpy(image.data() + offset, &value, sizeof(T));
+}
+
+template <typename T>
+T get(const Bytes& image, std::size_t offset) {
+  T value;
+  std::memcpy(&value, image.data() + offset, sizeof(T));
+  return value;
+}
+
+// Recomputes the trailer where the header puts it, if that is inside the bytes.
+void reseal(Bytes& image) {
+  const auto total = get<std::uint32_t>(image, model::image_field::total_size);
+  if (total < 8 || total > image.size()) return;
+  put<std::uint32_t>(image, total - 4, model::crc32(image.data(), total - 4));
+}
+
+struct CliResult {
+  int exit_code = -1;
+  std::string out;
+  std::string err;
+};
+
+class ImageCli : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+    dir = fs::path(CDCR_TEST_WORK_DIR) / (std::string(info->test_suite_name()) + "." + info->name());
+    fs::remove_all(dir);
+    fs::create_directories(dir);
+  }
+
+  fs::path save(const std::string& name, const Bytes& bytes) const {
+    const fs::path path = dir / name;
+    exporting::write_binary_file(path.string(), bytes.data(), bytes.size());
+    return path;
+  }
+
+  CliResult cdcr(const std::string& arguments) const {
+    const std::string command = "'" CDCR_CLI_PATH "' " + arguments + " > '" + (dir / "stdout").string() + "' 2> '" +
+                                (dir / "stderr").string() + "'";
+    const int status = std::system(command.c_str());
+    CliResult run;
+    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+    run.out = read_text(dir / "stdout");
+    run.err = read_text(dir / "stderr");
+    return run;
+  }
+
+  static std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
+
+  fs::path dir;
+  training::TrainedModel model = test_support::synthetic_trained_model();
+  Bytes image = exporting::write_image(model);
+};
+
+bool one_line(const std::string& text) {
+  return !text.empty() && text.back() == '\n' && text.find('\n') == text.size() - 1;
+}
+
+// --- inspect: valid images ---------------------------------------------------------
+
+TEST_F(ImageCli, InspectJsonReportsTheModel) {
+  const CliResult run = cdcr("inspect --json " + quoted(save("model.img", image)));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+  ASSERT_TRUE(one_line(run.out)) << "exactly one JSON object on one line";
+  const json j = json::parse(run.out);
+
+  EXPECT_EQ(j["valid"], true);
+  EXPECT_EQ(j["status"], "ok");
+  EXPECT_TRUE(j["failed_check"].is_null());
+  EXPECT_EQ(j["file_size"], image.size());
+  for (const char* name :
+       {"size", "magic", "version", "header", "alignment", "checksum", "kind", "capacity", "layout", "finite", "positive"}) {
+    ASSERT_TRUE(j["checks"].contains(name)) << name;
+    EXPECT_EQ(j["checks"][name]["passed"], true) << name << ": " << j["checks"][name]["detail"];
+  }
+
+  const json& header = j["header"];
+  EXPECT_EQ(header["magic"], "0x50474443");
+  EXPECT_EQ(header["version_major"], 1);
+  EXPECT_EQ(header["version_minor"], 0);
+  EXPECT_EQ(header["header_size"], 64);
+  EXPECT_EQ(header["total_size"], image.size());
+  EXPECT_EQ(header["trailing_bytes"], 0);
+  char crc[16];
+  std::snprintf(crc, sizeof crc, "0x%08x", get<std::uint32_t>(image, image.size() - 4));
+  EXPECT_EQ(header["crc32_stored"], crc);
+  EXPECT_EQ(header["crc32_computed"], crc);
+
+  EXPECT_EQ(j["dims"], (json{{"training_points", 5}, {"input_dims", 4}, {"output_dims", 6}, {"segments", 2}}));
+  EXPECT_EQ(j["scalar_type"]["name"], "float32");
+  EXPECT_EQ(j["kernel"]["code"], 1);
+  EXPECT_EQ(j["input_encoding"]["name"], "bend-vector");
+
+  // Numbers are printed as the shortest decimal of the float32: reading them
+  // back as float must give the stored value exactly.
+  const auto as_float = [](const json& value) { return static_cast<float>(value.get<double>()); };
+  ASSERT_EQ(j["geometry"].size(), 2u);
+  for (int s = 0; s < 2; ++s) {
+    EXPECT_EQ(as_float(j["geometry"][s]["backbone_length_mm"]),
+              static_cast<float>(model.geometry.segments[s].backbone_length_mm));
+    EXPECT_EQ(as_float(j["geometry"][s]["theta_max_rad"]), static_cast<float>(model.geometry.segments[s].theta_max_rad));
+  }
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(as_float(j["normalisation"]["input_mean"][k]), static_cast<float>(model.input_mean[k]));
+    EXPECT_EQ(as_float(j["normalisation"]["input_scale"][k]), static_cast<float>(model.input_scale[k]));
+    EXPECT_EQ(as_float(j["hyperparameters"]["length_scales"][k]), static_cast<float>(model.length_scales[k]));
+  }
+  for (int k = 0; k < 6; ++k) {
+    EXPECT_EQ(as_float(j["normalisation"]["output_mean"][k]), static_cast<float>(model.output_mean[k]));
+    EXPECT_EQ(as_float(j["hyperparameters"]["noise_variance"][k]), static_cast<float>(model.noise_variance[k]));
+  }
+
+  const model::ImageLayout layout = model::image_layout(5, 4, 2);
+  const json expected_blocks = json::array({
+      {{"name", "header"}, {"offset", 0}, {"size", 64}, {"inside_file", true}},
+      {{"name", "geometry"}, {"offset", 64}, {"size", 24}, {"inside_file", true}},
+      {{"name", "parameters"}, {"offset", layout.parameters_offset}, {"size", 144}, {"inside_file", true}},
+      {{"name", "inputs"}, {"offset", layout.inputs_offset}, {"size", 80}, {"inside_file", true}},
+      {{"name", "alpha"}, {"offset", layout.alpha_offset}, {"size", 120}, {"inside_file", true}},
+      {{"name", "metadata"}, {"offset", layout.metadata_offset}, {"size", 88}, {"inside_file", true}},
+      {{"name", "crc32"}, {"offset", layout.total_size - 4}, {"size", 4}, {"inside_file", true}},
+  });
+  EXPECT_EQ(j["blocks"], expected_blocks);
+
+  const json& meta = j["metadata"];
+  char hash[32];
+  std::snprintf(hash, sizeof hash, "%016llx", static_cast<unsigned long long>(model.dataset_hash));
+  EXPECT_EQ(meta["dataset_hash"], hash);
+  EXPECT_EQ(meta["created_unix_s"], 1700000000);
+  EXPECT_EQ(meta["created_utc"], "2023-11-14T22:13:20Z");
+  EXPECT_EQ(meta["validation_samples"], 70);
+  EXPECT_EQ(meta["trainer"], "cdcr-test 0.1.0");
+  EXPECT_EQ(meta["metrics"]["initial_position_mm"], 3.25);
+  EXPECT_EQ(meta["metrics"]["compensated_orientation_deg"], 0.25);
+  EXPECT_EQ(as_float(meta["metrics"]["float32_max_position_diff_mm"]), 0.004f);
+  EXPECT_EQ(as_float(meta["metrics"]["float32_mean_orientation_diff_deg"]), 0.0001f);
+}
+
+TEST_F(ImageCli, InspectTextShowsEveryCheck) {
+  const CliResult run = cdcr("inspect " + quoted(save("model.img", image)));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+  for (const char* expected :
+       {"  magic               0x50474443 (CDGP)\n", "  version             1.0\n", "  training points     5\n",
+        "  segments            2\n", "  input encoding      2 (bend-vector)\n",
+        "  created             2023-11-14T22:13:20Z (unix 1700000000)\n", "  trainer             \"cdcr-test 0.1.0\"\n",
+        "  checksum    pass", "  capacity    pass", "  positive    pass", "\nvalid\n"}) {
+    EXPECT_NE(run.out.find(expected), std::string::npos) << expected << "\n--- output ---\n" << run.out;
+  }
+  EXPECT_EQ(run.out.find("FAIL"), std::string::npos);
+}
+
+TEST_F(ImageCli, TrailingBytesAreReportedNotRefused) {
+  Bytes region = image;
+  region.resize(image.size() + 100, 0xFF);
+  const CliResult run = cdcr("inspect --json " + quoted(save("region.img", region)));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["valid"], true);
+  EXPECT_EQ(j["header"]["trailing_bytes"], 100);
+  EXPECT_EQ(j["file_size"], image.size() + 100);
+}
+
+// --- inspect: damaged images -------------------------------------------------------
+
+TEST_F(ImageCli, InspectOfAFlippedByteStillShowsTheImage) {
+  Bytes flipped = image;
+  flipped[model::image_layout(5, 4, 2).alpha_offset + 3] ^= 0x40;
+  const CliResult run = cdcr("inspect --json " + quoted(save("flipped.img", flipped)));
+  EXPECT_EQ(run.exit_code, 1);
+  ASSERT_TRUE(one_line(run.err)) << run.err;
+  EXPECT_NE(run.err.find("checksum_mismatch"), std::string::npos) << run.err;
+  ASSERT_TRUE(one_line(run.out));
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["valid"], false);
+  EXPECT_EQ(j["status"], "checksum_mismatch");
+  EXPECT_EQ(j["failed_check"], "checksum");
+  EXPECT_EQ(j["checks"]["checksum"]["passed"], false);
+  EXPECT_EQ(j["checks"]["magic"]["passed"], true);
+  EXPECT_EQ(j["checks"]["finite"]["passed"], true);
+  EXPECT_NE(j["header"]["crc32_stored"], j["header"]["crc32_computed"]);
+  EXPECT_EQ(j["dims"]["training_points"], 5);
+  EXPECT_EQ(j["metadata"]["trainer"], "cdcr-test 0.1.0");
+}
+
+TEST_F(ImageCli, InspectOfATruncatedImage) {
+  const Bytes truncated(image.begin(), image.end() - 10);
+  const CliResult text = cdcr("inspect " + quoted(save("truncated.img", truncated)));
+  EXPECT_EQ(text.exit_code, 1);
+  ASSERT_TRUE(one_line(text.err)) << text.err;
+  EXPECT_NE(text.err.find("(truncated)"), std::string::npos) << text.err;
+  EXPECT_NE(text.out.find("  size        FAIL"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("  checksum    not checked"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("invalid: size check failed (truncated: "), std::string::npos) << text.out;
+
+  // Without only its trailer, everything but the checksum can still be shown.
+  const CliResult run = cdcr("inspect --json " + quoted(save("no_trailer.img", Bytes(image.begin(), image.end() - 4))));
+  EXPECT_EQ(run.exit_code, 1);
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["status"], "truncated");
+  EXPECT_EQ(j["failed_check"], "size");
+  EXPECT_TRUE(j["checks"]["checksum"]["passed"].is_null());
+  EXPECT_EQ(j["metadata"]["trainer"], "cdcr-test 0.1.0");
+  EXPECT_EQ(j["checks"]["finite"]["passed"], true);
+  EXPECT_EQ(j["blocks"].back()["name"], "crc32");
+  EXPECT_EQ(j["blocks"].back()["inside_file"], false);
+}
+
+TEST_F(ImageCli, InspectOfAFileShorterThanAHeader) {
+  const CliResult run = cdcr("inspect --json " + quoted(save("short.img", Bytes(image.begin(), image.begin() + 20))));
+  EXPECT_EQ(run.exit_code, 1);
+  ASSERT_TRUE(one_line(run.err));
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["status"], "truncated");
+  EXPECT_EQ(j["header"]["magic"], "0x50474443");
+  EXPECT_EQ(j["header"]["version_major"], 1);
+  EXPECT_TRUE(j["dims"].is_null());
+  EXPECT_EQ(j["checks"]["magic"]["passed"], true);
+  EXPECT_TRUE(j["checks"]["header"]["passed"].is_null());
+}
+
+TEST_F(ImageCli, InspectOfAMissingFile) {
+  const CliResult run = cdcr("inspect " + quoted(dir / "missing.img"));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_TRUE(one_line(run.err)) << run.err;
+  EXPECT_EQ(run.out, "");
+}
+
+// Each damaged image: the report's status is the parser's, and the check it
+// names has failed.
+struct Damage {
+  const char* name;
+  ImageStatus status;
+  const char* check;
+};
+
+void PrintTo(const Damage& d, std::ostream* os) { *os << d.name; }
+
+class ImageReportDamage : public ImageCli, public ::testing::WithParamInterface<Damage> {
+ protected:
+  Bytes damaged(const std::string& name) const {
+    using namespace model::image_field;
+    const model::ImageLayout layout = model::image_layout(5, 4, 2);
+    Bytes bad = image;
+    if (name == "short") return Bytes(image.begin(), image.begin() + 40);
+    if (name == "truncated") return Bytes(image.begin(), image.end() - 1);
+    if (name == "magic") bad[0] = 'X';
+    if (name == "version") put<std::uint16_t>(bad, version_major, 2);
+    if (name == "header_size") put<std::uint32_t>(bad, header_size, 32);
+    if (name == "reserved") bad[reserved_b + 3] = 7;
+    if (name == "dims") put<std::uint16_t>(bad, input_dims, 3);
+    if (name == "offset_alignment") put<std::uint32_t>(bad, alpha_offset, layout.alpha_offset + 4);
+    if (name == "checksum") bad[layout.inputs_offset] ^= 1;
+    if (name == "kind") bad[kernel_kind] = 9;
+    if (name == "layout") put<std::uint32_t>(bad, metadata_offset, layout.metadata_offset + 8);
+    if (name == "nan") put<float>(bad, layout.inputs_offset + 8, std::numeric_limits<float>::quiet_NaN());
+    if (name == "zero_scale") put<float>(bad, layout.parameters_offset + 4 * 5, 0.0f);
+    if (name == "negative_radius") put<float>(bad, 64 + 4, -67.0f);
+    if (name != "checksum") reseal(bad);
+    return bad;
+  }
+};
+
+TEST_P(ImageReportDamage, NamesTheParsersStatusAndCheck) {
+  const Damage d = GetParam();
+  Bytes bytes;
+  if (std::string(d.name) == "capacity") {
+    test_support::SyntheticModelOptions options;
+    options.training_points = static_cast<int>(model::kMaxTrainingPoints) + 1;
+    options.segments = 1;
+    bytes = exporting::write_image(test_support::synthetic_trained_model(options));
+  } else {
+    bytes = damaged(d.name);
+  }
+  model::ImageView view{};
+  ASSERT_EQ(model::parse_image(bytes.data(), bytes.size(), view), d.status);
+
+  const ImageReport report = inspect_image(bytes.data(), bytes.size());
+  EXPECT_EQ(report.status, d.status);
+  ASSERT_NE(report.failed_check(), nullptr);
+  EXPECT_STREQ(report.failed_check()->name, d.check);
+  EXPECT_EQ(report.failed_check()->result, CheckResult::failed) << report.failed_check()->detail;
+
+  const CliResult run = cdcr("inspect --json " + quoted(save("damaged.img", bytes)));
+  EXPECT_EQ(run.exit_code, 1);
+  ASSERT_TRUE(one_line(run.err)) << run.err;
+  EXPECT_NE(run.err.find(std::string("(") + image_status_name(d.status) + ")"), std::string::npos) << run.err;
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["status"], image_status_name(d.status));
+  EXPECT_EQ(j["failed_check"], d.check);
+  EXPECT_EQ(j["checks"][d.check]["passed"], false);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    EveryStatus, ImageReportDamage,
+    ::testing::Values(Damage{"short", ImageStatus::truncated, "size"},
+                      Damage{"truncated", ImageStatus::truncated, "size"},
+                      Damage{"magic", ImageStatus::bad_magic, "magic"},
+                      Damage{"version", ImageStatus::unsupported_version, "version"},
+                      Damage{"header_size", ImageStatus::bad_header, "header"},
+                      Damage{"reserved", ImageStatus::bad_header, "header"},
+                      Damage{"dims", ImageStatus::bad_header, "header"},
+                      Damage{"offset_alignment", ImageStatus::misaligned, "alignment"},
+                      Damage{"checksum", ImageStatus::checksum_mismatch, "checksum"},
+                      Damage{"kind", ImageStatus::unsupported_kind, "kind"},
+                      Damage{"capacity", ImageStatus::over_capacity, "capacity"},
+                      Damage{"layout", ImageStatus::size_mismatch, "layout"},
+                      Damage{"nan", ImageStatus::non_finite_payload, "finite"},
+                      Damage{"zero_scale", ImageStatus::invalid_parameters, "positive"},
+                      Damage{"negative_radius", ImageStatus::invalid_parameters, "positive"}),
+    [](const ::testing::TestParamInfo<Damage>& info) { return std::string(info.param.name); });
+
+// The report evaluates every check on its own; on any prefix or single
+// damaged byte its failed check must be the parser's without being told.
+TEST_F(ImageCli, ReportFindsTheParsersFailureOnItsOwn) {
+  const auto expect_agreement = [](const Bytes& bytes, const std::string& what) {
+    model::ImageView view{};
+    const ImageStatus status = model::parse_image(bytes.data(), bytes.size(), view);
+    const ImageReport report = inspect_image(bytes.data(), bytes.size());
+    ASSERT_EQ(report.status, status) << what;
+    if (status == ImageStatus::ok) {
+      for (const ImageCheck& check : report.checks) EXPECT_EQ(check.result, CheckResult::passed) << what << " " << check.name;
+      return;
+    }
+    ASSERT_NE(report.failed_check(), nullptr) << what;
+    EXPECT_EQ(report.failed_check()->detail.find(kParserVerdict), std::string::npos)
+        << what << ": " << report.failed_check()->name << ": " << report.failed_check()->detail;
+  };
+  for (std::size_t length = 0; length <= image.size(); ++length) {
+    expect_agreement(Bytes(image.begin(), image.begin() + static_cast<std::ptrdiff_t>(length)),
+                     "prefix " + std::to_string(length));
+  }
+  for (std::size_t i = 0; i < image.size(); ++i) {
+    for (std::uint8_t mask : {std::uint8_t{0x01}, std::uint8_t{0x80}, std::uint8_t{0xFF}}) {
+      Bytes bad = image;
+      bad[i] ^= mask;
+      expect_agreement(bad, "byte " + std::to_string(i) + " ^ " + std::to_string(mask));
+      reseal(bad);  // past the CRC to the checks behind it
+      expect_agreement(bad, "resealed byte " + std::to_string(i) + " ^ " + std::to_string(mask));
+    }
+  }
+}
+
+TEST(ImageStatusNames, AreDistinctIdentifiers) {
+  std::vector<std::string> names;
+  for (int s = 0; s <= static_cast<int>(ImageStatus::invalid_parameters); ++s) {
+    const std::string name = image_status_name(static_cast<ImageStatus>(s));
+    EXPECT_EQ(name.find_first_not_of("abcdefghijklmnopqrstuvwxyz_"), std::string::npos) << name;
+    for (const std::string& other : names) EXPECT_NE(name, other);
+    names.push_back(name);
+  }
+}
+
+// --- export ------------------------------------------------------------------------
+
+TEST_F(ImageCli, ExportBinaryWritesOnlyTheImage) {
+  Bytes region = image;
+  region.resize(image.size() + 64, 0xFF);
+  const fs::path out = dir / "model.bin";
+  const CliResult run = cdcr("export --model " + quoted(save("region.img", region)) + " --format bin --out " + quoted(out));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.err, "");
+  EXPECT_TRUE(one_line(run.out)) << run.out;
+  EXPECT_EQ(exporting::read_binary_file(out.string()), image);
+}
+
+TEST_F(ImageCli, ExportHexDecodesToTheImage) {
+#ifndef CDCR_OBJCOPY
+  GTEST_SKIP() << "objcopy not found";
+#else
+  const fs::path out = dir / "model.hex";
+  const CliResult run = cdcr("export --model " + quoted(save("model.img", image)) +
+                       " --format hex --base-address 0x08040000 --record-bytes 32 --out " + quoted(out));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("0x08040000"), std::string::npos) << run.out;
+  const std::string text = read_text(out);
+  EXPECT_EQ(text.rfind(":020000040804EE\n", 0), 0u) << text.substr(0, 40);
+  const std::string decode = "'" CDCR_OBJCOPY "' -I ihex -O binary " + quoted(out) + " " + quoted(dir / "decoded.bin");
+  ASSERT_EQ(std::system(decode.c_str()), 0);
+  EXPECT_EQ(exporting::read_binary_file((dir / "decoded.bin").string()), image);
+#endif
+}
+
+TEST_F(ImageCli, ExportCSourceUsesTheChosenNames) {
+  const fs::path out = dir / "model.c";
+  const CliResult run = cdcr("export --model " + quoted(save("model.img", image)) +
+                       " --format c --symbol arm_model --section .arm_model_flash --out " + quoted(out));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  exporting::CSourceOptions options;
+  options.symbol = "arm_model";
+  options.section = ".arm_model_flash";
+  options.description = "Exported from " + (dir / "model.img").string() + " by cdcr export.";
+  EXPECT_EQ(read_text(out), exporting::format_c_source(image.data(), image.size(), options));
+}
+
+TEST_F(ImageCli, ExportRefusesAnInvalidImageAndWritesNothing) {
+  Bytes flipped = image;
+  flipped[100] ^= 0xFF;
+  const fs::path model_path = save("flipped.img", flipped);
+  for (const char* format : {"bin", "hex", "c"}) {
+    const fs::path out = dir / (std::string("out.") + format);
+    const CliResult run = cdcr("export --model " + quoted(model_path) + " --format " + format + " --out " + quoted(out));
+    EXPECT_EQ(run.exit_code, 1) << format;
+    EXPECT_TRUE(one_line(run.err)) << run.err;
+    EXPECT_NE(run.err.find("checksum_mismatch"), std::string::npos) << run.err;
+    EXPECT_EQ(run.out, "");
+    EXPECT_FALSE(fs::exists(out)) << format;
+  }
+}
+
+TEST_F(ImageCli, ExportUsageErrors) {
+  const std::string model_path = quoted(save("model.img", image));
+  const std::string out = " --out " + quoted(dir / "out");
+  for (const std::string& arguments :
+       {"--format elf" + out, "--format bin --base-address 0x1000" + out, "--format hex --symbol name" + out,
+        "--format hex --base-address 0x0804zz" + out, "--format c --symbol 9lives" + out,
+        "--format hex --record-bytes 20" + out, "--format c --section 'a b'" + out, std::string("--format bin")}) {
+    const CliResult run = cdcr("export --model " + model_path + " " + arguments);
+    EXPECT_EQ(run.exit_code, 2) << arguments << ": " << run.err;
+    EXPECT_TRUE(one_line(run.err)) << run.err;
+  }
+  const CliResult beyond = cdcr("export --model " + model_path + " --format hex --base-address 0xFFFFFF00" + out);
+  EXPECT_EQ(beyond.exit_code, 1) << beyond.err;
+  EXPECT_TRUE(one_line(beyond.err)) << beyond.err;
+}
+
+}  // namespace
+}  // namespace cdcr::cli

@@ -1,0 +1,107 @@
+#pragma once
+// Everything `cdcr inspect` can say about a flash image, including a damaged
+// one: each field is read only if it lies inside the file, and each of the
+// parser's checks is evaluated on its own, so a report shows every problem
+// rather than only the first. The verdict itself is the shared parser's
+// (model::parse_image with the firmware's compile-time capacity).
+
+#include <array>
+#include <cstddef>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cdcr/model/flash_image.hpp"
+
+namespace cdcr::cli {
+
+// The enumerator's name, e.g. "checksum_mismatch": stable for scripts,
+// unlike the message of model::to_string().
+const char* image_status_name(model::ImageStatus status);
+
+enum class CheckResult { passed, failed, not_checked };
+
+struct ImageCheck {
+  const char* name;  // size, magic, version, header, alignment, checksum, kind, capacity, layout, finite, positive
+  CheckResult result = CheckResult::not_checked;
+  std::string detail;
+};
+
+// Starts a check's detail when only the parser saw the failure.
+inline constexpr const char* kParserVerdict = "the parser reports: ";
+
+// The check that a parser status reports, e.g. "checksum" for
+// checksum_mismatch; nullptr for ok.
+const char* check_for_status(model::ImageStatus status);
+
+struct ImageHeaderFields {
+  std::uint32_t magic = 0;
+  std::uint16_t version_major = 0;
+  std::uint16_t version_minor = 0;
+  std::uint32_t header_size = 0;
+  std::uint32_t total_size = 0;
+  std::uint32_t training_points = 0;
+  std::uint16_t input_dims = 0;
+  std::uint16_t output_dims = 0;
+  std::uint16_t segment_count = 0;
+  std::uint8_t scalar_type = 0;
+  std::uint8_t kernel_kind = 0;
+  std::uint8_t input_encoding = 0;
+  std::uint32_t geometry_offset = 0;
+  std::uint32_t parameters_offset = 0;
+  std::uint32_t inputs_offset = 0;
+  std::uint32_t alpha_offset = 0;
+  std::uint32_t metadata_offset = 0;
+  std::uint32_t metadata_size = 0;
+};
+
+// A block where the header says it is, with the size the dims imply.
+struct ImageBlock {
+  const char* name;
+  std::uint64_t offset;
+  std::uint64_t size;
+  bool inside_file;
+};
+
+struct ImageParameters {
+  std::vector<float> input_mean, input_scale, length_scale;        // D each
+  std::vector<float> output_mean, output_scale;                    // 6 each
+  std::vector<float> signal_variance, noise_variance;              // 6 each
+};
+
+struct ImageMetadata {
+  std::uint64_t dataset_hash = 0;
+  std::int64_t created_unix_s = 0;
+  std::uint32_t validation_samples = 0;
+  model::ImageMetrics metrics{};
+  std::string trainer;  // non-printable bytes escaped as \xNN
+};
+
+struct ImageReport {
+  std::size_t file_size = 0;
+  model::ImageStatus status = model::ImageStatus::truncated;
+
+  std::optional<std::uint32_t> magic;          // from 4 bytes on
+  std::optional<std::uint16_t> version_major;  // from 6 bytes on
+  std::optional<ImageHeaderFields> header;     // from 64 bytes on
+  std::optional<std::uint32_t> stored_crc;     // when total_size lies inside the file
+  std::optional<std::uint32_t> computed_crc;
+  std::optional<std::uint64_t> trailing_bytes;
+
+  std::vector<ImageBlock> blocks;
+  std::optional<std::vector<std::array<float, 3>>> geometry;  // per segment: length_mm, radius_mm, theta_max_rad
+  std::optional<ImageParameters> parameters;
+  std::optional<float> max_abs_input;  // kernel coordinates
+  std::optional<float> max_abs_alpha;
+  std::optional<ImageMetadata> metadata;
+
+  std::vector<ImageCheck> checks;  // in the parser's order
+
+  bool valid() const { return status == model::ImageStatus::ok; }
+  const ImageCheck* failed_check() const;
+};
+
+ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size);
+
+}  // namespace cdcr::cli
