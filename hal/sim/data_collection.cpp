@@ -42,7 +42,8 @@ std::vector<CollectedSample> collect(SimulatedRobot& robot, WorkspaceSampler& sa
 }
 
 std::vector<CollectedSample> collect(SimulatedRobot& robot, int samples) {
-  WorkspaceSampler sampler(robot.nominal_geometry(), robot.config().workspace_theta_max_rad, robot.config().seed);
+  WorkspaceSampler sampler(robot.nominal_geometry(), robot.config().workspace_theta_max_rad,
+                           robot.config().session_seed());
   return collect(robot, sampler, samples);
 }
 

@@ -23,7 +23,7 @@ constexpr double kGravityToleranceRad = 1e-13;
 }  // namespace
 
 SimulatedRobot::SimulatedRobot(const model::RobotGeometry<double>& nominal, const SimulatorConfig& config)
-    : nominal_(nominal), config_(config), noise_(config.seed, StreamId::noise) {
+    : nominal_(nominal), config_(config), noise_(config.session_seed(), StreamId::noise) {
   if (const model::Status status = nominal.validate(); status != model::Status::ok) {
     throw std::invalid_argument(std::string("invalid nominal geometry: ") + model::to_string(status));
   }

@@ -130,6 +130,14 @@ struct MocapNoiseConfig {
 
 struct SimulatorConfig {
   std::uint64_t seed = 1;
+  // A data-collection session on the same robot: the robot's imperfections
+  // come from `seed` alone, the sampled configurations and the noise from
+  // (seed, session). Session 0 is the default data set; another session gives
+  // an independent test set of the same physical robot.
+  std::uint64_t session = 0;
+
+  // The seed of the workspace and noise streams.
+  std::uint64_t session_seed() const { return session == 0 ? seed : seed ^ (session * 0x9E3779B97F4A7C15ull); }
   // Upper limit of theta for the workspace sampler (alpha is uniform in
   // [-pi, pi], theta uniform in [0, this]). The design limit pi/2 is a
   // mechanical bound, not what the experiment sampled: the only

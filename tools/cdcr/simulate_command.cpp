@@ -43,6 +43,8 @@ sim::SimulatorConfig make_config(const SimulateCommandOptions& options, const mo
                                 std::uint64_t seed) {
   sim::SimulatorConfig config;
   config.seed = seed;
+  if (options.session < 0) throw InputError(fmt::format("--session must not be negative (got {})", options.session));
+  config.session = static_cast<std::uint64_t>(options.session);
   if (options.workspace_theta_max_rad) {
     const double theta_max_rad = *options.workspace_theta_max_rad;
     if (!std::isfinite(theta_max_rad)) {
@@ -86,10 +88,10 @@ std::string dataset_comment(const model::RobotGeometry<double>& geometry,
                             const sim::SimulatorConfig& config, const sim::CollectionSummary& summary) {
   const model::SegmentGeometry<double>& segment = geometry.segments[0];
   return fmt::format(
-             "simulated robot (cdcr simulate): seed {}, {} samples\n"
+             "simulated robot (cdcr simulate): seed {}, session {}, {} samples\n"
              "geometry: {} segments, L = {} mm, r = {} mm, theta_max = {} rad; workspace theta_max = {} rad\n"
              "error sources: geometric {}, curvature {}, compliance {}, gravity {}, repeatability {}, mocap-noise {}\n",
-             config.seed, summary.samples, geometry.segment_count, segment.backbone_length_mm,
+             config.seed, config.session, summary.samples, geometry.segment_count, segment.backbone_length_mm,
              segment.anchor_radius_mm, segment.theta_max_rad, config.workspace_theta_max_rad,
              on_off(config.geometric.enabled), on_off(config.curvature.enabled), on_off(config.compliance.enabled),
              on_off(config.gravity.enabled), on_off(config.repeatability.enabled),
@@ -109,6 +111,9 @@ void register_simulate_command(CLI::App& app, CommandOutput& output) {
   command->add_option("--samples", options->samples, "Number of samples")->capture_default_str();
   command->add_option("--seed", options->seed, "Seed: a given seed is a given physical robot and data set")
       ->type_name("UINT")
+      ->capture_default_str();
+  command->add_option("--session", options->session,
+                      "Data-collection session on the same robot: another session gives an independent test set")
       ->capture_default_str();
   command->add_option("--out", options->out_path, "Write the dataset CSV to this file")->type_name("FILE");
   command->add_option("--workspace-theta-max", options->workspace_theta_max_rad,

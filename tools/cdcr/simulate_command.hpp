@@ -26,6 +26,7 @@ struct SimulateCommandOptions {
   // Text until run_simulate parses it: the whole uint64 range is valid, and a
   // negative or too large value must be refused rather than wrapped or clamped.
   std::string seed = "1";
+  int session = 0;
   std::optional<double> workspace_theta_max_rad;  // unset: the simulator's default
   std::optional<std::string> out_path;            // unset: summary only
   bool no_geometric = false;

@@ -51,12 +51,24 @@ Evaluation evaluate(const TrainingSet& set, const Eigen::MatrixXd& predicted_err
   return e;
 }
 
-std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
+const char* to_string(FirmwareAccumulator accumulator) {
+  switch (accumulator) {
+    case FirmwareAccumulator::float64: return "double accumulators";
+    case FirmwareAccumulator::compensated_float32: return "compensated float accumulators";
+    case FirmwareAccumulator::float32: return "plain float accumulators";
+  }
+  return "unknown";
+}
+
+namespace {
+
+template <typename Accumulator>
+std::vector<model::Pose<double>> firmware_poses_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
   model::RobotGeometry<float> geometry;
   if (const model::Status s = model::geometry_from_image(image, geometry); s != model::Status::ok) {
     throw std::invalid_argument(std::string("image geometry: ") + model::to_string(s));
   }
-  model::GpCorrection<float> correction;
+  model::GpCorrection<float, Accumulator> correction;
   if (const model::Status s = correction.bind(image); s != model::Status::ok) {
     throw std::invalid_argument(std::string("image: ") + model::to_string(s));
   }
@@ -72,6 +84,21 @@ std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, c
     poses.push_back(result.compensated.cast<double>());
   }
   return poses;
+}
+
+}  // namespace
+
+std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
+                                                FirmwareAccumulator accumulator) {
+  switch (accumulator) {
+    case FirmwareAccumulator::compensated_float32:
+      return firmware_poses_with<model::CompensatedFloat>(image, cables_mm);
+    case FirmwareAccumulator::float32:
+      return firmware_poses_with<float>(image, cables_mm);
+    case FirmwareAccumulator::float64:
+      break;
+  }
+  return firmware_poses_with<double>(image, cables_mm);
 }
 
 }  // namespace cdcr::training

@@ -31,9 +31,19 @@ std::vector<model::Pose<double>> compensated_poses(const TrainingSet& set, const
 
 Evaluation evaluate(const TrainingSet& set, const Eigen::MatrixXd& predicted_error_twists);
 
+// How the firmware's GP sums its N terms (model::GpCorrection's Accumulator).
+enum class FirmwareAccumulator {
+  float64,             // FPUs with double support: host, Cortex-M7
+  compensated_float32, // single-precision FPUs: Cortex-M4F
+  float32,             // naive single precision, for comparison only
+};
+
+const char* to_string(FirmwareAccumulator accumulator);
+
 // The firmware's forward path in float32 (model::compensated_forward on the
 // parsed image) over the samples' commanded cables.
-std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm);
+std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
+                                                FirmwareAccumulator accumulator = FirmwareAccumulator::float64);
 
 struct Fidelity {
   double max_position_mm = 0.0;

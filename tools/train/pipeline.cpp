@@ -66,11 +66,22 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   if (const model::ImageStatus s = model::parse_image(image.data(), image.size(), view); s != model::ImageStatus::ok) {
     throw std::runtime_error(std::string("exported image does not parse: ") + model::to_string(s));
   }
-  const std::vector<model::Pose<double>> float_poses = firmware_poses(view, validation_set.cables_mm);
-  r.fidelity = compare_poses(double_poses, float_poses);
-  r.firmware.samples = validation_set.size();
-  r.firmware.initial = r.validation.initial;
-  r.firmware.compensated = mean_errors(validation_set.measured, float_poses);
+  for (const FirmwareAccumulator accumulator :
+       {FirmwareAccumulator::float64, FirmwareAccumulator::compensated_float32, FirmwareAccumulator::float32}) {
+    const std::vector<model::Pose<double>> float_poses = firmware_poses(view, validation_set.cables_mm, accumulator);
+    const Fidelity f = compare_poses(double_poses, float_poses);
+    r.fidelity_by_accumulator.emplace_back(accumulator, f);
+    if (accumulator == FirmwareAccumulator::float32) continue;  // no firmware build sums this way
+    r.fidelity.max_position_mm = std::max(r.fidelity.max_position_mm, f.max_position_mm);
+    r.fidelity.mean_position_mm = std::max(r.fidelity.mean_position_mm, f.mean_position_mm);
+    r.fidelity.max_orientation_deg = std::max(r.fidelity.max_orientation_deg, f.max_orientation_deg);
+    r.fidelity.mean_orientation_deg = std::max(r.fidelity.mean_orientation_deg, f.mean_orientation_deg);
+    if (accumulator == FirmwareAccumulator::float64) {
+      r.firmware.samples = validation_set.size();
+      r.firmware.initial = r.validation.initial;
+      r.firmware.compensated = mean_errors(validation_set.measured, float_poses);
+    }
+  }
 
   r.model.metrics = metrics_of(r.validation, r.fidelity);
   r.image = exporting::write_image(r.model);

@@ -4,6 +4,7 @@
 // double-precision trainer on the same held-out samples.
 
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "evaluation.hpp"
@@ -29,13 +30,15 @@ struct ExportResult {
   TrainingReport report;
   std::vector<std::uint8_t> image;
   Evaluation validation;  // double-precision trainer on the held-out samples
-  Evaluation firmware;    // float32 image path on the same samples
-  Fidelity fidelity;      // float32 path vs double trainer
+  Evaluation firmware;    // float32 image path (double accumulators) on the same samples
+  // float32 path vs double trainer, one entry per FirmwareAccumulator.
+  std::vector<std::pair<FirmwareAccumulator, Fidelity>> fidelity_by_accumulator;
+  Fidelity fidelity;      // the worst of the accumulators that firmware builds use
 
-  bool fidelity_met() const {
-    return fidelity.max_position_mm <= kFidelityTargetPositionMm &&
-           fidelity.max_orientation_deg <= kFidelityTargetOrientationDeg;
+  static bool meets_target(const Fidelity& f) {
+    return f.max_position_mm <= kFidelityTargetPositionMm && f.max_orientation_deg <= kFidelityTargetOrientationDeg;
   }
+  bool fidelity_met() const { return meets_target(fidelity); }
 };
 
 ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& validation_set,
