@@ -1,6 +1,12 @@
 #!/usr/bin/env bash
-# Kinematics round trip on the paper's Table 1, case 2 (L = 120 mm, r = 70 mm):
-# cable lengths -> tip pose (FK) -> cable lengths (IK) -> the same tip pose.
+# The main job end to end on the built-in simulated robot:
+#   1-3. kinematics round trip on the paper's Table 1, case 2 (L = 120 mm,
+#        r = 70 mm): cable lengths -> tip pose -> cable lengths -> same pose;
+#   4.   a dataset from the simulated robot with the paper's protocol;
+#   5.   GP training, held-out accuracy and the float32 flash image;
+#   6.   the image checked and exported for a board;
+#   7.   accuracy on an independent test set of the same robot.
+# Everything it writes goes to build/demo/.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
@@ -62,3 +68,21 @@ print(f"\nLargest difference between the poses of steps 1 and 3: {difference:.1e
 if difference > tolerance:
     sys.exit("demo: the round trip did not reproduce the pose")
 PYTHON
+
+out=build/demo
+mkdir -p "$out"
+
+heading "4. Simulated robot: 750 random workspace samples (the paper's protocol)"
+run "$cdcr" simulate --samples 750 --seed 1 --out "$out/train.csv"
+
+heading "5. Train on 700 samples, validate on 50 held out, export the float32 image"
+run "$cdcr" train --data "$out/train.csv" --out "$out/model.img"
+
+heading "6. Check the image and export it for a board"
+run "$cdcr" inspect "$out/model.img"
+run "$cdcr" export --model "$out/model.img" --format hex --base-address 0x08040000 --out "$out/model.hex"
+run "$cdcr" export --model "$out/model.img" --format c --out "$out/model_image.c"
+
+heading "7. Accuracy on an independent test session of the same robot (200 samples)"
+run "$cdcr" simulate --samples 200 --seed 1 --session 1 --out "$out/test.csv"
+run "$cdcr" eval --model "$out/model.img" --data "$out/test.csv"
