@@ -11,6 +11,10 @@ declare -A package_groups=(
   [base]="build-essential cmake pkg-config libeigen3-dev libcli11-dev nlohmann-json3-dev libfmt-dev liblbfgspp-dev libgtest-dev libgmock-dev libbenchmark-dev python3"
   # The reference implementation the GP trainer is tested and benchmarked against.
   [sklearn]="python3-sklearn python3-numpy"
+  # The libFuzzer targets (ctest -L fuzz). clang does not pull in the fuzzer
+  # and sanitizer runtimes (libclang-rt-14-dev is only a Recommends); llvm-14
+  # brings llvm-symbolizer for readable sanitizer reports.
+  [fuzz]="clang libclang-rt-14-dev llvm-14"
 )
 
 log_file=${CDCR_INSTALL_LOG:-/tmp/cdcr-install-deps.log}

@@ -15,6 +15,13 @@
 #include "command_output.hpp"
 #include "fk_command.hpp"
 #include "ik_command.hpp"
+#include "train_command.hpp"
+#include "eval_command.hpp"
+#include "learning_curve_command.hpp"
+#include "import_mocap_command.hpp"
+#include "inspect_command.hpp"
+#include "export_command.hpp"
+#include "simulate_command.hpp"
 
 namespace {
 
@@ -62,6 +69,13 @@ int main(int argc, char** argv) {
   CommandOutput output;
   register_fk_command(app, output);
   register_ik_command(app, output);
+  register_train_command(app, output);
+  register_eval_command(app, output);
+  register_learning_curve_command(app, output);
+  register_import_mocap_command(app, output);
+  register_inspect_command(app, output);
+  register_export_command(app, output);
+  register_simulate_command(app, output);
 
   try {
     app.parse(argc, argv);

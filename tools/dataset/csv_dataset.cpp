@@ -1,6 +1,5 @@
 #include "dataset/csv_dataset.hpp"
 
-#include <charconv>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -9,27 +8,26 @@
 #include <vector>
 
 #include "cdcr/model/limits.hpp"
+#include "dataset/field_parsing.hpp"
 
 namespace cdcr::dataset {
 
 namespace {
 
+using detail::quoted;
+using detail::trim_blanks;
+
 constexpr const char* kPoseColumns[] = {"x", "y", "z", "qw", "qx", "qy", "qz"};
 constexpr int kPoseColumnCount = 7;
 constexpr double kQuaternionNormTolerance = 1e-3;
-
-std::string_view trim(std::string_view s) {
-  while (!s.empty() && (s.front() == ' ' || s.front() == '\t')) s.remove_prefix(1);
-  while (!s.empty() && (s.back() == ' ' || s.back() == '\t' || s.back() == '\r')) s.remove_suffix(1);
-  return s;
-}
+constexpr std::string_view kUtf8ByteOrderMark = "\xEF\xBB\xBF";
 
 std::vector<std::string_view> split_fields(std::string_view line) {
   std::vector<std::string_view> fields;
   std::size_t start = 0;
   for (;;) {
     const std::size_t comma = line.find(',', start);
-    fields.push_back(trim(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
+    fields.push_back(trim_blanks(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
     if (comma == std::string_view::npos) break;
     start = comma + 1;
   }
@@ -40,27 +38,33 @@ std::string cable_column_name(int segment, int cable) {
   return "l" + std::to_string(segment + 1) + "_" + std::to_string(cable + 1);
 }
 
-// Strict number parsing: the whole field must be a finite decimal number.
 double parse_number(std::string_view field, int line, const std::string& column) {
   double value = 0.0;
-  const char* begin = field.data();
-  const char* end = field.data() + field.size();
-  if (!field.empty() && *begin == '+') ++begin;
-  const auto [ptr, ec] = std::from_chars(begin, end, value);
-  if (field.empty() || ec != std::errc() || ptr != end) {
-    throw DatasetError(line, "column " + column + ": '" + std::string(field) + "' is not a number");
+  switch (detail::parse_decimal(field, value)) {
+    case detail::NumberStatus::ok: return value;
+    case detail::NumberStatus::empty: throw DatasetError(line, "column " + column + ": empty field");
+    case detail::NumberStatus::out_of_range:
+      throw DatasetError(line, "column " + column + ": " + quoted(field) + " is out of the range of a double");
+    case detail::NumberStatus::not_finite:
+      throw DatasetError(line, "column " + column + ": " + quoted(field) + " is NaN or Inf");
+    case detail::NumberStatus::not_a_number: break;
   }
-  if (!std::isfinite(value)) throw DatasetError(line, "column " + column + ": value is NaN or Inf");
-  return value;
+  throw DatasetError(line, "column " + column + ": " + quoted(field) + " is not a number");
 }
 
 struct Header {
+  int line = 0;
   int segment_count = 0;
   bool has_poses = false;
 };
 
 Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
   const std::vector<std::string_view> fields = split_fields(line);
+  double ignored = 0.0;
+  const detail::NumberStatus first = detail::parse_decimal(fields[0], ignored);
+  if (first != detail::NumberStatus::not_a_number && first != detail::NumberStatus::empty) {
+    throw DatasetError(line_number, "missing header: the first line must name the columns (l1_1,l1_2,...), found data");
+  }
   int cables = 0;
   while (cables < static_cast<int>(fields.size()) && !fields[cables].empty() && fields[cables][0] == 'l') ++cables;
   if (cables == 0 || cables % 4 != 0) {
@@ -68,16 +72,18 @@ Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
                                         std::to_string(cables));
   }
   Header h;
+  h.line = line_number;
   h.segment_count = cables / 4;
   if (h.segment_count > model::kMaxSegments) {
-    throw DatasetError(line_number, std::to_string(h.segment_count) + " segments exceed the maximum of " +
-                                        std::to_string(model::kMaxSegments));
+    throw DatasetError(line_number, std::to_string(cables) + " cable columns make " + std::to_string(h.segment_count) +
+                                        " segments, more than the " + std::to_string(model::kMaxSegments) +
+                                        " supported");
   }
   for (int i = 0; i < cables; ++i) {
     const std::string expected = cable_column_name(i / 4, i % 4);
     if (fields[i] != expected) {
-      throw DatasetError(line_number, "header column " + std::to_string(i + 1) + " is '" + std::string(fields[i]) +
-                                          "', expected '" + expected + "'");
+      throw DatasetError(line_number, "header column " + std::to_string(i + 1) + " is " + quoted(fields[i]) +
+                                          ", expected '" + expected + "'");
     }
   }
   const int rest = static_cast<int>(fields.size()) - cables;
@@ -92,21 +98,52 @@ Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
       throw DatasetError(line_number, std::string("missing column '") + kPoseColumns[i] + "'");
     }
     if (fields[cables + i] != kPoseColumns[i]) {
-      throw DatasetError(line_number, "header column " + std::to_string(cables + i + 1) + " is '" +
-                                          std::string(fields[cables + i]) + "', expected '" + kPoseColumns[i] + "'");
+      throw DatasetError(line_number, "header column " + std::to_string(cables + i + 1) + " is " +
+                                          quoted(fields[cables + i]) + ", expected '" + kPoseColumns[i] + "'");
     }
   }
   if (rest > kPoseColumnCount) {
-    throw DatasetError(line_number, "unexpected column '" + std::string(fields[cables + kPoseColumnCount]) + "'");
+    throw DatasetError(line_number, "unexpected column " + quoted(fields[cables + kPoseColumnCount]));
   }
   h.has_poses = true;
   return h;
 }
 
+model::Pose<double> pose_from_fields(const double* p, int line_number) {
+  Eigen::Quaterniond q(p[3], p[4], p[5], p[6]);  // (w, x, y, z)
+  const double norm = q.norm();
+  if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) {
+    std::ostringstream message;
+    message << "quaternion norm " << norm << " is not 1 (tolerance " << kQuaternionNormTolerance << ")";
+    throw DatasetError(line_number, message.str());
+  }
+  q.coeffs() /= norm;
+  model::Pose<double> pose;
+  pose.rotation = q.toRotationMatrix();
+  pose.position_mm = Eigen::Vector3d(p[0], p[1], p[2]);
+  return pose;
+}
+
+std::string one_line(const std::string& text) {
+  std::string out = text;
+  for (char& c : out) {
+    if (c == '\n' || c == '\r') c = ' ';
+  }
+  return out;
+}
+
 }  // namespace
 
-DatasetError::DatasetError(int line, const std::string& message)
-    : std::runtime_error(line > 0 ? "line " + std::to_string(line) + ": " + message : message), line_(line) {}
+DatasetError::DatasetError(int line, const std::string& message) : DatasetError(std::string(), line, message) {}
+
+DatasetError::DatasetError(const std::string& source, const DatasetError& error)
+    : DatasetError(source, error.line(), error.message()) {}
+
+DatasetError::DatasetError(const std::string& source, int line, const std::string& message)
+    : std::runtime_error(one_line((source.empty() ? "" : source + ": ") +
+                                  (line > 0 ? "line " + std::to_string(line) + ": " : "") + message)),
+      line_(line),
+      message_(message) {}
 
 std::uint64_t fnv1a64(std::string_view bytes) {
   std::uint64_t hash = 0xcbf29ce484222325ull;
@@ -120,17 +157,16 @@ std::uint64_t fnv1a64(std::string_view bytes) {
 Dataset parse_dataset_csv(std::string_view text, PoseColumns poses) {
   Dataset data;
   data.content_hash = fnv1a64(text);
+  // Spreadsheet programs like to start UTF-8 files with a byte order mark.
+  if (text.substr(0, kUtf8ByteOrderMark.size()) == kUtf8ByteOrderMark) text.remove_prefix(kUtf8ByteOrderMark.size());
+
   Header header;
   bool have_header = false;
   std::vector<double> values;
-  int line_number = 0;
-  std::size_t start = 0;
-  while (start < text.size()) {
-    std::size_t end = text.find('\n', start);
-    if (end == std::string_view::npos) end = text.size();
-    const std::string_view line = trim(text.substr(start, end - start));
-    start = end + 1;
-    ++line_number;
+  detail::LineReader lines(text);
+  for (std::string_view raw; lines.next(raw);) {
+    const std::string_view line = trim_blanks(raw);
+    const int line_number = lines.number();
     if (line.empty() || line.front() == '#') continue;
     if (!have_header) {
       header = parse_header(line, line_number, poses);
@@ -149,27 +185,15 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses) {
       values.push_back(parse_number(fields[i], line_number, column));
     }
     if (header.has_poses) {
-      const double* p = values.data() + values.size() - kPoseColumnCount;
-      Eigen::Quaterniond q(p[3], p[4], p[5], p[6]);
-      const double norm = q.norm();
-      if (std::abs(norm - 1.0) > kQuaternionNormTolerance) {
-        std::ostringstream message;
-        message << "quaternion norm " << norm << " is not 1 (tolerance " << kQuaternionNormTolerance << ")";
-        throw DatasetError(line_number, message.str());
-      }
-      q.normalize();
-      model::Pose<double> pose;
-      pose.rotation = q.toRotationMatrix();
-      pose.position_mm = Eigen::Vector3d(p[0], p[1], p[2]);
-      data.poses.push_back(pose);
+      data.poses.push_back(pose_from_fields(values.data() + values.size() - kPoseColumnCount, line_number));
     }
   }
-  if (!have_header) throw DatasetError(0, "no header line (expected l1_1,l1_2,...)");
+  if (!have_header) throw DatasetError(0, "no header line (expected l1_1,l1_2,...): the file is empty or only comments");
   data.segment_count = header.segment_count;
   data.has_poses = header.has_poses;
   const int columns = 4 * header.segment_count + (header.has_poses ? kPoseColumnCount : 0);
   const auto rows = static_cast<Eigen::Index>(values.size() / static_cast<std::size_t>(columns));
-  if (rows == 0) throw DatasetError(0, "no data rows");
+  if (rows == 0) throw DatasetError(header.line, "no data rows after the header");
   const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> all(values.data(), rows,
                                                                                                      columns);
   data.cables_mm = all.leftCols(4 * header.segment_count);
@@ -178,17 +202,26 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses) {
 
 Dataset read_dataset_csv(const std::string& path, PoseColumns poses) {
   std::ifstream file(path, std::ios::binary);
-  if (!file) throw DatasetError(0, path + ": cannot open file");
+  if (!file) throw DatasetError(path, DatasetError(0, "cannot open file"));
   std::ostringstream buffer;
   buffer << file.rdbuf();
   try {
     return parse_dataset_csv(buffer.str(), poses);
   } catch (const DatasetError& e) {
-    throw DatasetError(0, path + ": " + e.what());
+    throw DatasetError(path, e);
   }
 }
 
 std::string format_dataset_csv(const Dataset& data, const std::string& comment) {
+  if (data.segment_count < 1 || data.segment_count > model::kMaxSegments ||
+      data.cables_mm.cols() != 4 * data.segment_count) {
+    throw std::invalid_argument("dataset has " + std::to_string(data.cables_mm.cols()) + " cable columns for " +
+                                std::to_string(data.segment_count) + " segments");
+  }
+  if (data.has_poses && data.poses.size() != static_cast<std::size_t>(data.sample_count())) {
+    throw std::invalid_argument("dataset has " + std::to_string(data.poses.size()) + " poses for " +
+                                std::to_string(data.sample_count()) + " samples");
+  }
   std::ostringstream out;
   out << std::setprecision(std::numeric_limits<double>::max_digits10);
   if (!comment.empty()) {
@@ -215,10 +248,12 @@ std::string format_dataset_csv(const Dataset& data, const std::string& comment) 
 }
 
 void write_dataset_csv(const std::string& path, const Dataset& data, const std::string& comment) {
+  const std::string text = format_dataset_csv(data, comment);
   std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) throw DatasetError(0, path + ": cannot open file for writing");
-  file << format_dataset_csv(data, comment);
-  if (!file) throw DatasetError(0, path + ": write failed");
+  if (!file) throw DatasetError(path, DatasetError(0, "cannot open file for writing"));
+  file << text;
+  file.close();
+  if (!file) throw DatasetError(path, DatasetError(0, "write failed"));
 }
 
 }  // namespace cdcr::dataset

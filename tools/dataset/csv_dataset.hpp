@@ -5,7 +5,8 @@
 //
 // Cable columns first (li_j: cable j of segment i, mm), then optionally the
 // measured end-platform pose in the base frame (mm; unit quaternion,
-// Hamilton, w first). Lines starting with '#' are comments.
+// Hamilton, w first). Lines starting with '#' are comments; blank lines are
+// ignored; LF and CRLF line endings are both accepted.
 
 #include <cstdint>
 #include <stdexcept>
@@ -16,15 +17,23 @@
 
 namespace cdcr::dataset {
 
-// Every rejection names the file line (1-based) it happened on, or 0 when it
-// concerns the whole file; what() is a single line ready to print.
+// Every rejection names the file line (1-based, comments and blank lines
+// included) it happened on, or 0 when it concerns the whole file; what() is a
+// single line ready to print: "[source: ][line N: ]message".
 class DatasetError : public std::runtime_error {
  public:
   DatasetError(int line, const std::string& message);
+  // The same rejection, attributed to a file (or any other named source).
+  DatasetError(const std::string& source, const DatasetError& error);
+
   int line() const { return line_; }
+  const std::string& message() const { return message_; }
 
  private:
+  DatasetError(const std::string& source, int line, const std::string& message);
+
   int line_;
+  std::string message_;
 };
 
 enum class PoseColumns { optional, required };
@@ -36,7 +45,9 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses = PoseColumns
 // Reads a file (errors are prefixed with the path).
 Dataset read_dataset_csv(const std::string& path, PoseColumns poses = PoseColumns::optional);
 
-// Writes with full round-trip precision; poses are written when has_poses.
+// Writes with full round-trip precision (max_digits10); poses are written when
+// has_poses. Each line of `comment` becomes a '#' line before the header.
+// Throws std::invalid_argument if the dataset's shapes disagree.
 std::string format_dataset_csv(const Dataset& data, const std::string& comment = {});
 void write_dataset_csv(const std::string& path, const Dataset& data, const std::string& comment = {});
 

@@ -1,0 +1,69 @@
+// Fuzzes the dataset CSV reader (tools/dataset/csv_dataset.cpp). Accepted
+// text must give a consistent dataset that survives format -> parse exactly;
+// rejected text must give one DatasetError line naming its line.
+
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdlib>
+#include <string>
+#include <string_view>
+
+#include "dataset/csv_dataset.hpp"
+
+namespace {
+
+using namespace cdcr::dataset;
+
+void require(bool condition) {
+  if (!condition) std::abort();
+}
+
+void check_rejection(const DatasetError& e) {
+  const std::string what = e.what();
+  require(e.line() >= 0);
+  require(what.find_first_of("\r\n") == std::string::npos);
+  if (e.line() > 0) require(what.rfind("line " + std::to_string(e.line()) + ": ", 0) == 0);
+}
+
+void check_accepted(const Dataset& data, std::string_view text, PoseColumns poses) {
+  require(data.segment_count >= 1 && data.segment_count <= 8);
+  require(data.cables_mm.cols() == 4 * data.segment_count);
+  require(data.sample_count() >= 1);
+  require(data.cables_mm.allFinite());
+  require(data.content_hash == fnv1a64(text));
+  require(poses == PoseColumns::optional || data.has_poses);
+  require(data.poses.size() == (data.has_poses ? static_cast<std::size_t>(data.sample_count()) : 0u));
+  for (const auto& pose : data.poses) {
+    require(pose.all_finite());
+    const double orthonormality = (pose.rotation.transpose() * pose.rotation - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
+    require(orthonormality < 1e-12);
+  }
+
+  const Dataset back = parse_dataset_csv(format_dataset_csv(data, "fuzz"), poses);
+  require(back.segment_count == data.segment_count && back.has_poses == data.has_poses);
+  require(back.cables_mm.rows() == data.cables_mm.rows());
+  for (Eigen::Index i = 0; i < data.cables_mm.size(); ++i) {
+    const double a = data.cables_mm.data()[i];
+    const double b = back.cables_mm.data()[i];
+    require(a == b && std::signbit(a) == std::signbit(b));
+  }
+  for (std::size_t i = 0; i < data.poses.size(); ++i) {
+    require(back.poses[i].position_mm == data.poses[i].position_mm);
+    require((back.poses[i].rotation - data.poses[i].rotation).cwiseAbs().maxCoeff() < 1e-12);
+  }
+}
+
+}  // namespace
+
+extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
+  const std::string_view text(reinterpret_cast<const char*>(data), size);
+  for (const PoseColumns poses : {PoseColumns::optional, PoseColumns::required}) {
+    try {
+      check_accepted(parse_dataset_csv(text, poses), text, poses);
+    } catch (const DatasetError& e) {
+      check_rejection(e);
+    }
+  }
+  return 0;
+}

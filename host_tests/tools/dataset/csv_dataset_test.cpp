@@ -1,0 +1,344 @@
+// The dataset CSV reader and writer: what is accepted, that every rejection is
+// one line naming the file line, and that writing then reading loses nothing.
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <ostream>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+#include <gtest/gtest.h>
+
+#include "dataset/csv_dataset.hpp"
+
+namespace {
+
+using cdcr::dataset::Dataset;
+using cdcr::dataset::DatasetError;
+using cdcr::dataset::fnv1a64;
+using cdcr::dataset::format_dataset_csv;
+using cdcr::dataset::parse_dataset_csv;
+using cdcr::dataset::PoseColumns;
+using cdcr::dataset::read_dataset_csv;
+using cdcr::dataset::write_dataset_csv;
+
+constexpr const char* kPoseHeader = "l1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy,qz\n";
+
+// Runs the parser and returns the rejection; fails the test if there is none.
+DatasetError rejection(const std::string& text, PoseColumns poses = PoseColumns::optional) {
+  try {
+    parse_dataset_csv(text, poses);
+  } catch (const DatasetError& e) {
+    return e;
+  }
+  ADD_FAILURE() << "accepted:\n" << text;
+  return DatasetError(-1, "accepted");
+}
+
+std::string temp_path(const std::string& name) { return testing::TempDir() + "cdcr_dataset_" + name; }
+
+TEST(DatasetCsv, ParsesCableColumns) {
+  const std::string text = "l1_1,l1_2,l1_3,l1_4,l2_1,l2_2,l2_3,l2_4\n120,121.5,119,118.25,1,2,3,4\n-0.5,+2,3e1,.5,5,6,7,8\n";
+  const Dataset data = parse_dataset_csv(text);
+  EXPECT_EQ(data.segment_count, 2);
+  EXPECT_FALSE(data.has_poses);
+  EXPECT_TRUE(data.poses.empty());
+  ASSERT_EQ(data.sample_count(), 2);
+  ASSERT_EQ(data.cables_mm.cols(), 8);
+  EXPECT_EQ(data.cables_mm(0, 1), 121.5);
+  EXPECT_EQ(data.cables_mm(0, 3), 118.25);
+  EXPECT_EQ(data.cables_mm(1, 0), -0.5);
+  EXPECT_EQ(data.cables_mm(1, 1), 2.0);
+  EXPECT_EQ(data.cables_mm(1, 2), 30.0);
+  EXPECT_EQ(data.cables_mm(1, 3), 0.5);
+  EXPECT_EQ(data.cables_mm(1, 7), 8.0);
+  EXPECT_EQ(data.content_hash, fnv1a64(text));
+}
+
+TEST(DatasetCsv, ParsesPosesAsHamiltonQuaternionWFirst) {
+  const Eigen::Quaterniond q(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, -0.5).normalized()));
+  char row[256];
+  std::snprintf(row, sizeof row, "120,120,120,120,1.5,-2,240,%.17g,%.17g,%.17g,%.17g\n", q.w(), q.x(), q.y(), q.z());
+  const Dataset data = parse_dataset_csv(std::string(kPoseHeader) + row, PoseColumns::required);
+  ASSERT_TRUE(data.has_poses);
+  ASSERT_EQ(data.poses.size(), 1u);
+  EXPECT_EQ(data.poses[0].position_mm, Eigen::Vector3d(1.5, -2, 240));
+  EXPECT_LT((data.poses[0].rotation - q.toRotationMatrix()).cwiseAbs().maxCoeff(), 1e-15);
+}
+
+TEST(DatasetCsv, SkipsCommentsAndBlankLinesButCountsThem) {
+  const std::string text =
+      "# measured 2020-03-01\n"
+      "\n"
+      "l1_1,l1_2,l1_3,l1_4\n"
+      "   # indented comment\n"
+      "120,120,120,120\n"
+      "\t\n"
+      "121,119,120,120\n";
+  const Dataset data = parse_dataset_csv(text);
+  EXPECT_EQ(data.sample_count(), 2);
+  EXPECT_EQ(data.cables_mm(1, 0), 121.0);
+
+  const DatasetError e = rejection(text + "# another\n\n120,120,oops,120\n");
+  EXPECT_EQ(e.line(), 10);
+  EXPECT_STREQ(e.what(), "line 10: column l1_3: 'oops' is not a number");
+}
+
+TEST(DatasetCsv, AcceptsCrlfLineEndings) {
+  const std::string lf = "# comment\nl1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy,qz\n120,121,122,123,1,2,3,1,0,0,0\n";
+  std::string crlf;
+  for (const char c : lf) crlf += c == '\n' ? std::string("\r\n") : std::string(1, c);
+  const Dataset a = parse_dataset_csv(lf);
+  const Dataset b = parse_dataset_csv(crlf);
+  EXPECT_EQ(a.cables_mm, b.cables_mm);
+  ASSERT_EQ(b.poses.size(), 1u);
+  EXPECT_EQ(b.poses[0].position_mm, a.poses[0].position_mm);
+  EXPECT_EQ(b.poses[0].rotation, a.poses[0].rotation);
+  EXPECT_EQ(rejection(crlf + "1,2,3\r\n").line(), 4);
+  // Without a final newline, too.
+  EXPECT_EQ(parse_dataset_csv("l1_1,l1_2,l1_3,l1_4\r\n1,2,3,4").sample_count(), 1);
+}
+
+TEST(DatasetCsv, AcceptsUtf8ByteOrderMark) {
+  const Dataset data = parse_dataset_csv("\xEF\xBB\xBFl1_1,l1_2,l1_3,l1_4\n1,2,3,4\n");
+  EXPECT_EQ(data.sample_count(), 1);
+}
+
+struct BadCsv {
+  const char* name;
+  std::string text;
+  int line;
+  std::string message;  // exact what()
+};
+
+void PrintTo(const BadCsv& c, std::ostream* os) { *os << c.name; }
+
+class DatasetCsvRejects : public testing::TestWithParam<BadCsv> {};
+
+TEST_P(DatasetCsvRejects, WithOneLineNamingTheLine) {
+  const BadCsv& c = GetParam();
+  const DatasetError e = rejection(c.text);
+  EXPECT_EQ(e.line(), c.line);
+  EXPECT_EQ(std::string(e.what()), c.message);
+  EXPECT_EQ(std::string(e.what()).find_first_of("\r\n"), std::string::npos);
+}
+
+const std::string kCables = "l1_1,l1_2,l1_3,l1_4\n";
+const std::string kPoses = kPoseHeader;
+
+INSTANTIATE_TEST_SUITE_P(
+    Malformed, DatasetCsvRejects,
+    testing::Values(
+        BadCsv{"too_few_fields", kCables + "1,2,3,4\n1,2,3\n", 3, "line 3: expected 4 fields, found 3"},
+        BadCsv{"too_many_fields", kCables + "1,2,3,4,5\n", 2, "line 2: expected 4 fields, found 5"},
+        BadCsv{"trailing_comma", kCables + "1,2,3,4,\n", 2, "line 2: expected 4 fields, found 5"},
+        BadCsv{"empty_field", kCables + "1,,3,4\n", 2, "line 2: column l1_2: empty field"},
+        BadCsv{"blank_field", kCables + "1,2, ,4\n", 2, "line 2: column l1_3: empty field"},
+        BadCsv{"text", kCables + "1,2,3,abc\n", 2, "line 2: column l1_4: 'abc' is not a number"},
+        BadCsv{"trailing_garbage", kCables + "1.0x,2,3,4\n", 2, "line 2: column l1_1: '1.0x' is not a number"},
+        BadCsv{"inner_space", kCables + "1,2 3,3,4\n", 2, "line 2: column l1_2: '2 3' is not a number"},
+        BadCsv{"double_sign", kCables + "+-1,2,3,4\n", 2, "line 2: column l1_1: '+-1' is not a number"},
+        BadCsv{"hex", kCables + "0x10,2,3,4\n", 2, "line 2: column l1_1: '0x10' is not a number"},
+        BadCsv{"decimal_comma", kCables + "1;2;3;4\n", 2, "line 2: expected 4 fields, found 1"},
+        BadCsv{"control_byte", kCables + "1,2\x01,3,4\n", 2, "line 2: column l1_2: '2\\x01' is not a number"},
+        BadCsv{"out_of_range", kCables + "1e999,2,3,4\n", 2,
+               "line 2: column l1_1: '1e999' is out of the range of a double"},
+        BadCsv{"long_field", kCables + "1,2,3," + std::string(100, 'z') + "\n", 2,
+               "line 2: column l1_4: '" + std::string(40, 'z') + "...' is not a number"}),
+    [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
+
+INSTANTIATE_TEST_SUITE_P(
+    NotFinite, DatasetCsvRejects,
+    testing::Values(BadCsv{"nan_cable", kCables + "nan,2,3,4\n", 2, "line 2: column l1_1: 'nan' is NaN or Inf"},
+                    BadCsv{"NaN_cable", kCables + "1,NaN,3,4\n", 2, "line 2: column l1_2: 'NaN' is NaN or Inf"},
+                    BadCsv{"inf_cable", kCables + "1,2,inf,4\n", 2, "line 2: column l1_3: 'inf' is NaN or Inf"},
+                    BadCsv{"minus_infinity", kCables + "1,2,3,-Infinity\n", 2,
+                           "line 2: column l1_4: '-Infinity' is NaN or Inf"},
+                    BadCsv{"nan_position", kPoses + "1,2,3,4,nan,0,0,1,0,0,0\n", 2,
+                           "line 2: column x: 'nan' is NaN or Inf"},
+                    BadCsv{"inf_quaternion", kPoses + "1,2,3,4,0,0,0,1,0,0,inf\n", 2,
+                           "line 2: column qz: 'inf' is NaN or Inf"}),
+    [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
+
+INSTANTIATE_TEST_SUITE_P(
+    Quaternion, DatasetCsvRejects,
+    testing::Values(BadCsv{"norm_too_large", kPoses + "1,2,3,4,0,0,0,1.0011,0,0,0\n", 2,
+                           "line 2: quaternion norm 1.0011 is not 1 (tolerance 0.001)"},
+                    BadCsv{"norm_too_small", kPoses + "1,2,3,4,0,0,0,0.6,0,0.6,0\n", 2,
+                           "line 2: quaternion norm 0.848528 is not 1 (tolerance 0.001)"},
+                    BadCsv{"zero", kPoses + "1,2,3,4,0,0,0,0,0,0,0\n", 2,
+                           "line 2: quaternion norm 0 is not 1 (tolerance 0.001)"},
+                    BadCsv{"overflowing_norm", kPoses + "1,2,3,4,0,0,0,1e300,1e300,0,0\n", 2,
+                           "line 2: quaternion norm inf is not 1 (tolerance 0.001)"}),
+    [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
+
+INSTANTIATE_TEST_SUITE_P(
+    Header, DatasetCsvRejects,
+    testing::Values(
+        BadCsv{"no_header", "120,120,120,120\n", 1,
+               "line 1: missing header: the first line must name the columns (l1_1,l1_2,...), found data"},
+        BadCsv{"no_header_after_comments", "# data\n\n120,120,120,120\n", 3,
+               "line 3: missing header: the first line must name the columns (l1_1,l1_2,...), found data"},
+        BadCsv{"not_multiple_of_4", "l1_1,l1_2,l1_3\n1,2,3\n", 1,
+               "line 1: header must start with cable columns l1_1,l1_2,l1_3,l1_4,... (a multiple of 4), found 3"},
+        BadCsv{"no_cable_columns", "x,y,z,qw,qx,qy,qz\n", 1,
+               "line 1: header must start with cable columns l1_1,l1_2,l1_3,l1_4,... (a multiple of 4), found 0"},
+        BadCsv{"wrong_cable_name", "l1_1,l1_2,l1_3,l2_4\n1,2,3,4\n", 1,
+               "line 1: header column 4 is 'l2_4', expected 'l1_4'"},
+        BadCsv{"segments_out_of_order", "l1_1,l1_2,l1_3,l1_4,l3_1,l3_2,l3_3,l3_4\n", 1,
+               "line 1: header column 5 is 'l3_1', expected 'l2_1'"},
+        BadCsv{"too_many_segments",
+               [] {
+                 std::string h;
+                 for (int s = 1; s <= 9; ++s)
+                   for (int c = 1; c <= 4; ++c) h += (h.empty() ? "" : ",") + ("l" + std::to_string(s) + "_" + std::to_string(c));
+                 return h + "\n";
+               }(),
+               1, "line 1: 36 cable columns make 9 segments, more than the 8 supported"},
+        BadCsv{"missing_pose_column", "l1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy\n", 1, "line 1: missing column 'qz'"},
+        BadCsv{"wrong_pose_name", "l1_1,l1_2,l1_3,l1_4,x,y,z,qx,qy,qz,qw\n", 1,
+               "line 1: header column 8 is 'qx', expected 'qw'"},
+        BadCsv{"extra_column", "l1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy,qz,t\n", 1, "line 1: unexpected column 't'"},
+        BadCsv{"no_rows", "# only a header\nl1_1,l1_2,l1_3,l1_4\n\n# nothing\n", 2,
+               "line 2: no data rows after the header"},
+        BadCsv{"empty", "", 0, "no header line (expected l1_1,l1_2,...): the file is empty or only comments"},
+        BadCsv{"only_comments", "# a\n\n# b\n", 0,
+               "no header line (expected l1_1,l1_2,...): the file is empty or only comments"}),
+    [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
+
+TEST(DatasetCsv, RequiredPoseColumns) {
+  const DatasetError e = rejection(kCables + "1,2,3,4\n", PoseColumns::required);
+  EXPECT_EQ(e.line(), 1);
+  EXPECT_STREQ(e.what(), "line 1: missing pose columns x,y,z,qw,qx,qy,qz after the cable columns");
+}
+
+TEST(DatasetCsv, RenormalisesQuaternionsWithinTheTolerance) {
+  const Eigen::Quaterniond unit(Eigen::AngleAxisd(1.1, Eigen::Vector3d(0.2, -1, 0.4).normalized()));
+  for (const double scale : {1.0009, 0.9991, 1.0 + 1e-12}) {
+    const Eigen::Vector4d q = scale * unit.coeffs();  // (x, y, z, w)
+    char row[256];
+    std::snprintf(row, sizeof row, "1,2,3,4,0,0,0,%.17g,%.17g,%.17g,%.17g\n", q[3], q[0], q[1], q[2]);
+    const Dataset data = parse_dataset_csv(kPoses + row);
+    const Eigen::Matrix3d r = data.poses.at(0).rotation;
+    const double eps = std::numeric_limits<double>::epsilon();
+    EXPECT_LE((r.transpose() * r - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff(), 4 * eps) << scale;
+    EXPECT_NEAR(r.determinant(), 1.0, 4 * eps) << scale;
+    EXPECT_LE((r - unit.toRotationMatrix()).cwiseAbs().maxCoeff(), 4 * eps) << scale;
+    // Written back, the quaternion is unit to the last bit or two.
+    const Dataset again = parse_dataset_csv(format_dataset_csv(data));
+    EXPECT_LE((again.poses[0].rotation - r).cwiseAbs().maxCoeff(), 4 * eps);
+  }
+}
+
+Dataset random_dataset(int segments, int samples, bool poses, unsigned seed) {
+  std::mt19937_64 rng(seed);
+  std::uniform_real_distribution<double> length(60.0, 180.0);
+  std::normal_distribution<double> gauss(0.0, 1.0);
+  Dataset data;
+  data.segment_count = segments;
+  data.has_poses = poses;
+  data.cables_mm.resize(samples, 4 * segments);
+  for (int r = 0; r < samples; ++r) {
+    for (int c = 0; c < 4 * segments; ++c) data.cables_mm(r, c) = length(rng);
+    if (poses) {
+      Eigen::Quaterniond q(gauss(rng), gauss(rng), gauss(rng), gauss(rng));
+      q.normalize();
+      cdcr::model::Pose<double> pose;
+      pose.rotation = q.toRotationMatrix();
+      pose.position_mm = Eigen::Vector3d(gauss(rng), gauss(rng), 400 + gauss(rng)) * 37.0;
+      data.poses.push_back(pose);
+    }
+  }
+  // Values whose shortest decimal needs all 17 digits, or none.
+  data.cables_mm(0, 0) = 0.1 + 0.2;
+  data.cables_mm(0, 1) = 1.0 / 3.0;
+  data.cables_mm(samples - 1, 0) = -0.0;
+  data.cables_mm(samples - 1, 1) = 1e-300;
+  data.cables_mm(samples - 1, 2) = 123456789012345.67;
+  data.cables_mm(samples - 1, 3) = std::nextafter(120.0, 200.0);
+  return data;
+}
+
+TEST(DatasetCsv, FormatThenParseIsExact) {
+  for (const bool poses : {false, true}) {
+    const Dataset data = random_dataset(3, 40, poses, poses ? 7 : 8);
+    const std::string text = format_dataset_csv(data, "first line\nsecond line");
+    EXPECT_EQ(text.rfind("# first line\n# second line\nl1_1,", 0), 0u) << text.substr(0, 80);
+    const Dataset back = parse_dataset_csv(text, poses ? PoseColumns::required : PoseColumns::optional);
+    ASSERT_EQ(back.segment_count, 3);
+    ASSERT_EQ(back.has_poses, poses);
+    ASSERT_EQ(back.sample_count(), 40);
+    for (int r = 0; r < 40; ++r) {
+      for (int c = 0; c < 12; ++c) {
+        // Bit for bit, the sign of zero included.
+        EXPECT_EQ(std::signbit(back.cables_mm(r, c)), std::signbit(data.cables_mm(r, c)));
+        EXPECT_EQ(back.cables_mm(r, c), data.cables_mm(r, c)) << r << "," << c;
+      }
+    }
+    ASSERT_EQ(back.poses.size(), data.poses.size());
+    for (std::size_t i = 0; i < data.poses.size(); ++i) {
+      EXPECT_EQ(back.poses[i].position_mm, data.poses[i].position_mm);
+      // The quaternion text is exact; the matrix is rebuilt from it.
+      EXPECT_LE((back.poses[i].rotation - data.poses[i].rotation).cwiseAbs().maxCoeff(), 1e-15);
+    }
+  }
+}
+
+TEST(DatasetCsv, FormatRejectsInconsistentShapes) {
+  Dataset data = random_dataset(2, 3, true, 1);
+  data.poses.pop_back();
+  EXPECT_THROW(format_dataset_csv(data), std::invalid_argument);
+  data = random_dataset(2, 3, false, 1);
+  data.segment_count = 3;
+  EXPECT_THROW(format_dataset_csv(data), std::invalid_argument);
+}
+
+TEST(DatasetCsv, Fnv1a64TestVectors) {
+  EXPECT_EQ(fnv1a64(""), 0xcbf29ce484222325ull);
+  EXPECT_EQ(fnv1a64("a"), 0xaf63dc4c8601ec8cull);
+  EXPECT_EQ(fnv1a64("foobar"), 0x85944171f73967e8ull);
+  // Bytes above 0x7f are hashed as unsigned, whatever the signedness of char.
+  EXPECT_NE(fnv1a64("\xff"), fnv1a64("\x7f"));
+}
+
+TEST(DatasetCsv, WriteThenReadAFile) {
+  const Dataset data = random_dataset(4, 10, true, 3);
+  const std::string path = temp_path("round_trip.csv");
+  write_dataset_csv(path, data, "synthetic");
+  const Dataset back = read_dataset_csv(path, PoseColumns::required);
+  EXPECT_EQ(back.cables_mm, data.cables_mm);
+  EXPECT_EQ(back.content_hash, fnv1a64(format_dataset_csv(data, "synthetic")));
+  std::remove(path.c_str());
+}
+
+TEST(DatasetCsv, FileErrorsNameThePath) {
+  const std::string missing = temp_path("does_not_exist.csv");
+  try {
+    read_dataset_csv(missing);
+    FAIL() << "read a missing file";
+  } catch (const DatasetError& e) {
+    EXPECT_EQ(e.line(), 0);
+    EXPECT_EQ(std::string(e.what()), missing + ": cannot open file");
+  }
+
+  const std::string path = temp_path("bad.csv");
+  std::ofstream(path) << "l1_1,l1_2,l1_3,l1_4\n1,2,3,4\n1,2,x,4\n";
+  try {
+    read_dataset_csv(path);
+    FAIL() << "accepted a bad row";
+  } catch (const DatasetError& e) {
+    EXPECT_EQ(e.line(), 3);
+    EXPECT_EQ(e.message(), "column l1_3: 'x' is not a number");
+    EXPECT_EQ(std::string(e.what()), path + ": line 3: column l1_3: 'x' is not a number");
+  }
+  std::remove(path.c_str());
+
+  EXPECT_THROW(write_dataset_csv(testing::TempDir() + "no/such/dir/out.csv", random_dataset(1, 2, false, 1)),
+               DatasetError);
+}
+
+}  // namespace
