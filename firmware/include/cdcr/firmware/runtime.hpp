@@ -1,0 +1,157 @@
+#pragma once
+// The fixed-rate runtime: one object, statically allocated, that owns every
+// buffer it needs. init() is BOOT; run_cycle() is the whole per-cycle work.
+//
+// States (see fault.hpp):
+//   BOOT -> RUN       the model image parses and binds: compensated kinematics.
+//   BOOT -> DEGRADED  no usable image: nominal kinematics on the fallback
+//                     geometry, the image's fault code reported in every STATUS.
+//   RUN/DEGRADED -> FAULT  no valid cable set for kStaleInputCycles cycles.
+//   FAULT -> RUN/DEGRADED  as soon as a valid cable set arrives again.
+// In FAULT the runtime stops publishing poses and setpoints and refuses new
+// targets; the drives keep the last setpoint they received (holding position
+// is the drives' own behaviour on a silent bus), and STATUS keeps coming.
+//
+// Per cycle: drain up to kMaxRxFramesPerCycle frames (cable feedback, target
+// frames), estimate the pose from the latest cable lengths, solve a committed
+// target, publish, and measure execution time and start jitter on the HAL clock.
+
+#include <cstdint>
+
+#include "cdcr/firmware/capacity.hpp"
+#include "cdcr/firmware/fault.hpp"
+#include "cdcr/firmware/protocol.hpp"
+#include "cdcr/hal/hal.hpp"
+#include "cdcr/model/compensated_kinematics.hpp"
+#include "cdcr/model/flash_image.hpp"
+#include "cdcr/model/gp_correction.hpp"
+#include "cdcr/model/inverse_kinematics.hpp"
+
+namespace cdcr::firmware {
+
+// float kinematics with double GP sums: single-precision work where the FPU
+// is fast, double only where the image's alternating terms need it (see
+// gp_correction.hpp).
+using Scalar = float;
+using Accumulator = double;
+using Geometry = model::RobotGeometry<Scalar, kMaxSegments>;
+using Cables = model::CableVector<Scalar, kMaxSegments>;
+using Joints = model::JointVector<Scalar, kMaxSegments>;
+using Correction = model::GpCorrection<Scalar, Accumulator, kMaxSegments>;
+using Pose = model::Pose<Scalar>;
+
+struct CycleStatistics {
+  std::uint32_t cycles = 0;
+  std::uint32_t overruns = 0;  // cycles longer than the period plus releases the timer reports missed
+  std::int64_t execution_max_ns = 0;
+  std::int64_t execution_total_ns = 0;
+  std::int64_t jitter_max_ns = 0;  // start of work after its release time
+  std::uint32_t rejected_frames = 0;
+  std::uint32_t rejected_cable_sets = 0;
+  std::uint32_t stale_events = 0;
+  std::uint32_t poses_published = 0;
+  std::uint32_t targets_received = 0;
+
+  std::int64_t execution_mean_ns() const { return cycles == 0 ? 0 : execution_total_ns / cycles; }
+};
+
+struct PoseEstimate {
+  Pose pose;
+  Joints joints;
+  bool compensated = false;
+};
+
+struct IkReport {
+  std::uint8_t sequence = 0;
+  protocol::IkOutcome outcome = protocol::IkOutcome::converged;
+  model::Status model_status = model::Status::ok;
+  int iterations = 0;
+  Scalar position_error_mm = 0;
+};
+
+class Runtime {
+ public:
+  // fallback_geometry is the robot's design geometry, used when no image is
+  // usable; with an image, the image's geometry is the one it was trained on.
+  Runtime(const hal::Hal& hal, const Geometry& fallback_geometry);
+
+  Runtime(const Runtime&) = delete;
+  Runtime& operator=(const Runtime&) = delete;
+
+  // BOOT: validates the image with the shared parser and sets the CAN filters.
+  RuntimeState init();
+
+  // One cycle of work for the given release.
+  void run_cycle(const hal::TimerTick& tick);
+
+  // The forward path run_cycle applies to the latest cable set: nominal or
+  // compensated by state. Writes `estimate` only on success.
+  model::Status estimate_pose(const Cables& cables_mm, PoseEstimate& estimate) const;
+
+  RuntimeState state() const { return state_; }
+  // What STATUS reports: stale input in FAULT, else the last rejection since
+  // the previous STATUS, else the boot fault (image) or none.
+  FaultCode active_fault() const;
+  FaultCode boot_fault() const { return boot_fault_; }
+  std::uint8_t boot_fault_detail() const { return boot_fault_detail_; }
+  FaultCode last_event() const { return last_event_; }
+  const CycleStatistics& statistics() const { return statistics_; }
+  const Geometry& geometry() const { return geometry_; }
+  const IkReport& last_ik_report() const { return last_ik_report_; }
+  bool has_setpoints() const { return has_setpoints_; }
+  const Cables& setpoints_mm() const { return setpoints_mm_; }
+  bool has_pose() const { return has_pose_; }
+  const PoseEstimate& latest_pose() const { return latest_pose_; }
+
+ private:
+  void handle_frame(const hal::CanFrame& frame);
+  void handle_cable_frame(const hal::CanFrame& frame);
+  void handle_target_commit(const hal::CanFrame& frame);
+  void solve_target(const Pose& target, protocol::TargetMode mode, std::uint8_t sequence);
+  void update_pose();
+  void publish_pose();
+  void publish_setpoints();
+  void publish_ik_report();
+  void publish_status();
+  void send(const hal::CanFrame& frame);
+  void reject_frame(FaultCode code);
+  void enter(RuntimeState next);
+  void log(const char* format, ...);
+
+  hal::Hal hal_;
+  Geometry fallback_geometry_;
+  Geometry geometry_;
+  model::ImageView image_{};
+  Correction correction_;
+  RuntimeState state_ = RuntimeState::boot;
+  RuntimeState mode_ = RuntimeState::boot;  // RUN or DEGRADED: where FAULT returns to
+  FaultCode boot_fault_ = FaultCode::none;
+  std::uint8_t boot_fault_detail_ = 0;
+  FaultCode last_event_ = FaultCode::none;
+  FaultCode unreported_event_ = FaultCode::none;
+  std::uint8_t last_event_detail_ = 0;
+
+  std::uint32_t cycle_ = 0;
+  Cables latest_cables_mm_;
+  std::uint32_t segment_updated_cycle_[kMaxSegments] = {};
+  bool segment_seen_[kMaxSegments] = {};
+  bool fresh_cables_ = false;
+  std::uint32_t last_valid_cycle_ = 0;
+
+  PoseEstimate latest_pose_;
+  bool has_pose_ = false;
+
+  bool pending_xy_ = false;
+  bool pending_orientation_ = false;
+  double pending_x_mm_ = 0;
+  double pending_y_mm_ = 0;
+  double pending_quaternion_[4] = {1, 0, 0, 0};
+  IkReport last_ik_report_;
+  bool has_setpoints_ = false;
+  Cables setpoints_mm_;
+  Joints setpoint_joints_;
+
+  CycleStatistics statistics_;
+};
+
+}  // namespace cdcr::firmware

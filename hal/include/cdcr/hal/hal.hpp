@@ -1,0 +1,21 @@
+#pragma once
+// The one object a platform hands the runtime: every peripheral it may use,
+// each behind a narrow interface. Runtime code includes only this directory,
+// never a backend's headers; a backend builds a Hal from its own objects.
+
+#include "cdcr/hal/can_bus.hpp"
+#include "cdcr/hal/clock.hpp"
+#include "cdcr/hal/console.hpp"
+#include "cdcr/hal/model_storage.hpp"
+
+namespace cdcr::hal {
+
+struct Hal {
+  MonotonicClock& clock;
+  PeriodicTimer& timer;
+  CanBus& can;
+  ModelStorage& model_storage;
+  Console& console;
+};
+
+}  // namespace cdcr::hal

@@ -1,0 +1,40 @@
+#pragma once
+// The cable drives as the runtime sees them over CAN: they take setpoint
+// frames, move each cable toward its setpoint at a limited rate, and report
+// the achieved lengths every step, one feedback frame per segment.
+
+#include <cdcr/firmware/capacity.hpp>
+#include <cdcr/hal/can_bus.hpp>
+#include <cdcr/model/types.hpp>
+
+namespace cdcr::sim {
+
+class SimulatedCableDrives {
+ public:
+  using Cables = model::CableVector<double, firmware::kMaxSegments>;
+
+  // `bus` is the drives' own node; lengths start at initial_cables_mm.
+  SimulatedCableDrives(hal::CanBus& bus, const Cables& initial_cables_mm, double max_rate_mm_per_s);
+
+  // Takes every pending setpoint frame, moves the cables by dt_s, publishes.
+  void step(double dt_s);
+
+  // Stops or resumes the feedback frames (a drive losing its bus).
+  void set_silent(bool silent) { silent_ = silent; }
+
+  const Cables& cables_mm() const { return cables_mm_; }
+  const Cables& setpoints_mm() const { return setpoints_mm_; }
+  std::uint32_t setpoint_frames() const { return setpoint_frames_; }
+  std::uint32_t rejected_frames() const { return rejected_frames_; }
+
+ private:
+  hal::CanBus& bus_;
+  Cables cables_mm_;
+  Cables setpoints_mm_;
+  double max_rate_mm_per_s_;
+  bool silent_ = false;
+  std::uint32_t setpoint_frames_ = 0;
+  std::uint32_t rejected_frames_ = 0;
+};
+
+}  // namespace cdcr::sim

@@ -1,0 +1,98 @@
+// cdcr-runtime --replay runs the firmware's forward path; over the same image
+// and cables its poses agree with `cdcr eval`'s firmware poses
+// (training::firmware_poses).
+
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "dataset/csv_dataset.hpp"
+#include "runtime_fixture.hpp"
+#include "train/evaluation.hpp"
+
+namespace cdcr::firmware {
+namespace {
+
+TEST(RuntimeReplay, MatchesTheEvaluationsFirmwarePoses) {
+  const std::vector<std::uint8_t> image = exporting::write_image(test_support::synthetic_trained_model());
+  model::ImageView view;
+  ASSERT_EQ(model::parse_image(image.data(), image.size(), view), model::ImageStatus::ok);
+  model::RobotGeometry<double> geometry;
+  ASSERT_EQ(model::geometry_from_image(view, geometry), model::Status::ok);
+
+  dataset::Dataset data;
+  data.segment_count = geometry.segment_count;
+  const int samples = 200;
+  data.cables_mm.resize(samples, 4 * geometry.segment_count);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> alpha(-M_PI, M_PI), theta(0.0, 1.2);
+  for (int i = 0; i < samples; ++i) {
+    model::JointVector<double> joints(2 * geometry.segment_count);
+    for (int s = 0; s < geometry.segment_count; ++s) {
+      joints[2 * s] = alpha(rng);
+      joints[2 * s + 1] = theta(rng);
+    }
+    model::CableVector<double> cables;
+    ASSERT_EQ(model::cables_from_joints(joints, geometry, cables), model::Status::ok);
+    data.cables_mm.row(i) = cables.transpose();
+  }
+
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream out(dir / "model.img", std::ios::binary);
+    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
+  }
+  dataset::write_dataset_csv((dir / "cables.csv").string(), data);
+  const std::string command = std::string("\"") + CDCR_RUNTIME_EXE + "\" --image \"" + (dir / "model.img").string() +
+                              "\" --replay \"" + (dir / "cables.csv").string() + "\" --out \"" +
+                              (dir / "poses.csv").string() + "\"";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+
+  // The replay reads the cables back from the CSV, as cdcr eval does.
+  const dataset::Dataset written = dataset::read_dataset_csv((dir / "cables.csv").string());
+  const std::vector<model::Pose<double>> reference = training::firmware_poses(view, written.cables_mm);
+
+  std::ifstream in(dir / "poses.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  EXPECT_EQ(line, "x,y,z,qw,qx,qy,qz");
+  std::vector<model::Pose<double>> replayed;
+  while (std::getline(in, line)) {
+    double v[7];
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6]),
+              7);
+    model::Pose<double> pose;
+    pose.position_mm = model::Vec3<double>(v[0], v[1], v[2]);
+    pose.rotation = Eigen::Quaterniond(v[3], v[4], v[5], v[6]).normalized().toRotationMatrix();
+    replayed.push_back(pose);
+  }
+  ASSERT_EQ(replayed.size(), reference.size());
+  const training::Fidelity fidelity = training::compare_poses(reference, replayed);
+  EXPECT_LT(fidelity.max_position_mm, 0.01);
+  EXPECT_LT(fidelity.max_orientation_deg, 0.001);
+}
+
+TEST(RuntimeReplay, CorruptImageIsOneLineErrorWithExitOne) {
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_bad";
+  std::filesystem::create_directories(dir);
+  { std::ofstream(dir / "bad.img") << "not an image"; }
+  { std::ofstream(dir / "c.csv") << "l1_1,l1_2,l1_3,l1_4\n120,120,120,120\n"; }
+  const std::string command = std::string("\"") + CDCR_RUNTIME_EXE + "\" --image \"" + (dir / "bad.img").string() +
+                              "\" --replay \"" + (dir / "c.csv").string() + "\" --out \"" +
+                              (dir / "p.csv").string() + "\" 2>/dev/null";
+  const int status = std::system(command.c_str());
+  ASSERT_TRUE(WIFEXITED(status));
+  EXPECT_EQ(WEXITSTATUS(status), 1);
+  const int usage = std::system((std::string("\"") + CDCR_RUNTIME_EXE + "\" --replay x 2>/dev/null").c_str());
+  ASSERT_TRUE(WIFEXITED(usage));
+  EXPECT_EQ(WEXITSTATUS(usage), 2);
+}
+
+}  // namespace
+}  // namespace cdcr::firmware

@@ -1,0 +1,252 @@
+// cdcr-runtime: the firmware's cycle code on the host.
+//   --replay: the forward path over recorded cable lengths, as fast as possible.
+//   --sim:    the closed loop with simulated drives and robot over the virtual
+//             bus, at a fixed rate in lockstep simulated time.
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
+
+#include <cdcr/firmware/runtime.hpp>
+#include <cdcr/model/compensation.hpp>
+
+#include "dataset/csv_dataset.hpp"
+#include "sim/host_backends.hpp"
+#include "sim/lockstep_timer.hpp"
+#include "sim/simulated_drives.hpp"
+#include "sim/simulated_robot.hpp"
+#include "sim/virtual_can.hpp"
+
+namespace {
+
+namespace fw = cdcr::firmware;
+namespace model = cdcr::model;
+namespace protocol = cdcr::firmware::protocol;
+namespace sim = cdcr::sim;
+
+constexpr int kExitInvalidInput = 1;
+constexpr int kExitUsage = 2;
+
+struct InputError : std::runtime_error {
+  using std::runtime_error::runtime_error;
+};
+
+std::vector<std::uint8_t> read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError("cannot open " + path);
+  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+// The host's Hal around the simulated platform.
+struct HostPlatform {
+  sim::VirtualCanBus bus;
+  sim::LockstepClock clock;
+  sim::LockstepTimer timer{clock};
+  sim::MemoryModelStorage storage;
+  sim::StderrConsole console{false};
+  cdcr::hal::Hal hal{clock, timer, bus.node(0), storage, console};
+};
+
+int replay(const std::string& image_path, const std::string& cables_path, const std::string& out_path) {
+  HostPlatform platform;
+  platform.storage.assign(read_bytes(image_path));
+  fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
+  if (runtime.init() != fw::RuntimeState::run) {
+    std::string message = std::string("image ") + image_path + ": " + fw::to_string(runtime.boot_fault());
+    if (runtime.boot_fault() == fw::FaultCode::image_invalid) {
+      message += std::string(" (") + model::to_string(static_cast<model::ImageStatus>(runtime.boot_fault_detail())) + ")";
+    }
+    throw InputError(message);
+  }
+  cdcr::dataset::Dataset data;
+  try {
+    data = cdcr::dataset::read_dataset_csv(cables_path);
+  } catch (const std::exception& e) {
+    throw InputError(e.what());
+  }
+  if (data.segment_count != runtime.geometry().segment_count) {
+    throw InputError(cables_path + ": " + std::to_string(data.segment_count) + " segments, the image has " +
+                     std::to_string(runtime.geometry().segment_count));
+  }
+  std::FILE* out = std::fopen(out_path.c_str(), "w");
+  if (out == nullptr) throw InputError("cannot write " + out_path);
+  std::fprintf(out, "x,y,z,qw,qx,qy,qz\n");
+  for (Eigen::Index i = 0; i < data.cables_mm.rows(); ++i) {
+    const fw::Cables cables = data.cables_mm.row(i).transpose().cast<float>();
+    fw::PoseEstimate estimate;
+    if (const model::Status s = runtime.estimate_pose(cables, estimate); s != model::Status::ok) {
+      std::fclose(out);
+      throw InputError(cables_path + ": sample " + std::to_string(i + 1) + ": " + model::to_string(s));
+    }
+    const model::Pose<double> pose = estimate.pose.cast<double>();
+    Eigen::Quaterniond q(pose.rotation);
+    q.normalize();
+    if (q.w() < 0) q.coeffs() *= -1.0;
+    std::fprintf(out, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", pose.position_mm.x(), pose.position_mm.y(),
+                 pose.position_mm.z(), q.w(), q.x(), q.y(), q.z());
+  }
+  if (std::fclose(out) != 0) throw InputError("cannot write " + out_path);
+  return 0;
+}
+
+void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, std::uint8_t sequence) {
+  cdcr::hal::CanFrame frame = protocol::make_frame(protocol::kTargetPositionXyId, 8);
+  protocol::put(frame, protocol::signal::position_xy[0], target_mm.x());
+  protocol::put(frame, protocol::signal::position_xy[1], target_mm.y());
+  host.send(frame);
+  frame = protocol::make_frame(protocol::kTargetPositionZId, 6);
+  protocol::put(frame, protocol::signal::target_z[0], target_mm.z());
+  protocol::put_raw(frame, protocol::signal::target_z[1], static_cast<int>(protocol::TargetMode::position));
+  protocol::put_raw(frame, protocol::signal::target_z[2], sequence);
+  host.send(frame);
+}
+
+int simulate(const std::string& image_path, double rate_hz, double seconds, bool ideal_robot) {
+  if (!(rate_hz > 0) || !(rate_hz <= 100000)) throw std::invalid_argument("--rate must be in (0, 100000] Hz");
+  if (!(seconds > 0) || !(seconds <= 3600)) throw std::invalid_argument("--seconds must be in (0, 3600]");
+  HostPlatform platform;
+  if (!image_path.empty()) platform.storage.assign(read_bytes(image_path));
+  fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
+  runtime.init();
+
+  model::RobotGeometry<double> geometry;
+  geometry.segment_count = runtime.geometry().segment_count;
+  for (int s = 0; s < geometry.segment_count; ++s) {
+    const auto& g = runtime.geometry().segments[s];
+    geometry.segments[s] = {double(g.backbone_length_mm), double(g.anchor_radius_mm), double(g.theta_max_rad)};
+  }
+  const sim::SimulatedRobot robot(geometry, ideal_robot ? sim::SimulatorConfig::nominal_only() : sim::SimulatorConfig{});
+
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> alpha(-M_PI, M_PI), theta(0.02, 0.2);
+  const auto random_joints = [&] {
+    model::JointVector<double> joints(2 * geometry.segment_count);
+    for (int s = 0; s < geometry.segment_count; ++s) {
+      joints[2 * s] = alpha(rng);
+      joints[2 * s + 1] = theta(rng);
+    }
+    return joints;
+  };
+  model::CableVector<double> start_cables;
+  model::cables_from_joints(random_joints(), geometry, start_cables);
+  sim::SimulatedCableDrives drives(platform.bus.node(1), start_cables, 50.0);
+  cdcr::hal::CanBus& host = platform.bus.node(2);
+  const cdcr::hal::CanFilter host_filter{protocol::kIkReportId, 0x7FF};
+  host.set_filters(&host_filter, 1);
+
+  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
+  const double dt_s = double(period_ns) * 1e-9;
+  const long cycles = std::lround(seconds * rate_hz);
+  const long cycles_per_target = std::max(1L, std::lround(0.5 * rate_hz));
+  platform.timer.start(period_ns);
+
+  double estimate_error_sum_mm = 0, estimate_error_max_mm = 0;
+  long estimate_samples = 0;
+  double target_error_sum_mm = 0, target_error_max_mm = 0;
+  long targets_sent = 0, targets_checked = 0, targets_converged = 0;
+  model::Vec3<double> target_mm = model::Vec3<double>::Zero();
+  std::int64_t host_max_ns = 0, host_total_ns = 0;
+
+  for (long k = 0; k < cycles; ++k) {
+    const cdcr::hal::TimerTick tick = platform.timer.wait_next();
+    drives.step(dt_s);
+    if (k % cycles_per_target == 0) {
+      if (targets_sent > 0) {
+        const double error_mm = (robot.true_pose(drives.cables_mm()).position_mm - target_mm).norm();
+        target_error_sum_mm += error_mm;
+        target_error_max_mm = std::max(target_error_max_mm, error_mm);
+        ++targets_checked;
+      }
+      // Targets the real robot can reach: where it goes for random cables.
+      model::CableVector<double> target_cables;
+      model::cables_from_joints(random_joints(), geometry, target_cables);
+      target_mm = robot.true_pose(target_cables).position_mm;
+      send_target(host, target_mm, static_cast<std::uint8_t>(targets_sent++));
+    }
+    const auto begin = std::chrono::steady_clock::now();
+    runtime.run_cycle(tick);
+    const std::int64_t elapsed_ns =
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - begin).count();
+    host_max_ns = std::max(host_max_ns, elapsed_ns);
+    host_total_ns += elapsed_ns;
+    cdcr::hal::CanFrame report;
+    while (host.receive(report) == cdcr::hal::CanStatus::ok) {
+      if (report.id == protocol::kIkReportId &&
+          protocol::get_raw(report, protocol::signal::ik_report[1]) == int(protocol::IkOutcome::converged)) {
+        ++targets_converged;
+      }
+    }
+    if (runtime.has_pose()) {
+      const double error_mm =
+          (robot.true_pose(drives.cables_mm()).position_mm - runtime.latest_pose().pose.position_mm.cast<double>())
+              .norm();
+      estimate_error_sum_mm += error_mm;
+      estimate_error_max_mm = std::max(estimate_error_max_mm, error_mm);
+      ++estimate_samples;
+    }
+  }
+  const fw::CycleStatistics& stats = runtime.statistics();
+  std::printf("state %s, fault: %s\n", fw::to_string(runtime.state()), fw::to_string(runtime.active_fault()));
+  std::printf("cycles %u at %.0f Hz (%.3f s simulated), overruns %u, rejected frames %u, stale events %u\n",
+              stats.cycles, rate_hz, double(cycles) / rate_hz, stats.overruns, stats.rejected_frames,
+              stats.stale_events);
+  std::printf("cycle execution on this host: max %.1f us, mean %.1f us (period %.1f us)\n", host_max_ns * 1e-3,
+              cycles > 0 ? double(host_total_ns) / double(cycles) * 1e-3 : 0.0, double(period_ns) * 1e-3);
+  std::printf("pose estimate vs simulated robot: mean %.3f mm, max %.3f mm over %ld cycles\n",
+              estimate_samples > 0 ? estimate_error_sum_mm / double(estimate_samples) : 0.0, estimate_error_max_mm,
+              estimate_samples);
+  std::printf("targets: %ld sent, %ld converged; tip vs target after %.2f s: mean %.3f mm, max %.3f mm over %ld\n",
+              targets_sent, targets_converged, double(cycles_per_target) / rate_hz,
+              targets_checked > 0 ? target_error_sum_mm / double(targets_checked) : 0.0, target_error_max_mm,
+              targets_checked);
+  return 0;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"The firmware runtime on the host: replay recorded cables or run the simulated closed loop."};
+  app.name("cdcr-runtime");
+  std::string image_path, replay_path, out_path;
+  bool run_sim = false;
+  bool ideal_robot = false;
+  double rate_hz = 1000.0, seconds = 2.0;
+  app.add_option("--image", image_path, "model image (flash image v1)");
+  auto* replay_option = app.add_option("--replay", replay_path, "cable-length CSV (dataset layout) to replay");
+  app.add_option("--out", out_path, "pose CSV written by --replay");
+  auto* sim_option = app.add_flag("--sim", run_sim, "close the loop with the simulated robot");
+  app.add_option("--rate", rate_hz, "cycle rate for --sim, Hz")->capture_default_str();
+  app.add_option("--seconds", seconds, "simulated duration for --sim")->capture_default_str();
+  app.add_flag("--ideal-robot", ideal_robot, "--sim with every simulated error source off (the nominal model)");
+  replay_option->excludes(sim_option);
+  try {
+    app.parse(argc, argv);
+    if (!run_sim && replay_path.empty()) throw CLI::ValidationError("one of --replay or --sim is required");
+    if (!replay_path.empty() && (image_path.empty() || out_path.empty())) {
+      throw CLI::ValidationError("--replay needs --image and --out");
+    }
+  } catch (const CLI::CallForHelp& e) {
+    return app.exit(e);
+  } catch (const CLI::ParseError& e) {
+    std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());
+    return kExitUsage;
+  }
+  try {
+    return run_sim ? simulate(image_path, rate_hz, seconds, ideal_robot) : replay(image_path, replay_path, out_path);
+  } catch (const std::invalid_argument& e) {
+    std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());
+    return kExitUsage;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());
+    return kExitInvalidInput;
+  }
+}
