@@ -20,8 +20,14 @@ mkdir -p "$work_dir"
 cdcr=$build_dir/bin/cdcr
 
 "$cdcr" simulate --samples 750 --seed "$seed" --out "$work_dir/data.csv" --json >"$work_dir/simulate.json"
-floor=$(/usr/bin/python3 -c 'import json,sys; f=json.load(open(sys.argv[1]))["noise_floor"]; print(f"{f[\"position_mm\"]},{f[\"orientation_deg\"]}")' \
-  "$work_dir/simulate.json")
+floor=$(/usr/bin/python3 - "$work_dir/simulate.json" <<'PYTHON'
+import json
+import sys
+
+floor = json.load(open(sys.argv[1]))["noise_floor"]
+print("{},{}".format(floor["position_mm"], floor["orientation_deg"]))
+PYTHON
+)
 echo "simulated robot (seed $seed): $(cat "$work_dir/simulate.json")"
 
 echo

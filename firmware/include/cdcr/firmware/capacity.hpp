@@ -29,7 +29,11 @@ inline constexpr int kRxQueueDepth = 128;
 inline constexpr int kMaxCanFilters = 4;
 
 // Levenberg-Marquardt iterations one IK request may take; bounds the cycle
-// in which a target arrives.
+// in which a target arrives. Each iteration, accepted or not, costs one
+// compensated model evaluation (tip pose, Jacobian, GP mean and gradient over
+// every training point), plus one for the start: a target cycle costs at most
+// kMaxIkIterations + 1 of them on top of the forward path.
+// cdcr-bench-runtime measures that worst case.
 inline constexpr int kMaxIkIterations = 50;
 
 // Cycles without a fresh, valid cable frame from every segment before the

@@ -1,0 +1,411 @@
+// Per-cycle compute time of the firmware runtime on this host: the exact
+// Runtime::run_cycle() of a board build, fed over the simulated bus in
+// lockstep time, so only the cycle itself sits between the two clock reads.
+//
+// Cycle kinds, each with fresh cable feedback from every segment:
+//   forward         the compensated pose estimate (RUN state);
+//   IK stream       plus a position target a small step from the previous
+//                   one, warm-started from the current setpoint (tracking);
+//   IK jump         plus a position target anywhere in the workspace;
+//   IK pose jump    plus a full pose target anywhere in the workspace: the
+//                   slowest per iteration and the likeliest to hit the cap.
+// Targets are poses the simulated robot actually reaches, so the compensated
+// IK can meet them.
+//
+// Baselines in the same process (on a shared machine only ratios to them are
+// comparable between runs): one nominal forward_kinematics_bend() in float,
+// and one bare GP predict of the image.
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstddef>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <memory>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <time.h>
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
+
+#include <cdcr/firmware/runtime.hpp>
+
+#include "sim/host_backends.hpp"
+#include "sim/lockstep_timer.hpp"
+#include "sim/simulated_robot.hpp"
+#include "sim/virtual_can.hpp"
+#include "sim/workspace_sampler.hpp"
+
+namespace {
+
+namespace fw = cdcr::firmware;
+namespace model = cdcr::model;
+namespace protocol = cdcr::firmware::protocol;
+namespace sim = cdcr::sim;
+using Clock = std::chrono::steady_clock;
+
+constexpr std::int64_t kPeriodNs = 1'000'000;  // 1 kHz; lockstep, so only the release times use it
+constexpr std::size_t kRingSize = 4096;
+// Per-cycle joint step of the tracked trajectory: up to 1 rad/s per joint at
+// 1 kHz, well under a millimetre of tip motion per cycle.
+constexpr double kStreamStepRad = 1e-3;
+constexpr int kBaselineBatch = 4096;
+
+struct Options {
+  std::string image_path;
+  int forward_cycles = 20000;
+  int ik_cycles = 1000;
+  int repetitions = 5;
+  std::uint64_t seed = 1;
+};
+
+std::vector<std::uint8_t> read_bytes(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw std::runtime_error("cannot open " + path);
+  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+}
+
+struct HostPlatform {
+  sim::VirtualCanBus bus;
+  sim::LockstepClock clock;
+  sim::LockstepTimer timer{clock};
+  sim::MemoryModelStorage storage;
+  sim::StderrConsole console{false};
+  cdcr::hal::Hal hal{clock, timer, bus.node(0), storage, console};
+};
+
+using CableFrames = std::vector<cdcr::hal::CanFrame>;
+
+CableFrames cable_frames(const model::CableVector<double>& cables_mm, int segment_count) {
+  CableFrames frames(static_cast<std::size_t>(segment_count));
+  for (int s = 0; s < segment_count; ++s) {
+    const double lengths_mm[4] = {cables_mm[4 * s], cables_mm[4 * s + 1], cables_mm[4 * s + 2], cables_mm[4 * s + 3]};
+    if (!protocol::encode_cables(protocol::kCableFeedbackBaseId + std::uint32_t(s), lengths_mm, frames[std::size_t(s)])) {
+      throw std::runtime_error("cable length out of the frame's range");
+    }
+  }
+  return frames;
+}
+
+std::vector<cdcr::hal::CanFrame> target_frames(const model::Pose<double>& target, protocol::TargetMode mode,
+                                               std::uint8_t sequence) {
+  std::vector<cdcr::hal::CanFrame> frames;
+  if (mode == protocol::TargetMode::pose) {
+    Eigen::Quaterniond q(target.rotation);
+    q.normalize();
+    cdcr::hal::CanFrame frame = protocol::make_frame(protocol::kTargetOrientationId, 8);
+    const double w_first[4] = {q.w(), q.x(), q.y(), q.z()};
+    for (int k = 0; k < 4; ++k) protocol::put(frame, protocol::signal::quaternion[k], w_first[k]);
+    frames.push_back(frame);
+  }
+  cdcr::hal::CanFrame frame = protocol::make_frame(protocol::kTargetPositionXyId, 8);
+  protocol::put(frame, protocol::signal::position_xy[0], target.position_mm.x());
+  protocol::put(frame, protocol::signal::position_xy[1], target.position_mm.y());
+  frames.push_back(frame);
+  frame = protocol::make_frame(protocol::kTargetPositionZId, 6);
+  protocol::put(frame, protocol::signal::target_z[0], target.position_mm.z());
+  protocol::put_raw(frame, protocol::signal::target_z[1], static_cast<int>(mode));
+  protocol::put_raw(frame, protocol::signal::target_z[2], sequence);
+  frames.push_back(frame);
+  return frames;
+}
+
+// Everything the cycles read, generated before any timing.
+struct Workload {
+  model::RobotGeometry<double> geometry;
+  std::vector<CableFrames> feedback;                      // kRingSize workspace samples
+  std::vector<fw::Joints> bends;                          // the same samples, for the baselines
+  std::vector<std::vector<cdcr::hal::CanFrame>> stream;   // position targets along a trajectory
+  std::vector<std::vector<cdcr::hal::CanFrame>> jump;     // position targets anywhere
+  std::vector<std::vector<cdcr::hal::CanFrame>> pose_jump;
+};
+
+Workload make_workload(const fw::Runtime& runtime, const Options& options) {
+  Workload w;
+  const fw::Geometry& g = runtime.geometry();
+  w.geometry.segment_count = g.segment_count;
+  for (int s = 0; s < g.segment_count; ++s) {
+    w.geometry.segments[s] = {double(g.segments[s].backbone_length_mm), double(g.segments[s].anchor_radius_mm),
+                              double(g.segments[s].theta_max_rad)};
+  }
+  sim::SimulatorConfig config;
+  config.seed = options.seed;
+  const sim::SimulatedRobot robot(w.geometry, config);
+  sim::WorkspaceSampler sampler(w.geometry, config.workspace_theta_max_rad, options.seed + 1000);
+
+  for (std::size_t k = 0; k < kRingSize; ++k) {
+    const sim::WorkspaceSample sample = sampler.next();
+    w.feedback.push_back(cable_frames(sample.cables_mm, w.geometry.segment_count));
+    w.bends.push_back(model::bend_from_joints(sample.joints).cast<float>());
+    const model::Pose<double> reached = robot.true_pose(sample.cables_mm);
+    const auto sequence = static_cast<std::uint8_t>(k);
+    w.jump.push_back(target_frames(reached, protocol::TargetMode::position, sequence));
+    w.pose_jump.push_back(target_frames(reached, protocol::TargetMode::pose, sequence));
+  }
+
+  // A random walk in joint space, kept inside the sampled workspace.
+  std::mt19937 rng(static_cast<std::uint32_t>(options.seed));
+  std::uniform_real_distribution<double> step(-kStreamStepRad, kStreamStepRad);
+  model::JointVector<double> joints = sampler.next().joints;
+  for (std::size_t k = 0; k < kRingSize; ++k) {
+    for (int s = 0; s < w.geometry.segment_count; ++s) {
+      joints[2 * s] += step(rng);
+      joints[2 * s + 1] = std::clamp(joints[2 * s + 1] + step(rng), 0.0, config.workspace_theta_max_rad);
+    }
+    model::CableVector<double> cables_mm;
+    if (model::cables_from_joints(joints, w.geometry, cables_mm) != model::Status::ok) {
+      throw std::runtime_error("trajectory left the nominal model's range");
+    }
+    w.stream.push_back(
+        target_frames(robot.true_pose(cables_mm), protocol::TargetMode::position, static_cast<std::uint8_t>(k)));
+  }
+  return w;
+}
+
+struct CycleSamples {
+  std::vector<std::int64_t> ns;
+  // Thread CPU time of the same cycles: the wall-clock maximum on a shared
+  // machine is usually a preemption, which this leaves out.
+  std::vector<std::int64_t> cpu_ns;
+  std::vector<int> iterations;
+  int converged = 0;
+};
+
+enum class CycleKind { forward, ik_stream, ik_jump, ik_pose_jump };
+constexpr CycleKind kKinds[] = {CycleKind::forward, CycleKind::ik_stream, CycleKind::ik_jump, CycleKind::ik_pose_jump};
+constexpr int kKindCount = 4;
+
+const char* label(CycleKind kind) {
+  switch (kind) {
+    case CycleKind::forward: return "forward (pose estimate)";
+    case CycleKind::ik_stream: return "forward + IK, position target on a trajectory";
+    case CycleKind::ik_jump: return "forward + IK, position target anywhere";
+    case CycleKind::ik_pose_jump: return "forward + IK, pose target anywhere";
+  }
+  return "?";
+}
+
+std::int64_t thread_cpu_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return std::int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
+// One run of one cycle kind on a freshly booted runtime.
+CycleSamples run_cycles(const std::vector<std::uint8_t>& image, const Workload& w, CycleKind kind, int cycles) {
+  auto platform = std::make_unique<HostPlatform>();
+  platform->storage.assign(image);
+  auto runtime = std::make_unique<fw::Runtime>(platform->hal, fw::Geometry::prototype());
+  if (runtime->init() != fw::RuntimeState::run) {
+    throw std::runtime_error(std::string("image does not boot: ") + fw::to_string(runtime->boot_fault()));
+  }
+  cdcr::hal::CanBus& peer = platform->bus.node(1);
+  platform->timer.start(kPeriodNs);
+  const std::vector<std::vector<cdcr::hal::CanFrame>>* targets =
+      kind == CycleKind::ik_stream ? &w.stream
+      : kind == CycleKind::ik_jump ? &w.jump
+      : kind == CycleKind::ik_pose_jump ? &w.pose_jump
+                                        : nullptr;
+
+  CycleSamples samples;
+  samples.ns.reserve(std::size_t(cycles));
+  cdcr::hal::CanFrame drained;
+  for (int k = 0; k < cycles; ++k) {
+    const std::size_t i = std::size_t(k) % kRingSize;
+    for (const auto& frame : w.feedback[i]) peer.send(frame);
+    if (targets != nullptr) {
+      for (const auto& frame : (*targets)[i]) peer.send(frame);
+    }
+    const cdcr::hal::TimerTick tick = platform->timer.wait_next();
+    const std::int64_t cpu_begin_ns = thread_cpu_ns();
+    const Clock::time_point begin = Clock::now();
+    runtime->run_cycle(tick);
+    const Clock::time_point end = Clock::now();
+    const std::int64_t cpu_end_ns = thread_cpu_ns();
+    samples.ns.push_back(std::chrono::duration_cast<std::chrono::nanoseconds>(end - begin).count());
+    samples.cpu_ns.push_back(cpu_end_ns - cpu_begin_ns);
+    while (peer.receive(drained) == cdcr::hal::CanStatus::ok) {
+    }
+    if (targets != nullptr) {
+      samples.iterations.push_back(runtime->last_ik_report().iterations);
+      if (runtime->last_ik_report().outcome == protocol::IkOutcome::converged) ++samples.converged;
+    }
+  }
+  if (runtime->statistics().rejected_frames != 0 || runtime->statistics().rejected_cable_sets != 0 ||
+      runtime->state() != fw::RuntimeState::run) {
+    throw std::runtime_error(std::string("runtime left the nominal path: state ") + fw::to_string(runtime->state()));
+  }
+  return samples;
+}
+
+double percentile(std::vector<std::int64_t> values, double fraction) {
+  if (values.empty()) return 0;
+  const auto rank = static_cast<std::size_t>(std::ceil(fraction * double(values.size()))) - 1;
+  std::nth_element(values.begin(), values.begin() + std::ptrdiff_t(rank), values.end());
+  return double(values[rank]);
+}
+
+double median(std::vector<double> values) {
+  std::sort(values.begin(), values.end());
+  const std::size_t n = values.size();
+  return n % 2 == 1 ? values[n / 2] : 0.5 * (values[n / 2 - 1] + values[n / 2]);
+}
+
+template <typename Call>
+double per_call_ns(Call&& call) {
+  const Clock::time_point begin = Clock::now();
+  for (int k = 0; k < kBaselineBatch; ++k) call(std::size_t(k) % kRingSize);
+  return double(std::chrono::duration_cast<std::chrono::nanoseconds>(Clock::now() - begin).count()) / kBaselineBatch;
+}
+
+volatile float g_sink = 0;
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"Per-cycle compute time of the firmware runtime on this host (simulated bus, lockstep time)."};
+  app.name("cdcr-bench-runtime");
+  Options options;
+  app.add_option("--image", options.image_path, "model image (flash image v1)")->required();
+  app.add_option("--forward-cycles", options.forward_cycles, "forward cycles per run")->capture_default_str();
+  app.add_option("--ik-cycles", options.ik_cycles, "cycles per run of each IK kind")->capture_default_str();
+  app.add_option("--repetitions", options.repetitions, "runs of every kind; the table shows medians")
+      ->capture_default_str();
+  app.add_option("--seed", options.seed, "simulated robot (as cdcr simulate --seed)")->capture_default_str();
+  CLI11_PARSE(app, argc, argv);
+  if (options.forward_cycles < 1 || options.ik_cycles < 1 || options.repetitions < 1) {
+    std::fprintf(stderr, "cdcr-bench-runtime: error: cycle and repetition counts must be positive\n");
+    return 2;
+  }
+
+  try {
+    const std::vector<std::uint8_t> image = read_bytes(options.image_path);
+    HostPlatform probe_platform;
+    probe_platform.storage.assign(image);
+    fw::Runtime probe(probe_platform.hal, fw::Geometry::prototype());
+    if (probe.init() != fw::RuntimeState::run) {
+      throw std::runtime_error(std::string("image does not boot: ") + fw::to_string(probe.boot_fault()));
+    }
+    const Workload w = make_workload(probe, options);
+
+    model::ImageView view{};
+    model::ImageCapacity capacity;
+    capacity.max_training_points = fw::kMaxTrainingPoints;
+    capacity.max_segments = fw::kMaxSegments;
+    const sim::MemoryModelStorage aligned(image);
+    const auto region = aligned.model_region();
+    if (model::parse_image(region.data, region.size_bytes, view, capacity) != model::ImageStatus::ok) {
+      throw std::runtime_error("image does not parse");
+    }
+    fw::Correction correction;
+    if (correction.bind(view) != model::Status::ok) throw std::runtime_error("image does not bind");
+    const fw::Geometry& geometry = probe.geometry();
+
+    std::vector<double> fk_ns, gp_ns, evaluation_ns;
+    std::vector<double> p50[kKindCount], p99[kKindCount], mean_iterations[kKindCount];
+    std::vector<std::int64_t> all_iterations[kKindCount];
+    std::int64_t worst_ns[kKindCount] = {}, worst_cpu_ns[kKindCount] = {};
+    int worst_cpu_iterations[kKindCount] = {};
+    int worst_iterations[kKindCount] = {};
+    long capped[kKindCount] = {}, converged[kKindCount] = {}, total[kKindCount] = {};
+    for (int r = 0; r < options.repetitions; ++r) {
+      fk_ns.push_back(per_call_ns([&](std::size_t i) {
+        g_sink = g_sink + model::forward_kinematics_bend(w.bends[i], geometry).position_mm.x();
+      }));
+      gp_ns.push_back(per_call_ns([&](std::size_t i) { g_sink = g_sink + correction.predict(w.bends[i])[0]; }));
+      // What each IK iteration evaluates (see evaluate_model in inverse_kinematics.hpp).
+      evaluation_ns.push_back(per_call_ns([&](std::size_t i) {
+        model::Pose<float> tip;
+        model::Jacobian<float, fw::kMaxSegments> jacobian, d_eps;
+        model::Twist<float> eps;
+        model::tip_jacobian_bend(w.bends[i], geometry, tip, jacobian);
+        correction(w.bends[i], eps, d_eps);
+        const model::Pose<float> correction_pose = model::exp(eps);
+        model::apply_adjoint(correction_pose, jacobian);
+        jacobian.noalias() += model::left_jacobian(eps) * d_eps;
+        g_sink = g_sink + (correction_pose * tip).position_mm.x() + jacobian(0, 0);
+      }));
+      for (int k = 0; k < kKindCount; ++k) {
+        const CycleKind kind = kKinds[k];
+        const CycleSamples s =
+            run_cycles(image, w, kind, kind == CycleKind::forward ? options.forward_cycles : options.ik_cycles);
+        p50[k].push_back(percentile(s.ns, 0.50));
+        p99[k].push_back(percentile(s.ns, 0.99));
+        worst_ns[k] = std::max(worst_ns[k], *std::max_element(s.ns.begin(), s.ns.end()));
+        for (std::size_t i = 0; i < s.cpu_ns.size(); ++i) {
+          if (s.cpu_ns[i] > worst_cpu_ns[k]) {
+            worst_cpu_ns[k] = s.cpu_ns[i];
+            worst_cpu_iterations[k] = s.iterations.empty() ? 0 : s.iterations[i];
+          }
+        }
+        if (!s.iterations.empty()) {
+          double sum = 0;
+          for (const int n : s.iterations) {
+            sum += n;
+            all_iterations[k].push_back(n);
+            worst_iterations[k] = std::max(worst_iterations[k], n);
+            if (n >= fw::kMaxIkIterations) ++capped[k];
+          }
+          mean_iterations[k].push_back(sum / double(s.iterations.size()));
+          converged[k] += s.converged;
+          total[k] += long(s.iterations.size());
+        }
+      }
+    }
+
+    const double fk_baseline_ns = median(fk_ns);
+    const double gp_baseline_ns = median(gp_ns);
+    const double evaluation_baseline_ns = median(evaluation_ns);
+    std::printf("Image: %u training points, %d inputs (%s), %d segments; IK cap %d iterations per target\n",
+                view.training_points, view.input_dims, model::to_string(view.encoding), view.segment_count,
+                fw::kMaxIkIterations);
+    std::printf("%d runs; per run %d forward cycles and %d cycles of each IK kind. p50/p99: median over runs; "
+                "max: worst of all runs.\n\n",
+                options.repetitions, options.forward_cycles, options.ik_cycles);
+    std::printf("| cycle | p50 us | p99 us | max us | max us, thread CPU | p50 / FK | p99 / FK | "
+                "IK iterations mean / p99 / max | at cap | converged |\n");
+    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    for (int k = 0; k < kKindCount; ++k) {
+      const double m50 = median(p50[k]), m99 = median(p99[k]);
+      std::printf("| %s | %.2f | %.2f | %.1f | %.1f | %.1f | %.1f |", label(kKinds[k]), m50 * 1e-3, m99 * 1e-3,
+                  double(worst_ns[k]) * 1e-3, double(worst_cpu_ns[k]) * 1e-3, m50 / fk_baseline_ns,
+                  m99 / fk_baseline_ns);
+      if (kKinds[k] == CycleKind::forward) {
+        std::printf(" - | - | - |\n");
+      } else {
+        std::printf(" %.1f / %.0f / %d | %ld | %.1f%% |\n", median(mean_iterations[k]),
+                    percentile(all_iterations[k], 0.99), worst_iterations[k], capped[k],
+                    100.0 * double(converged[k]) / double(total[k]));
+      }
+    }
+    std::printf("| baseline: nominal FK (`forward_kinematics_bend`, float) | %.3f | | | | 1.0 | | | | |\n",
+                fk_baseline_ns * 1e-3);
+    std::printf("| baseline: bare GP predict (%u points) | %.2f | | | | %.1f | | | | |\n", view.training_points,
+                gp_baseline_ns * 1e-3, gp_baseline_ns / fk_baseline_ns);
+    std::printf("| one IK model evaluation (FK, Jacobian, GP mean and gradient) | %.2f | | | | %.1f | | | | |\n",
+                evaluation_baseline_ns * 1e-3, evaluation_baseline_ns / fk_baseline_ns);
+    const double forward_p99_us = median(p99[0]) * 1e-3;
+    int slowest = 1;
+    for (int k = 2; k < kKindCount; ++k) {
+      if (worst_cpu_ns[k] > worst_cpu_ns[slowest]) slowest = k;
+    }
+    std::printf("\nSlowest IK cycle: %.1f us thread CPU, %d iterations (%s).\n", double(worst_cpu_ns[slowest]) * 1e-3,
+                worst_cpu_iterations[slowest], label(kKinds[slowest]));
+    std::printf("IK cycle bound at the cap: forward p50 + %d evaluations = %.0f us on this host.\n",
+                fw::kMaxIkIterations + 1,
+                (median(p50[0]) + double(fw::kMaxIkIterations + 1) * evaluation_baseline_ns) * 1e-3);
+    std::printf("\nHost goal p99 <= 10 us per forward cycle: %s (p99 %.2f us)\n",
+                forward_p99_us <= 10.0 ? "met" : "NOT met", forward_p99_us);
+    return 0;
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "cdcr-bench-runtime: error: %s\n", e.what());
+    return 1;
+  }
+}
