@@ -15,6 +15,10 @@ declare -A package_groups=(
   # and sanitizer runtimes (libclang-rt-14-dev is only a Recommends); llvm-14
   # brings llvm-symbolizer for readable sanitizer reports.
   [fuzz]="clang libclang-rt-14-dev llvm-14"
+  # Real SocketCAN tests (ctest -L socketcan): the host kernel may lack AF_CAN,
+  # so they boot a User-Mode Linux kernel that has can, can-raw and vcan as
+  # modules, and drive the bus with can-utils.
+  [uml]="user-mode-linux kmod iproute2 can-utils"
 )
 
 log_file=${CDCR_INSTALL_LOG:-/tmp/cdcr-install-deps.log}

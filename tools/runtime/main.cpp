@@ -2,8 +2,11 @@
 //   --replay: the forward path over recorded cable lengths, as fast as possible.
 //   --sim:    the closed loop with simulated drives and robot over the virtual
 //             bus, at a fixed rate in lockstep simulated time.
+//   --can:    the runtime itself on a SocketCAN interface, in real time, until
+//             --seconds have passed or SIGINT/SIGTERM.
 
 #include <chrono>
+#include <csignal>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -20,6 +23,12 @@
 #include <cdcr/model/compensation.hpp>
 
 #include "dataset/csv_dataset.hpp"
+#if CDCR_HAVE_LINUX_PLATFORM
+#include "linux/mapped_model_storage.hpp"
+#include "linux/posix_time.hpp"
+#include "linux/socketcan_bus.hpp"
+#include "linux/stdio_console.hpp"
+#endif
 #include "sim/host_backends.hpp"
 #include "sim/lockstep_timer.hpp"
 #include "sim/simulated_drives.hpp"
@@ -155,6 +164,21 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
   long targets_sent = 0, targets_checked = 0, targets_converged = 0;
   model::Vec3<double> target_mm = model::Vec3<double>::Zero();
   std::int64_t host_max_ns = 0, host_total_ns = 0;
+  long host_overruns = 0;
+  // The same measures for the nominal model alone, computed alongside on the
+  // host: what compensation gains.
+  double nominal_estimate_error_sum_mm = 0, nominal_estimate_error_max_mm = 0;
+  double nominal_target_error_sum_mm = 0, nominal_target_error_max_mm = 0;
+  long nominal_targets_reached = 0;
+  // Both sides at their commanded cables, settled: the runtime's setpoints
+  // against the nominal IK's.
+  double setpoint_target_error_sum_mm = 0, setpoint_target_error_max_mm = 0;
+  long setpoints_checked = 0;
+  model::JointVector<double> nominal_ik_joints(2 * geometry.segment_count);
+  for (int s = 0; s < geometry.segment_count; ++s) {
+    nominal_ik_joints[2 * s] = 0.0;
+    nominal_ik_joints[2 * s + 1] = 0.1;
+  }
 
   for (long k = 0; k < cycles; ++k) {
     const cdcr::hal::TimerTick tick = platform.timer.wait_next();
@@ -171,6 +195,14 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
       model::cables_from_joints(random_joints(), geometry, target_cables);
       target_mm = robot.true_pose(target_cables).position_mm;
       send_target(host, target_mm, static_cast<std::uint8_t>(targets_sent++));
+      const model::IkResult<double> nominal_ik = model::solve_ik_position(target_mm, geometry, nominal_ik_joints);
+      if (nominal_ik.converged()) {
+        nominal_ik_joints = nominal_ik.joints;
+        const double error_mm = (robot.true_pose(nominal_ik.cables_mm).position_mm - target_mm).norm();
+        nominal_target_error_sum_mm += error_mm;
+        nominal_target_error_max_mm = std::max(nominal_target_error_max_mm, error_mm);
+        ++nominal_targets_reached;
+      }
     }
     const auto begin = std::chrono::steady_clock::now();
     runtime.run_cycle(tick);
@@ -178,6 +210,17 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - begin).count();
     host_max_ns = std::max(host_max_ns, elapsed_ns);
     host_total_ns += elapsed_ns;
+    // Lockstep time charges the cycle nothing, so the runtime's own overrun
+    // count stays zero; this is the count the host's speed would give.
+    if (elapsed_ns > period_ns) ++host_overruns;
+    if (k % cycles_per_target == 0 && runtime.has_setpoints() &&
+        runtime.last_ik_report().outcome == protocol::IkOutcome::converged) {
+      model::CableVector<double> setpoints_mm = runtime.setpoints_mm().cast<double>();
+      const double error_mm = (robot.true_pose(setpoints_mm).position_mm - target_mm).norm();
+      setpoint_target_error_sum_mm += error_mm;
+      setpoint_target_error_max_mm = std::max(setpoint_target_error_max_mm, error_mm);
+      ++setpoints_checked;
+    }
     cdcr::hal::CanFrame report;
     while (host.receive(report) == cdcr::hal::CanStatus::ok) {
       if (report.id == protocol::kIkReportId &&
@@ -192,15 +235,26 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
       estimate_error_sum_mm += error_mm;
       estimate_error_max_mm = std::max(estimate_error_max_mm, error_mm);
       ++estimate_samples;
+      model::JointVector<double> nominal_joints;
+      model::Pose<double> nominal_pose;
+      if (model::joints_from_cables(drives.cables_mm(), geometry, nominal_joints) == model::Status::ok &&
+          model::forward_kinematics(nominal_joints, geometry, nominal_pose) == model::Status::ok) {
+        const double nominal_error_mm =
+            (robot.true_pose(drives.cables_mm()).position_mm - nominal_pose.position_mm).norm();
+        nominal_estimate_error_sum_mm += nominal_error_mm;
+        nominal_estimate_error_max_mm = std::max(nominal_estimate_error_max_mm, nominal_error_mm);
+      }
     }
   }
   const fw::CycleStatistics& stats = runtime.statistics();
   std::printf("state %s, fault: %s\n", fw::to_string(runtime.state()), fw::to_string(runtime.active_fault()));
-  std::printf("cycles %u at %.0f Hz (%.3f s simulated), overruns %u, rejected frames %u, stale events %u\n",
+  std::printf("cycles %u at %.0f Hz (%.3f s simulated), overruns in simulated time %u, rejected frames %u, "
+              "stale events %u\n",
               stats.cycles, rate_hz, double(cycles) / rate_hz, stats.overruns, stats.rejected_frames,
               stats.stale_events);
-  std::printf("cycle execution on this host: max %.1f us, mean %.1f us (period %.1f us)\n", host_max_ns * 1e-3,
-              cycles > 0 ? double(host_total_ns) / double(cycles) * 1e-3 : 0.0, double(period_ns) * 1e-3);
+  std::printf("cycle execution on this host: max %.1f us, mean %.1f us (period %.1f us), %ld over the period\n",
+              host_max_ns * 1e-3, cycles > 0 ? double(host_total_ns) / double(cycles) * 1e-3 : 0.0,
+              double(period_ns) * 1e-3, host_overruns);
   std::printf("pose estimate vs simulated robot: mean %.3f mm, max %.3f mm over %ld cycles\n",
               estimate_samples > 0 ? estimate_error_sum_mm / double(estimate_samples) : 0.0, estimate_error_max_mm,
               estimate_samples);
@@ -208,8 +262,85 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
               targets_sent, targets_converged, double(cycles_per_target) / rate_hz,
               targets_checked > 0 ? target_error_sum_mm / double(targets_checked) : 0.0, target_error_max_mm,
               targets_checked);
+  std::printf("accuracy, nominal model only -> %s runtime:\n",
+              runtime.latest_pose().compensated ? "compensated" : "uncompensated");
+  std::printf("  pose estimate vs robot: mean %.3f -> %.3f mm, max %.3f -> %.3f mm\n",
+              estimate_samples > 0 ? nominal_estimate_error_sum_mm / double(estimate_samples) : 0.0,
+              estimate_samples > 0 ? estimate_error_sum_mm / double(estimate_samples) : 0.0,
+              nominal_estimate_error_max_mm, estimate_error_max_mm);
+  std::printf("  tip vs target at the commanded cables (%ld and %ld of %ld solved): mean %.3f -> %.3f mm, "
+              "max %.3f -> %.3f mm\n",
+              nominal_targets_reached, setpoints_checked, targets_sent,
+              nominal_targets_reached > 0 ? nominal_target_error_sum_mm / double(nominal_targets_reached) : 0.0,
+              setpoints_checked > 0 ? setpoint_target_error_sum_mm / double(setpoints_checked) : 0.0,
+              nominal_target_error_max_mm, setpoint_target_error_max_mm);
   return 0;
 }
+
+#if CDCR_HAVE_LINUX_PLATFORM
+volatile std::sig_atomic_t stop_requested = 0;
+
+void request_stop(int) { stop_requested = 1; }
+
+void print_cycle_statistics(const fw::Runtime& runtime, const cdcr::hal::CanErrorCounters& can, double rate_hz,
+                            double elapsed_s) {
+  const fw::CycleStatistics& stats = runtime.statistics();
+  std::printf("state %s, fault: %s\n", fw::to_string(runtime.state()), fw::to_string(runtime.active_fault()));
+  std::printf("cycles %u at %.0f Hz (%.3f s), overruns %u, rejected frames %u, rejected cable sets %u, stale events %u\n",
+              stats.cycles, rate_hz, elapsed_s, stats.overruns, stats.rejected_frames, stats.rejected_cable_sets,
+              stats.stale_events);
+  std::printf("cycle execution: max %.1f us, mean %.1f us; start jitter max %.1f us\n",
+              double(stats.execution_max_ns) * 1e-3, double(stats.execution_mean_ns()) * 1e-3,
+              double(stats.jitter_max_ns) * 1e-3);
+  std::printf("poses published %u, targets received %u; CAN tx dropped %u, rx overruns %u, bus errors %u\n",
+              stats.poses_published, stats.targets_received, can.tx_dropped, can.rx_overruns, can.bus_errors);
+}
+
+// The runtime on a real bus: the same object the board runs, on the Linux
+// backends, until the duration ends or a signal asks it to stop.
+int run_on_socketcan(const std::string& image_path, const std::string& interface_name, double rate_hz,
+                     double seconds) {
+  if (!(rate_hz > 0) || !(rate_hz <= 100000)) throw std::invalid_argument("--rate must be in (0, 100000] Hz");
+  if (seconds != 0 && (!(seconds > 0) || !(seconds <= 86400))) {
+    throw std::invalid_argument("--seconds must be in (0, 86400]");
+  }
+  static cdcr::linux_host::SocketCanBus bus;
+  static cdcr::linux_host::PosixMonotonicClock clock;
+  static cdcr::linux_host::PosixPeriodicTimer timer{clock};
+  static cdcr::linux_host::MappedModelStorage storage;
+  static cdcr::linux_host::StdioConsole console{stderr};
+  std::string error;
+  if (!image_path.empty() && !storage.map_file(image_path, error)) throw InputError(error);
+  if (!bus.open(interface_name, error)) throw InputError("CAN interface " + interface_name + ": " + error);
+
+  struct sigaction action {};
+  action.sa_handler = request_stop;
+  sigemptyset(&action.sa_mask);
+  sigaction(SIGINT, &action, nullptr);
+  sigaction(SIGTERM, &action, nullptr);
+
+  static const cdcr::hal::Hal hal{clock, timer, bus, storage, console};
+  static fw::Runtime runtime(hal, fw::Geometry::prototype());
+  runtime.init();
+
+  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
+  const std::int64_t start_ns = clock.now_ns();
+  const std::int64_t end_ns = seconds > 0 ? start_ns + static_cast<std::int64_t>(std::llround(seconds * 1e9)) : 0;
+  timer.start(period_ns);
+  while (stop_requested == 0) {
+    const cdcr::hal::TimerTick tick = timer.wait_next();
+    if (end_ns != 0 && tick.release_ns > end_ns) break;
+    runtime.run_cycle(tick);
+  }
+  print_cycle_statistics(runtime, bus.error_counters(), rate_hz, double(clock.now_ns() - start_ns) * 1e-9);
+  std::fflush(stdout);
+  return 0;
+}
+#else
+int run_on_socketcan(const std::string&, const std::string&, double, double) {
+  throw InputError("--can needs a Linux host (SocketCAN)");
+}
+#endif
 
 }  // namespace
 
@@ -218,19 +349,25 @@ int main(int argc, char** argv) {
   app.name("cdcr-runtime");
   std::string image_path, replay_path, out_path;
   bool run_sim = false;
+  std::string can_interface;
   bool ideal_robot = false;
   double rate_hz = 1000.0, seconds = 2.0;
   app.add_option("--image", image_path, "model image (flash image v1)");
   auto* replay_option = app.add_option("--replay", replay_path, "cable-length CSV (dataset layout) to replay");
   app.add_option("--out", out_path, "pose CSV written by --replay");
   auto* sim_option = app.add_flag("--sim", run_sim, "close the loop with the simulated robot");
+  auto* can_option = app.add_option("--can", can_interface,
+                                    "run on this SocketCAN interface in real time (until --seconds or SIGINT/SIGTERM)");
   app.add_option("--rate", rate_hz, "cycle rate for --sim, Hz")->capture_default_str();
   app.add_option("--seconds", seconds, "simulated duration for --sim")->capture_default_str();
   app.add_flag("--ideal-robot", ideal_robot, "--sim with every simulated error source off (the nominal model)");
   replay_option->excludes(sim_option);
+  can_option->excludes(sim_option)->excludes(replay_option);
   try {
     app.parse(argc, argv);
-    if (!run_sim && replay_path.empty()) throw CLI::ValidationError("one of --replay or --sim is required");
+    if (!run_sim && replay_path.empty() && can_interface.empty()) {
+      throw CLI::ValidationError("one of --replay, --sim or --can is required");
+    }
     if (!replay_path.empty() && (image_path.empty() || out_path.empty())) {
       throw CLI::ValidationError("--replay needs --image and --out");
     }
@@ -241,6 +378,9 @@ int main(int argc, char** argv) {
     return kExitUsage;
   }
   try {
+    if (!can_interface.empty()) {
+      return run_on_socketcan(image_path, can_interface, rate_hz, app.count("--seconds") > 0 ? seconds : 0.0);
+    }
     return run_sim ? simulate(image_path, rate_hz, seconds, ideal_robot) : replay(image_path, replay_path, out_path);
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());

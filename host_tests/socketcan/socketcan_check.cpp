@@ -1,0 +1,399 @@
+// The host side of the SocketCAN test: builds the model image and the frames
+// the bus test sends, and checks what the runtime put on the bus (a candump -L
+// log) against the model library.
+//
+//   socketcan_check image <out.img>
+//   socketcan_check frames <image>            shell assignments for the driver
+//   socketcan_check check <image> <candump log>
+//
+// The log is cut into phases by marker frames (id 0x7F0, one byte: the phase
+// number) that the driver sends between the steps of the test.
+
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <iterator>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include <cdcr/firmware/fault.hpp>
+#include <cdcr/firmware/protocol.hpp>
+#include <cdcr/model/compensated_kinematics.hpp>
+#include <cdcr/model/flash_image.hpp>
+#include <cdcr/model/gp_correction.hpp>
+
+#include "export/image_writer.hpp"
+#include "synthetic_trained_model.hpp"
+
+namespace {
+
+namespace model = cdcr::model;
+namespace protocol = cdcr::firmware::protocol;
+using cdcr::firmware::FaultCode;
+using cdcr::firmware::RuntimeState;
+using cdcr::hal::CanFrame;
+
+constexpr std::uint32_t kMarkerId = 0x7F0;
+constexpr int kSegments = 4;
+constexpr std::uint8_t kTargetSequence = 5;
+// Quantisation of the pose frames (0.01 mm, Q15) plus the float arithmetic of
+// the runtime against this double reference.
+constexpr double kPoseToleranceMm = 0.02;
+constexpr double kOrientationToleranceRad = 5e-4;
+// Setpoints are quantised to 0.01 mm per cable; through the lever of the
+// whole robot that moves the tip by a few hundredths of a millimetre.
+constexpr double kSetpointReachToleranceMm = 0.3;
+
+struct Model {
+  std::vector<std::uint8_t> bytes;
+  model::ImageView image;
+  model::RobotGeometry<double> geometry;
+  model::GpCorrection<double, double> correction;
+};
+
+bool load_model(const std::string& path, Model& m) {
+  std::ifstream in(path, std::ios::binary);
+  m.bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  if (model::parse_image(m.bytes.data(), m.bytes.size(), m.image) != model::ImageStatus::ok) return false;
+  return model::geometry_from_image(m.image, m.geometry) == model::Status::ok &&
+         m.correction.bind(m.image) == model::Status::ok;
+}
+
+// The cable set the feeders send: a gently bent robot, quantised as on the bus.
+model::CableVector<double> bent_cables(const Model& m, double theta_rad, double alpha_offset_rad) {
+  model::JointVector<double> joints(2 * m.geometry.segment_count);
+  for (int s = 0; s < m.geometry.segment_count; ++s) {
+    joints[2 * s] = alpha_offset_rad + 0.7 * (s + 1);
+    joints[2 * s + 1] = theta_rad;
+  }
+  model::CableVector<double> cables;
+  model::cables_from_joints(joints, m.geometry, cables);
+  for (int i = 0; i < cables.size(); ++i) cables[i] = std::round(cables[i] / protocol::kLengthScaleMm) * protocol::kLengthScaleMm;
+  return cables;
+}
+
+model::CableVector<double> feedback_cables(const Model& m) { return bent_cables(m, 0.15, 0.0); }
+
+model::Vec3<double> target_position_mm(const Model& m) {
+  model::ForwardResult<double> result;
+  model::compensated_forward(bent_cables(m, 0.25, 0.4), m.geometry, m.correction, result);
+  return result.compensated.position_mm;
+}
+
+std::string hex(const CanFrame& frame) {
+  std::string text;
+  char byte[3];
+  for (int i = 0; i < frame.dlc; ++i) {
+    std::snprintf(byte, sizeof(byte), "%02X", frame.data[i]);
+    text += byte;
+  }
+  return text;
+}
+
+int write_image(const std::string& path) {
+  cdcr::test_support::SyntheticModelOptions options;
+  options.segments = kSegments;
+  options.training_points = 24;
+  cdcr::training::TrainedModel trained = cdcr::test_support::synthetic_trained_model(options);
+  trained.geometry = model::RobotGeometry<double>::prototype();
+  // Corrections of a few tenths of a millimetre, as a trained model makes.
+  for (int k = 0; k < 6; ++k) {
+    trained.output_mean[k] *= k < 3 ? 0.1 : 0.001;
+    trained.output_scale[k] *= k < 3 ? 0.1 : 0.001;
+  }
+  const std::vector<std::uint8_t> bytes = cdcr::exporting::write_image(trained);
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), std::streamsize(bytes.size()));
+  return out ? 0 : 1;
+}
+
+int print_frames(const Model& m) {
+  const model::CableVector<double> cables = feedback_cables(m);
+  for (int s = 0; s < m.geometry.segment_count; ++s) {
+    const double lengths_mm[4] = {cables[4 * s], cables[4 * s + 1], cables[4 * s + 2], cables[4 * s + 3]};
+    CanFrame frame;
+    protocol::encode_cables(protocol::kCableFeedbackBaseId + std::uint32_t(s), lengths_mm, frame);
+    std::printf("FEEDBACK_%d=%s\n", s, hex(frame).c_str());
+  }
+  std::printf("SEGMENTS=%d\n", m.geometry.segment_count);
+  const model::Vec3<double> target = target_position_mm(m);
+  CanFrame xy = protocol::make_frame(protocol::kTargetPositionXyId, 8);
+  protocol::put(xy, protocol::signal::position_xy[0], target.x());
+  protocol::put(xy, protocol::signal::position_xy[1], target.y());
+  CanFrame z = protocol::make_frame(protocol::kTargetPositionZId, 6);
+  protocol::put(z, protocol::signal::target_z[0], target.z());
+  protocol::put_raw(z, protocol::signal::target_z[1], int(protocol::TargetMode::position));
+  protocol::put_raw(z, protocol::signal::target_z[2], kTargetSequence);
+  std::printf("TARGET_XY=%s\nTARGET_Z=%s\n", hex(xy).c_str(), hex(z).c_str());
+  return 0;
+}
+
+struct LoggedFrame {
+  double time_s = 0;
+  CanFrame frame;
+};
+
+// candump -L: "(1700000000.123456) vcan0 123#0011AA".
+bool parse_candump_line(const std::string& line, LoggedFrame& logged) {
+  std::istringstream in(line);
+  std::string stamp, interface_name, body;
+  if (!(in >> stamp >> interface_name >> body) || stamp.size() < 3) return false;
+  logged.time_s = std::strtod(stamp.c_str() + 1, nullptr);
+  const std::size_t hash = body.find('#');
+  if (hash == std::string::npos || hash > 3 || body.size() > hash + 1 + 16 || (body.size() - hash - 1) % 2 != 0) {
+    return false;  // extended, remote or CAN FD frames: not the protocol's
+  }
+  logged.frame.id = std::uint32_t(std::stoul(body.substr(0, hash), nullptr, 16));
+  logged.frame.dlc = std::uint8_t((body.size() - hash - 1) / 2);
+  for (int i = 0; i < logged.frame.dlc; ++i) {
+    logged.frame.data[i] = std::uint8_t(std::stoul(body.substr(hash + 1 + 2 * i, 2), nullptr, 16));
+  }
+  return true;
+}
+
+struct Phase {
+  std::vector<LoggedFrame> frames;
+};
+
+class Checker {
+ public:
+  explicit Checker(const Model& m) : model_(m) {}
+
+  void expect(bool ok, const std::string& what) {
+    std::printf("%s: %s\n", ok ? "ok" : "FAILED", what.c_str());
+    if (!ok) ++failures_;
+  }
+  int failures() const { return failures_; }
+
+  // Every decoded pose in the phase against compensated_forward on the
+  // feedback cables; returns how many there were.
+  int check_poses(const Phase& phase, const char* name) {
+    model::ForwardResult<double> expected;
+    model::compensated_forward(feedback_cables(model_), model_.geometry, model_.correction, expected);
+    double worst_mm = 0, worst_rad = 0;
+    int poses = 0, uncompensated = 0;
+    // A pose is the three frames in a row, as the runtime sends them; a
+    // triplet with a frame missing from the log is skipped, not misread.
+    CanFrame xy{}, z{};
+    int pose_frames_in_row = 0;
+    for (const LoggedFrame& logged : phase.frames) {
+      const CanFrame& f = logged.frame;
+      if (f.id == protocol::kPosePositionXyId) {
+        xy = f;
+        pose_frames_in_row = 1;
+      } else if (f.id == protocol::kPosePositionZId) {
+        z = f;
+        pose_frames_in_row = pose_frames_in_row == 1 ? 2 : 0;
+      }
+      if (f.id != protocol::kPoseOrientationId) continue;
+      const bool complete = pose_frames_in_row == 2;
+      pose_frames_in_row = 0;
+      if (!complete) continue;
+      model::Vec3<double> position(protocol::get(xy, protocol::signal::position_xy[0]),
+                                   protocol::get(xy, protocol::signal::position_xy[1]),
+                                   protocol::get(z, protocol::signal::pose_z[0]));
+      Eigen::Quaterniond q(protocol::get(f, protocol::signal::quaternion[0]), protocol::get(f, protocol::signal::quaternion[1]),
+                           protocol::get(f, protocol::signal::quaternion[2]), protocol::get(f, protocol::signal::quaternion[3]));
+      q.normalize();
+      const Eigen::Quaterniond reference(expected.compensated.rotation);
+      worst_mm = std::max(worst_mm, (position - expected.compensated.position_mm).norm());
+      worst_rad = std::max(worst_rad, q.angularDistance(reference));
+      if (!(protocol::get_raw(z, protocol::signal::pose_z[1]) & protocol::kPoseFlagCompensated)) ++uncompensated;
+      ++poses;
+    }
+    std::printf("%s: %d poses, worst position %.4f mm, worst orientation %.2e rad\n", name, poses, worst_mm, worst_rad);
+    expect(worst_mm <= kPoseToleranceMm && worst_rad <= kOrientationToleranceRad,
+           std::string(name) + ": poses match compensated_forward within quantisation");
+    expect(uncompensated == 0, std::string(name) + ": every pose flagged compensated");
+    return poses;
+  }
+
+ private:
+  const Model& model_;
+  int failures_ = 0;
+};
+
+std::vector<const LoggedFrame*> with_id(const Phase& phase, std::uint32_t id) {
+  std::vector<const LoggedFrame*> out;
+  for (const LoggedFrame& f : phase.frames) {
+    if (f.frame.id == id) out.push_back(&f);
+  }
+  return out;
+}
+
+int last_stat(const std::vector<Phase>& phases, int upto_phase, const protocol::SignalSpec& spec) {
+  for (int p = upto_phase; p >= 0; --p) {
+    const auto stats = with_id(phases[p], protocol::kStatsId);
+    if (!stats.empty()) return int(protocol::get_raw(stats.back()->frame, spec));
+  }
+  return -1;
+}
+
+int check(const Model& m, const std::string& log_path) {
+  std::ifstream in(log_path);
+  if (!in) {
+    std::fprintf(stderr, "cannot open %s\n", log_path.c_str());
+    return 1;
+  }
+  // phases[k]: frames after marker k (phase 0: before the first marker).
+  std::vector<Phase> phases(1);
+  std::string line;
+  LoggedFrame logged;
+  while (std::getline(in, line)) {
+    if (!parse_candump_line(line, logged)) continue;
+    // Random traffic may hit the marker's id; only the next number counts.
+    if (logged.frame.id == kMarkerId && logged.frame.dlc == 1 && logged.frame.data[0] == phases.size()) {
+      phases.resize(std::size_t(logged.frame.data[0]) + 1);
+      continue;
+    }
+    phases.back().frames.push_back(logged);
+  }
+  Checker c(m);
+  c.expect(phases.size() == 8, "all 7 markers in the log (got " + std::to_string(phases.size() - 1) + ")");
+  if (phases.size() != 8) return 1;
+  const auto& status = protocol::signal::status;
+  const auto& stats = protocol::signal::stats;
+  const auto state_of = [&](const LoggedFrame* f) { return RuntimeState(protocol::get_raw(f->frame, status[0])); };
+  // Under User-Mode Linux every system call is expensive and the feeders
+  // share one virtual CPU with the runtime (and the host may be busy), so a
+  // 1 kHz cycle misses releases and the input may go stale for a while even
+  // as frames keep flowing. Phases with input therefore ask for RUN to be
+  // reached, and the pose content is what is checked strictly.
+  const auto reaches_run = [&](const Phase& phase, const char* name) {
+    int run = 0, total = 0;
+    for (const LoggedFrame* f : with_id(phase, protocol::kStatusId)) {
+      run += state_of(f) == RuntimeState::run ? 1 : 0;
+      ++total;
+    }
+    std::printf("%s: %d of %d STATUS frames in RUN\n", name, run, total);
+    return run > 0;
+  };
+
+  // 0: no cable input yet: the runtime's heartbeat says its input is stale.
+  const auto boot_status = with_id(phases[0], protocol::kStatusId);
+  c.expect(!boot_status.empty() && state_of(boot_status.back()) == RuntimeState::fault &&
+               FaultCode(protocol::get_raw(boot_status.back()->frame, status[1])) == FaultCode::cable_input_stale,
+           "before any cable frame: STATUS is FAULT, cable input stale");
+
+  // 1: cable feedback flowing: RUN, poses equal the model's.
+  {
+    const int poses = c.check_poses(phases[1], "feedback");
+    const double span_s = phases[1].frames.empty() ? 0 : phases[1].frames.back().time_s - phases[1].frames.front().time_s;
+    std::printf("feedback: %.0f poses/s over %.2f s\n", span_s > 0 ? poses / span_s : 0.0, span_s);
+    c.expect(poses >= 20, "feedback: poses published");
+    c.expect(reaches_run(phases[1], "feedback"), "feedback: STATUS is RUN");
+  }
+  // 2: malformed frames: the rejected counter grows. Phase 4 holds the first
+  // STATS certainly sent after the runtime read them (it answered the target
+  // sent after them, and nothing is rejected once the feeders stop).
+  {
+    const int before = last_stat(phases, 1, stats[1]);
+    const int after = last_stat(phases, 4, stats[1]);
+    std::printf("malformed: rejected frames %d -> %d\n", before, after);
+    c.expect(before >= 0 && after >= before + 4, "malformed: STATS rejected frames grew by the 4 sent");
+    bool reported = false;
+    for (int p = 2; p <= 3; ++p) {
+      for (const LoggedFrame* f : with_id(phases[p], protocol::kStatusId)) {
+        const auto fault = FaultCode(protocol::get_raw(f->frame, status[1]));
+        reported = reported || fault == FaultCode::cable_frame_malformed || fault == FaultCode::target_malformed;
+      }
+    }
+    c.expect(reported, "malformed: STATUS reported the rejection");
+    c.check_poses(phases[2], "malformed");
+  }
+  // 3: target -> IK_REPORT and setpoints whose kinematics reach the target.
+  {
+    const auto reports = with_id(phases[3], protocol::kIkReportId);
+    bool converged = false;
+    for (const LoggedFrame* f : reports) {
+      converged = converged || (protocol::get_raw(f->frame, protocol::signal::ik_report[0]) == kTargetSequence &&
+                                protocol::get_raw(f->frame, protocol::signal::ik_report[1]) == int(protocol::IkOutcome::converged));
+    }
+    c.expect(converged, "target: IK_REPORT with the sequence, converged");
+    model::CableVector<double> setpoints(4 * m.geometry.segment_count);
+    int found = 0;
+    for (int s = 0; s < m.geometry.segment_count; ++s) {
+      const auto frames = with_id(phases[3], protocol::kCableSetpointBaseId + std::uint32_t(s));
+      double lengths_mm[4];
+      if (frames.empty() || protocol::decode_cables(frames.back()->frame, lengths_mm) != protocol::CableFrameStatus::ok) continue;
+      for (int k = 0; k < 4; ++k) setpoints[4 * s + k] = lengths_mm[k];
+      ++found;
+    }
+    c.expect(found == m.geometry.segment_count, "target: a CABLE_SETPOINT frame per segment");
+    if (found == m.geometry.segment_count) {
+      model::ForwardResult<double> reached;
+      const model::Status s = model::compensated_forward(setpoints, m.geometry, m.correction, reached);
+      const double error_mm = (reached.compensated.position_mm - target_position_mm(m)).norm();
+      std::printf("target: setpoints reach the target within %.4f mm\n", error_mm);
+      c.expect(s == model::Status::ok && error_mm <= kSetpointReachToleranceMm, "target: setpoints reach the target");
+    }
+  }
+  // 4: feeders stopped: FAULT, and no pose after it.
+  {
+    const auto s = with_id(phases[4], protocol::kStatusId);
+    const LoggedFrame* first_fault = nullptr;
+    for (const LoggedFrame* f : s) {
+      if (state_of(f) == RuntimeState::fault) {
+        first_fault = f;
+        break;
+      }
+    }
+    c.expect(first_fault != nullptr && FaultCode(protocol::get_raw(first_fault->frame, status[1])) == FaultCode::cable_input_stale,
+             "stale: STATUS goes to FAULT, cable input stale");
+    int poses_after = 0;
+    for (const LoggedFrame& f : phases[4].frames) {
+      if (first_fault != nullptr && f.time_s > first_fault->time_s && f.frame.id == protocol::kPoseOrientationId) ++poses_after;
+    }
+    c.expect(first_fault != nullptr && poses_after == 0, "stale: no pose published in FAULT");
+    const int stale_before = last_stat(phases, 3, stats[4]);
+    const int stale_after = last_stat(phases, 4, stats[4]);
+    std::printf("stale: stale events %d -> %d\n", stale_before, stale_after);
+    c.expect(stale_before >= 0 && stale_after > stale_before, "stale: STATS stale events grew");
+  }
+  // 5: feeders resumed: back to RUN with the same poses.
+  {
+    c.expect(reaches_run(phases[5], "resume"), "resume: STATUS back to RUN");
+    c.expect(c.check_poses(phases[5], "resume") >= 20, "resume: poses published again");
+  }
+  // 6: random traffic from cangen: the runtime keeps its heartbeat and counts what it refused.
+  {
+    const auto s = with_id(phases[6], protocol::kStatusId);
+    std::printf("random traffic: %zu frames on the bus, %zu STATUS\n", phases[6].frames.size(), s.size());
+    c.expect(s.size() >= 10, "random traffic: STATUS keeps coming");
+    c.expect(last_stat(phases, 6, stats[1]) > last_stat(phases, 5, stats[1]), "random traffic: rejected frames grew");
+  }
+  // 7: after the noise: RUN and the feedback poses again.
+  {
+    const auto s = with_id(phases[7], protocol::kStatusId);
+    c.expect(reaches_run(phases[7], "after traffic"), "after traffic: STATUS is RUN");
+    c.expect(c.check_poses(phases[7], "after traffic") >= 10, "after traffic: poses published");
+    if (!s.empty()) {
+      std::printf("last STATUS: overruns %lld, execution max %lld us, mean %lld us; jitter max %d us\n",
+                  (long long)protocol::get_raw(s.back()->frame, status[2]), (long long)protocol::get_raw(s.back()->frame, status[3]),
+                  (long long)protocol::get_raw(s.back()->frame, status[4]), last_stat(phases, 7, stats[0]));
+    }
+  }
+  std::printf("%d check(s) failed\n", c.failures());
+  return c.failures() == 0 ? 0 : 1;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const std::string command = argc > 1 ? argv[1] : "";
+  if (command == "image" && argc == 3) return write_image(argv[2]);
+  Model m;
+  if ((command == "frames" && argc == 3) || (command == "check" && argc == 4)) {
+    if (!load_model(argv[2], m)) {
+      std::fprintf(stderr, "socketcan_check: %s: not a usable model image\n", argv[2]);
+      return 1;
+    }
+    return command == "frames" ? print_frames(m) : check(m, argv[3]);
+  }
+  std::fprintf(stderr, "usage: socketcan_check image <out> | frames <image> | check <image> <candump log>\n");
+  return 2;
+}
