@@ -19,6 +19,8 @@ declare -A package_groups=(
   # so they boot a User-Mode Linux kernel that has can, can-raw and vcan as
   # modules, and drive the bus with can-utils.
   [uml]="user-mode-linux kmod iproute2 can-utils"
+  # Cortex-M cross builds and their tests on QEMU's MPS2 boards (ctest -L qemu).
+  [cross]="gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm"
 )
 
 log_file=${CDCR_INSTALL_LOG:-/tmp/cdcr-install-deps.log}

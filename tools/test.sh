@@ -4,7 +4,7 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
-bash tools/install-deps.sh base sklearn fuzz uml
+bash tools/install-deps.sh base sklearn fuzz uml cross
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release --log-level=WARNING
 cmake --build build -j"$(nproc)"
 # ctest's summary must be the last thing printed: CI reads it from the tail.

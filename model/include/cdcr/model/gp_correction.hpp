@@ -122,7 +122,14 @@ class GpCorrection {
     }
   }
 
-  // The correction-term interface of solve_ik().
+  // The correction-term interface of solve_ik(): the twist alone, for trial
+  // steps, and with its derivative.
+  Status value(const JointVector<S, MaxSegments>& bend, Twist<S>& eps) const {
+    if (!bound() || bend.size() != input_dims_) return Status::correction_failed;
+    eps = predict(bend);
+    return Status::ok;
+  }
+
   Status operator()(const JointVector<S, MaxSegments>& bend, Twist<S>& eps,
                     Jacobian<S, MaxSegments>& d_eps_d_bend) const {
     if (!bound() || bend.size() != input_dims_) return Status::correction_failed;

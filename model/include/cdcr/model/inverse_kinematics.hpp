@@ -16,6 +16,7 @@
 #include <cmath>
 #include <limits>
 #include <type_traits>
+#include <utility>
 
 #include <Eigen/Cholesky>
 
@@ -92,27 +93,61 @@ Status evaluate_model(const JointVector<S, Max>& bend, const RobotGeometry<S, Ma
   return Status::ok;
 }
 
-// Residual rows: position error (mm) and, for pose targets, the weighted
-// rotation vector of R_target R^T. Jacobian rows: the tip point's velocity
-// (v + omega x p) and the weighted angular velocity.
-template <int Rows, typename S, int Max>
-void residual_and_jacobian(const Pose<S>& target, const Pose<S>& tip, const Jacobian<S, Max>& spatial,
-                           S orientation_weight, Eigen::Matrix<S, Rows, 1>& residual,
-                           Eigen::Matrix<S, Rows, Eigen::Dynamic, Eigen::RowMajor, Rows, 2 * Max>& rows,
-                           S& position_error, S& orientation_error) {
+// A correction may offer `Status value(bend, eps)`, the twist without its
+// derivative; trial steps that the iteration may reject then skip the
+// gradient, which for a GP costs several times the value.
+template <typename Correction, typename Bend, typename TwistType, typename = void>
+struct has_value_only : std::false_type {};
+template <typename Correction, typename Bend, typename TwistType>
+struct has_value_only<Correction, Bend, TwistType,
+                      std::void_t<decltype(std::declval<const Correction&>().value(std::declval<const Bend&>(),
+                                                                                   std::declval<TwistType&>()))>>
+    : std::true_type {};
+
+// The model's tip pose alone, for a trial step.
+template <typename S, int Max, typename Correction>
+Status evaluate_pose(const JointVector<S, Max>& bend, const RobotGeometry<S, Max>& geometry,
+                     const Correction& correction, Pose<S>& tip) {
+  tip = forward_kinematics_bend(bend, geometry);
+  if constexpr (!std::is_same_v<Correction, NoCorrection>) {
+    Twist<S> eps;
+    if constexpr (has_value_only<Correction, JointVector<S, Max>, Twist<S>>::value) {
+      if (const Status s = correction.value(bend, eps); s != Status::ok) return s;
+    } else {
+      Jacobian<S, Max> unused;
+      if (const Status s = correction(bend, eps, unused); s != Status::ok) return s;
+    }
+    if (!eps.allFinite()) return Status::correction_failed;
+    tip = exp(eps) * tip;
+  }
+  return Status::ok;
+}
+
+// Position error (mm) and, for pose targets, the weighted rotation vector of
+// R_target R^T.
+template <int Rows, typename S>
+void residual_of(const Pose<S>& target, const Pose<S>& tip, S orientation_weight,
+                 Eigen::Matrix<S, Rows, 1>& residual, S& position_error, S& orientation_error) {
   const Vec3<S> dp = target.position_mm - tip.position_mm;
   position_error = dp.norm();
-  rows.resize(Rows, spatial.cols());
-  rows.template topRows<3>() = spatial.template topRows<3>() - hat3<S>(tip.position_mm) * spatial.template bottomRows<3>();
   residual.template head<3>() = dp;
   if constexpr (Rows == 6) {
     const Vec3<S> dr = log_so3<S>(Mat3<S>(target.rotation * tip.rotation.transpose()));
     orientation_error = dr.norm();
     residual.template tail<3>() = orientation_weight * dr;
-    rows.template bottomRows<3>() = orientation_weight * spatial.template bottomRows<3>();
   } else {
     orientation_error = S(0);
   }
+}
+
+// Rows matching residual_of: the tip point's velocity (v + omega x p) and the
+// weighted angular velocity.
+template <int Rows, typename S, int Max>
+void jacobian_rows(const Pose<S>& tip, const Jacobian<S, Max>& spatial, S orientation_weight,
+                   Eigen::Matrix<S, Rows, Eigen::Dynamic, Eigen::RowMajor, Rows, 2 * Max>& rows) {
+  rows.resize(Rows, spatial.cols());
+  rows.template topRows<3>() = spatial.template topRows<3>() - hat3<S>(tip.position_mm) * spatial.template bottomRows<3>();
+  if constexpr (Rows == 6) rows.template bottomRows<3>() = orientation_weight * spatial.template bottomRows<3>();
 }
 
 template <int Rows, typename S, int Max, typename Correction>
@@ -144,17 +179,19 @@ IkResult<S, Max> solve(const Pose<S>& target, const RobotGeometry<S, Max>& geome
 
   JointVector<S, Max> bend = bend_from_joints(initial_joints);
   Pose<S> tip;
-  Jacobian<S, Max> spatial;
   Residual residual;
   Rows_t rows;
   S position_error = S(0);
   S orientation_error = S(0);
-  if (const Status s = evaluate_model(bend, geometry, correction, tip, spatial); s != Status::ok) {
+  if (const Status s = evaluate_pose(bend, geometry, correction, tip); s != Status::ok) {
     result.status = s;
     return result;
   }
-  residual_and_jacobian<Rows, S, Max>(target, tip, spatial, weight, residual, rows, position_error, orientation_error);
+  residual_of<Rows>(target, tip, weight, residual, position_error, orientation_error);
   S cost = residual.squaredNorm();
+  // The Jacobian is evaluated only where a step starts, never at rejected
+  // trial points or at the final one.
+  bool rows_current = false;
 
   const S min_damping = std::numeric_limits<S>::epsilon();
   const S max_damping = S(1e8);
@@ -170,6 +207,16 @@ IkResult<S, Max> solve(const Pose<S>& target, const RobotGeometry<S, Max>& geome
     if (iteration >= options.max_iterations || damping > max_damping) break;
     ++iteration;
 
+    if (!rows_current) {
+      Jacobian<S, Max> spatial;
+      if (const Status s = evaluate_model(bend, geometry, correction, tip, spatial); s != Status::ok) {
+        result.status = s;
+        break;
+      }
+      jacobian_rows<Rows, S, Max>(tip, spatial, weight, rows);
+      rows_current = true;
+    }
+
     Normal normal = rows * rows.transpose();
     const S scale = normal.trace() / S(Rows);
     normal.diagonal().array() += damping * scale + std::numeric_limits<S>::min();
@@ -178,25 +225,22 @@ IkResult<S, Max> solve(const Pose<S>& target, const RobotGeometry<S, Max>& geome
     project_onto_limits(trial, geometry);
 
     Pose<S> trial_tip;
-    Jacobian<S, Max> trial_spatial;
-    if (const Status s = evaluate_model(trial, geometry, correction, trial_tip, trial_spatial); s != Status::ok) {
+    if (const Status s = evaluate_pose(trial, geometry, correction, trial_tip); s != Status::ok) {
       result.status = s;
       break;
     }
     Residual trial_residual;
-    Rows_t trial_rows;
     S trial_position_error = S(0);
     S trial_orientation_error = S(0);
-    residual_and_jacobian<Rows, S, Max>(target, trial_tip, trial_spatial, weight, trial_residual, trial_rows,
-                                trial_position_error, trial_orientation_error);
+    residual_of<Rows>(target, trial_tip, weight, trial_residual, trial_position_error, trial_orientation_error);
     const S trial_cost = trial_residual.squaredNorm();
     if (trial_cost < cost) {
       bend = trial;
       residual = trial_residual;
-      rows = trial_rows;
       cost = trial_cost;
       position_error = trial_position_error;
       orientation_error = trial_orientation_error;
+      rows_current = false;
       damping = std::max(damping * S(0.1), min_damping);
     } else {
       damping *= S(10);

@@ -1,0 +1,22 @@
+# cmake -DSOURCE_DIR= -DBINARY_DIR= -DTOOLCHAIN= -DGOLDEN_DIR= -DTARGET= -P build_cross.cmake
+# Configures the cross build of the tree once and rebuilds TARGET.
+foreach(variable SOURCE_DIR BINARY_DIR TOOLCHAIN GOLDEN_DIR TARGET)
+  if(NOT ${variable})
+    message(FATAL_ERROR "build_cross.cmake: ${variable} is not set")
+  endif()
+endforeach()
+
+execute_process(
+  COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${BINARY_DIR} -DCMAKE_TOOLCHAIN_FILE=${TOOLCHAIN}
+          -DCMAKE_BUILD_TYPE=Release -DCDCR_QEMU_GOLDEN_DIR=${GOLDEN_DIR}
+  RESULT_VARIABLE configure_result)
+if(NOT configure_result EQUAL 0)
+  message(FATAL_ERROR "configuring the cross build in ${BINARY_DIR} failed")
+endif()
+
+execute_process(
+  COMMAND ${CMAKE_COMMAND} --build ${BINARY_DIR} --target ${TARGET} -j2
+  RESULT_VARIABLE build_result)
+if(NOT build_result EQUAL 0)
+  message(FATAL_ERROR "building ${TARGET} in ${BINARY_DIR} failed")
+endif()

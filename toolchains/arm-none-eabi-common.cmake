@@ -1,0 +1,34 @@
+# Shared part of the arm-none-eabi toolchain files. The including file sets
+# CDCR_CORTEXM_CPU (the -mcpu value), CDCR_CORTEXM_FPU (the -mfpu value) and
+# CDCR_CORTEXM_BOARD (the QEMU machine the startup code targets) first.
+set(CMAKE_SYSTEM_NAME Generic)
+set(CMAKE_SYSTEM_PROCESSOR arm)
+
+set(CMAKE_C_COMPILER arm-none-eabi-gcc)
+set(CMAKE_CXX_COMPILER arm-none-eabi-g++)
+set(CMAKE_ASM_COMPILER arm-none-eabi-gcc)
+set(CMAKE_AR arm-none-eabi-ar CACHE FILEPATH "")
+set(CMAKE_RANLIB arm-none-eabi-ranlib CACHE FILEPATH "")
+set(CMAKE_OBJCOPY arm-none-eabi-objcopy CACHE FILEPATH "")
+set(CMAKE_NM arm-none-eabi-nm CACHE FILEPATH "")
+
+# A test executable cannot link without the board's startup code and linker
+# script, which the project itself provides.
+set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
+
+set(CDCR_CORTEXM_BOARD ${CDCR_CORTEXM_BOARD} CACHE STRING "QEMU machine the Cortex-M startup code targets")
+
+set(_cdcr_arch_flags "-mcpu=${CDCR_CORTEXM_CPU} -mthumb -mfpu=${CDCR_CORTEXM_FPU} -mfloat-abi=hard")
+# No exceptions, RTTI or atexit registration on the target; -fno-math-errno
+# lets sqrtf compile to one instruction instead of a libm call.
+set(_cdcr_common_flags "${_cdcr_arch_flags} -fno-math-errno -ffunction-sections -fdata-sections")
+set(CMAKE_C_FLAGS_INIT "${_cdcr_common_flags}")
+set(CMAKE_CXX_FLAGS_INIT "${_cdcr_common_flags} -fno-exceptions -fno-rtti -fno-use-cxa-atexit -fno-threadsafe-statics")
+set(CMAKE_ASM_FLAGS_INIT "${_cdcr_arch_flags}")
+# nano newlib; the project's startup code replaces crt0, and its system calls
+# go through semihosting, so libnosys only fills in the stubs nothing uses.
+set(CMAKE_EXE_LINKER_FLAGS_INIT "${_cdcr_arch_flags} --specs=nano.specs --specs=nosys.specs -nostartfiles -Wl,--gc-sections")
+
+# Host programs and packages (Eigen is header-only) are found as usual;
+# target libraries come from the toolchain's own sysroot.
+set(CMAKE_FIND_ROOT_PATH_MODE_PROGRAM NEVER)
