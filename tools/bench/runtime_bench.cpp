@@ -22,8 +22,6 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstdio>
-#include <fstream>
-#include <iterator>
 #include <memory>
 #include <random>
 #include <stdexcept>
@@ -37,8 +35,10 @@
 
 #include <cdcr/firmware/runtime.hpp>
 
+#include "export/binary_file.hpp"
 #include "sim/host_backends.hpp"
 #include "sim/lockstep_timer.hpp"
+#include "sim/simulated_platform.hpp"
 #include "sim/simulated_robot.hpp"
 #include "sim/virtual_can.hpp"
 #include "sim/workspace_sampler.hpp"
@@ -66,20 +66,6 @@ struct Options {
   std::uint64_t seed = 1;
 };
 
-std::vector<std::uint8_t> read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw std::runtime_error("cannot open " + path);
-  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-struct HostPlatform {
-  sim::VirtualCanBus bus;
-  sim::LockstepClock clock;
-  sim::LockstepTimer timer{clock};
-  sim::MemoryModelStorage storage;
-  sim::StderrConsole console{false};
-  cdcr::hal::Hal hal{clock, timer, bus.node(0), storage, console};
-};
 
 using CableFrames = std::vector<cdcr::hal::CanFrame>;
 
@@ -200,7 +186,7 @@ std::int64_t thread_cpu_ns() {
 
 // One run of one cycle kind on a freshly booted runtime.
 CycleSamples run_cycles(const std::vector<std::uint8_t>& image, const Workload& w, CycleKind kind, int cycles) {
-  auto platform = std::make_unique<HostPlatform>();
+  auto platform = std::make_unique<sim::SimulatedPlatform>();
   platform->storage.assign(image);
   auto runtime = std::make_unique<fw::Runtime>(platform->hal, fw::Geometry::prototype());
   if (runtime->init() != fw::RuntimeState::run) {
@@ -286,8 +272,8 @@ int main(int argc, char** argv) {
   }
 
   try {
-    const std::vector<std::uint8_t> image = read_bytes(options.image_path);
-    HostPlatform probe_platform;
+    const std::vector<std::uint8_t> image = cdcr::exporting::read_binary_file(options.image_path);
+    sim::SimulatedPlatform probe_platform;
     probe_platform.storage.assign(image);
     fw::Runtime probe(probe_platform.hal, fw::Geometry::prototype());
     if (probe.init() != fw::RuntimeState::run) {

@@ -1,7 +1,6 @@
 #include "train_command.hpp"
 
 #include <chrono>
-#include <fstream>
 #include <memory>
 #include <string>
 
@@ -10,6 +9,7 @@
 
 #include "cli_errors.hpp"
 #include "dataset_input.hpp"
+#include "export/binary_file.hpp"
 #include "json_output.hpp"
 #include "train/pipeline.hpp"
 #include "training_options.hpp"
@@ -26,13 +26,6 @@ struct TrainCommandOptions {
   TrainingFlags training;
   bool json = false;
 };
-
-void write_file(const std::string& path, const std::vector<std::uint8_t>& bytes) {
-  std::ofstream file(path, std::ios::binary | std::ios::trunc);
-  if (!file) throw InputError(fmt::format("{}: cannot open for writing", path));
-  file.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
-  if (!file) throw InputError(fmt::format("{}: write failed", path));
-}
 
 std::string check_mark(bool ok) { return ok ? "meets target" : "MISSES target"; }
 
@@ -76,7 +69,11 @@ CommandOutput run_train(const TrainCommandOptions& o) {
       train_set, validation_set, geometry, options, data.content_hash,
       std::chrono::duration_cast<std::chrono::seconds>(now.time_since_epoch()).count());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  write_file(o.out_path, r.image);
+  try {
+    exporting::write_binary_file(o.out_path, r.image.data(), r.image.size());
+  } catch (const std::runtime_error& e) {
+    throw InputError(e.what());
+  }
 
   CommandOutput output;
   const training::TrainedModel& m = r.model;

@@ -15,24 +15,13 @@ namespace cdcr::dataset {
 namespace {
 
 using detail::quoted;
+using detail::kUtf8ByteOrderMark;
+using detail::split_fields;
 using detail::trim_blanks;
 
 constexpr const char* kPoseColumns[] = {"x", "y", "z", "qw", "qx", "qy", "qz"};
 constexpr int kPoseColumnCount = 7;
 constexpr double kQuaternionNormTolerance = 1e-3;
-constexpr std::string_view kUtf8ByteOrderMark = "\xEF\xBB\xBF";
-
-std::vector<std::string_view> split_fields(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t comma = line.find(',', start);
-    fields.push_back(trim_blanks(line.substr(start, comma == std::string_view::npos ? std::string_view::npos : comma - start)));
-    if (comma == std::string_view::npos) break;
-    start = comma + 1;
-  }
-  return fields;
-}
 
 std::string cable_column_name(int segment, int cable) {
   return "l" + std::to_string(segment + 1) + "_" + std::to_string(cable + 1);
@@ -59,7 +48,7 @@ struct Header {
 };
 
 Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
-  const std::vector<std::string_view> fields = split_fields(line);
+  const std::vector<std::string_view> fields = split_fields(line, ',');
   double ignored = 0.0;
   const detail::NumberStatus first = detail::parse_decimal(fields[0], ignored);
   if (first != detail::NumberStatus::not_a_number && first != detail::NumberStatus::empty) {
@@ -173,7 +162,7 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses) {
       have_header = true;
       continue;
     }
-    const std::vector<std::string_view> fields = split_fields(line);
+    const std::vector<std::string_view> fields = split_fields(line, ',');
     const int cables = 4 * header.segment_count;
     const int expected = cables + (header.has_poses ? kPoseColumnCount : 0);
     if (static_cast<int>(fields.size()) != expected) {

@@ -15,23 +15,17 @@ namespace cdcr::dataset {
 namespace {
 
 using detail::quoted;
+using detail::kUtf8ByteOrderMark;
 using detail::trim_blanks;
 
 constexpr int kBlockColumns = 16;  // X Y Z, three angles, Residual, Rot[0..8]
 constexpr int kResidualOffset = 6;
 constexpr int kRotationOffset = 7;
 constexpr double kOrthonormalityTolerance = 1e-3;
-constexpr std::string_view kUtf8ByteOrderMark = "\xEF\xBB\xBF";
 
+// QTM may end a row with a tab; the empty fields that leaves are not columns.
 std::vector<std::string_view> split_tabs(std::string_view line) {
-  std::vector<std::string_view> fields;
-  std::size_t start = 0;
-  for (;;) {
-    const std::size_t tab = line.find('\t', start);
-    fields.push_back(trim_blanks(line.substr(start, tab == std::string_view::npos ? std::string_view::npos : tab - start)));
-    if (tab == std::string_view::npos) break;
-    start = tab + 1;
-  }
+  std::vector<std::string_view> fields = detail::split_fields(line, '\t');
   while (fields.size() > 1 && fields.back().empty()) fields.pop_back();
   return fields;
 }

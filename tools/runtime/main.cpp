@@ -9,8 +9,6 @@
 #include <csignal>
 #include <cmath>
 #include <cstdio>
-#include <fstream>
-#include <iterator>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -29,8 +27,10 @@
 #include "linux/socketcan_bus.hpp"
 #include "linux/stdio_console.hpp"
 #endif
+#include "export/binary_file.hpp"
 #include "sim/host_backends.hpp"
 #include "sim/lockstep_timer.hpp"
+#include "sim/simulated_platform.hpp"
 #include "sim/simulated_drives.hpp"
 #include "sim/simulated_robot.hpp"
 #include "sim/virtual_can.hpp"
@@ -49,25 +49,10 @@ struct InputError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-std::vector<std::uint8_t> read_bytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError("cannot open " + path);
-  return std::vector<std::uint8_t>(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
-}
-
-// The host's Hal around the simulated platform.
-struct HostPlatform {
-  sim::VirtualCanBus bus;
-  sim::LockstepClock clock;
-  sim::LockstepTimer timer{clock};
-  sim::MemoryModelStorage storage;
-  sim::StderrConsole console{false};
-  cdcr::hal::Hal hal{clock, timer, bus.node(0), storage, console};
-};
 
 int replay(const std::string& image_path, const std::string& cables_path, const std::string& out_path) {
-  HostPlatform platform;
-  platform.storage.assign(read_bytes(image_path));
+  sim::SimulatedPlatform platform;
+  platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
   fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
   if (runtime.init() != fw::RuntimeState::run) {
     std::string message = std::string("image ") + image_path + ": " + fw::to_string(runtime.boot_fault());
@@ -122,8 +107,8 @@ void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, 
 int simulate(const std::string& image_path, double rate_hz, double seconds, bool ideal_robot) {
   if (!(rate_hz > 0) || !(rate_hz <= 100000)) throw std::invalid_argument("--rate must be in (0, 100000] Hz");
   if (!(seconds > 0) || !(seconds <= 3600)) throw std::invalid_argument("--seconds must be in (0, 3600]");
-  HostPlatform platform;
-  if (!image_path.empty()) platform.storage.assign(read_bytes(image_path));
+  sim::SimulatedPlatform platform;
+  if (!image_path.empty()) platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
   fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
   runtime.init();
 
