@@ -1,8 +1,6 @@
 #include "cdcr/firmware/runtime.hpp"
 
 #include <cmath>
-#include <cstdarg>
-#include <cstdio>
 
 #include <Eigen/Geometry>
 
@@ -27,6 +25,33 @@ void quaternion_of(const model::Mat3<Scalar>& rotation, double (&q)[4]) {
   q[2] = sign * quaternion.y();
   q[3] = sign * quaternion.z();
 }
+
+// Console lines built without printf: newlib's formatted output allocates,
+// and a board build links no heap.
+class LogLine {
+ public:
+  LogLine& operator<<(const char* text) {
+    while (*text != '\0' && length_ + 1 < kConsoleLineBytes) text_[length_++] = *text++;
+    text_[length_] = '\0';
+    return *this;
+  }
+  LogLine& operator<<(unsigned value) {
+    char digits[10];
+    int count = 0;
+    do {
+      digits[count++] = static_cast<char>('0' + value % 10);
+      value /= 10;
+    } while (value != 0);
+    while (count > 0 && length_ + 1 < kConsoleLineBytes) text_[length_++] = digits[--count];
+    text_[length_] = '\0';
+    return *this;
+  }
+  const char* c_str() const { return text_; }
+
+ private:
+  char text_[kConsoleLineBytes] = {};
+  int length_ = 0;
+};
 
 }  // namespace
 
@@ -75,7 +100,11 @@ RuntimeState Runtime::init() {
   mode_ = boot_fault_ == FaultCode::none ? RuntimeState::run : RuntimeState::degraded;
   latest_cables_mm_.setZero(4 * geometry_.segment_count);
   enter(mode_);
-  if (boot_fault_ != FaultCode::none) log("fault: %s (detail %u)", to_string(boot_fault_), unsigned(boot_fault_detail_));
+  if (boot_fault_ != FaultCode::none) {
+    LogLine line;
+    line << "fault: " << to_string(boot_fault_) << " (detail " << unsigned(boot_fault_detail_) << ")";
+    hal_.console.write_line(line.c_str());
+  }
   return state_;
 }
 
@@ -366,16 +395,9 @@ void Runtime::reject_frame(FaultCode code) {
 void Runtime::enter(RuntimeState next) {
   if (next == state_) return;
   state_ = next;
-  log("state %s", to_string(next));
-}
-
-void Runtime::log(const char* format, ...) {
-  char line[kConsoleLineBytes];
-  va_list arguments;
-  va_start(arguments, format);
-  std::vsnprintf(line, sizeof(line), format, arguments);
-  va_end(arguments);
-  hal_.console.write_line(line);
+  LogLine line;
+  line << "state " << to_string(next);
+  hal_.console.write_line(line.c_str());
 }
 
 }  // namespace cdcr::firmware

@@ -1,6 +1,6 @@
-# cmake -DSOURCE_DIR= -DBINARY_DIR= -DTOOLCHAIN= -DGOLDEN_DIR= -DTARGET= -P build_cross.cmake
-# Configures the cross build of the tree once and rebuilds TARGET.
-foreach(variable SOURCE_DIR BINARY_DIR TOOLCHAIN GOLDEN_DIR TARGET)
+# cmake -DSOURCE_DIR= -DBINARY_DIR= -DTOOLCHAIN= -DGOLDEN_DIR= -DTARGETS= -P build_cross.cmake
+# Configures the cross build of the tree once and rebuilds TARGETS.
+foreach(variable SOURCE_DIR BINARY_DIR TOOLCHAIN GOLDEN_DIR TARGETS)
   if(NOT ${variable})
     message(FATAL_ERROR "build_cross.cmake: ${variable} is not set")
   endif()
@@ -15,8 +15,8 @@ if(NOT configure_result EQUAL 0)
 endif()
 
 execute_process(
-  COMMAND ${CMAKE_COMMAND} --build ${BINARY_DIR} --target ${TARGET} -j2
+  COMMAND ${CMAKE_COMMAND} --build ${BINARY_DIR} --target ${TARGETS} -j2
   RESULT_VARIABLE build_result)
 if(NOT build_result EQUAL 0)
-  message(FATAL_ERROR "building ${TARGET} in ${BINARY_DIR} failed")
+  message(FATAL_ERROR "building ${TARGETS} in ${BINARY_DIR} failed")
 endif()

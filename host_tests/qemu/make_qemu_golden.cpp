@@ -1,13 +1,16 @@
-// Writes what the QEMU smoke program is built from, into the directory given
-// as the only argument:
+// Writes what the QEMU board programs are built from, into OUT_DIR:
 //
-//   cdcr_model_image.cpp  a synthetic flash image as C source, in .cdcr_model
-//   qemu_golden.hpp       cable inputs and the compensated poses the host
-//                         computes for them in double from the same image
+//   cdcr_model_image.cpp          IMAGE as the exporter's C array, in .cdcr_model
+//   cdcr_model_image_flipped.cpp  the same image with one byte flipped
+//   qemu_golden.hpp               cable inputs as they travel on the bus, and
+//                                 the poses the host computes for them in
+//                                 double: compensated with the image, and
+//                                 nominal on the image's geometry (what a
+//                                 board falls back to without a usable image)
 //
-// The expected poses come from the image's float32 values widened to double,
-// so the comparison on the target measures the float path alone, not the
-// float32 rounding of the image.
+// The expected poses start from the image's float32 values widened to double
+// and from the float cable lengths the runtime decodes, so the comparison on
+// the target measures the float path alone.
 
 #include <cmath>
 #include <cstdio>
@@ -20,17 +23,17 @@
 #include <string>
 #include <vector>
 
+#include "cdcr/firmware/protocol.hpp"
 #include "cdcr/model/compensated_kinematics.hpp"
+#include "export/binary_file.hpp"
 #include "export/c_source.hpp"
-#include "export/image_writer.hpp"
-
-#include "../support/synthetic_trained_model.hpp"
 
 namespace {
 
-constexpr int kSegments = 3;
-constexpr int kTrainingPoints = 40;
-constexpr int kCases = 5;
+constexpr int kCases = 16;
+// Inside the workspace the simulator samples by default, where the model
+// was trained.
+constexpr double kThetaMaxRad = 0.2;
 
 using cdcr::model::Status;
 
@@ -48,49 +51,54 @@ std::string exact(double value) {
 
 std::string exact_float(float value) {
   char text[40];
-  std::snprintf(text, sizeof(text), "%.9gf", static_cast<double>(value));
-  return text;
+  std::snprintf(text, sizeof(text), "%.9g", static_cast<double>(value));
+  std::string literal = text;
+  if (literal.find_first_of(".en") == std::string::npos) literal += ".0";
+  return literal + "f";
+}
+
+void append_pose(const cdcr::model::Pose<double>& pose, std::ostringstream& position, std::ostringstream& rotation) {
+  position << "    {" << exact(pose.position_mm[0]) << ", " << exact(pose.position_mm[1]) << ", "
+           << exact(pose.position_mm[2]) << "},\n";
+  rotation << "    {";
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) rotation << (r || c ? ", " : "") << exact(pose.rotation(r, c));
+  }
+  rotation << "},\n";
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::fprintf(stderr, "usage: make_qemu_golden OUT_DIR\n");
+  if (argc != 3) {
+    std::fprintf(stderr, "usage: make_qemu_golden IMAGE OUT_DIR\n");
     return 2;
   }
-  const std::string dir = argv[1];
+  const std::string dir = argv[2];
   try {
     std::filesystem::create_directories(dir);
-    cdcr::test_support::SyntheticModelOptions options;
-    options.segments = kSegments;
-    options.training_points = kTrainingPoints;
-    const std::vector<std::uint8_t> image = cdcr::exporting::write_image(cdcr::test_support::synthetic_trained_model(options));
-
-    cdcr::exporting::CSourceOptions c_options;
-    c_options.description = "synthetic model for the QEMU smoke test";
-    write_text(dir + "/cdcr_model_image.cpp", cdcr::exporting::format_c_source(image.data(), image.size(), c_options));
+    std::vector<std::uint8_t> image = cdcr::exporting::read_binary_file(argv[1]);
 
     cdcr::model::ImageView view{};
-    if (cdcr::model::parse_image(image.data(), image.size(), view, cdcr::model::ImageCapacity{}) !=
-        cdcr::model::ImageStatus::ok) {
-      throw std::runtime_error("the synthetic image does not parse");
+    if (const auto s = cdcr::model::parse_image(image.data(), image.size(), view, cdcr::model::ImageCapacity{});
+        s != cdcr::model::ImageStatus::ok) {
+      throw std::runtime_error(std::string(argv[1]) + ": " + cdcr::model::to_string(s));
     }
     cdcr::model::RobotGeometry<double> geometry;
     if (cdcr::model::geometry_from_image(view, geometry) != Status::ok) throw std::runtime_error("bad geometry");
     cdcr::model::GpCorrection<double, double> correction;
     if (correction.bind(view) != Status::ok) throw std::runtime_error("cannot bind the image");
+    const int segments = geometry.segment_count;
 
     std::mt19937 rng(20201109);
-    std::uniform_real_distribution<double> alpha_rad(-3.0, 3.0);
-    std::uniform_real_distribution<double> theta_rad(0.1, 1.0);
+    std::uniform_real_distribution<double> alpha_rad(-3.1, 3.1);
+    std::uniform_real_distribution<double> theta_rad(0.01, kThetaMaxRad);
 
-    std::ostringstream cables_text;
-    std::ostringstream position_text;
-    std::ostringstream rotation_text;
+    std::ostringstream cables_text, joints_text;
+    std::ostringstream compensated_position, compensated_rotation, nominal_position, nominal_rotation;
     for (int c = 0; c < kCases; ++c) {
-      cdcr::model::JointVector<double> joints(2 * kSegments);
-      for (int s = 0; s < kSegments; ++s) {
+      cdcr::model::JointVector<double> joints(2 * segments);
+      for (int s = 0; s < segments; ++s) {
         joints[2 * s] = alpha_rad(rng);
         joints[2 * s + 1] = theta_rad(rng);
       }
@@ -98,12 +106,12 @@ int main(int argc, char** argv) {
       if (cdcr::model::cables_from_joints(joints, geometry, cables_mm) != Status::ok) {
         throw std::runtime_error("cannot compute cable lengths");
       }
-      // The target reads float cables; the reference starts from the same values.
+      // As the runtime sees them: 0.01 mm units on the bus, then float.
       cables_text << "    {";
       for (int k = 0; k < cables_mm.size(); ++k) {
-        const float rounded = static_cast<float>(cables_mm[k]);
-        cables_mm[k] = static_cast<double>(rounded);
-        cables_text << (k ? ", " : "") << exact_float(rounded);
+        const auto raw = static_cast<std::uint16_t>(std::lround(cables_mm[k] / cdcr::firmware::protocol::kLengthScaleMm));
+        cables_mm[k] = static_cast<double>(static_cast<float>(raw * cdcr::firmware::protocol::kLengthScaleMm));
+        cables_text << (k ? ", " : "") << raw;
       }
       cables_text << "},\n";
 
@@ -111,27 +119,52 @@ int main(int argc, char** argv) {
       if (cdcr::model::compensated_forward(cables_mm, geometry, correction, result) != Status::ok) {
         throw std::runtime_error("compensated_forward failed on a golden input");
       }
-      const auto& pose = result.compensated;
-      position_text << "    {" << exact(pose.position_mm[0]) << ", " << exact(pose.position_mm[1]) << ", "
-                    << exact(pose.position_mm[2]) << "},\n";
-      rotation_text << "    {";
-      for (int r = 0; r < 3; ++r) {
-        for (int col = 0; col < 3; ++col) rotation_text << (r || col ? ", " : "") << exact(pose.rotation(r, col));
+      append_pose(result.compensated, compensated_position, compensated_rotation);
+      append_pose(result.nominal, nominal_position, nominal_rotation);
+      joints_text << "    {";
+      for (int k = 0; k < result.joints.size(); ++k) {
+        joints_text << (k ? ", " : "") << exact_float(static_cast<float>(result.joints[k]));
       }
-      rotation_text << "},\n";
+      joints_text << "},\n";
     }
+
+    std::ostringstream geometry_text;
+    for (int s = 0; s < segments; ++s) {
+      const auto& g = geometry.segments[static_cast<std::size_t>(s)];
+      geometry_text << "    {" << exact_float(static_cast<float>(g.backbone_length_mm)) << ", "
+                    << exact_float(static_cast<float>(g.anchor_radius_mm)) << ", "
+                    << exact_float(static_cast<float>(g.theta_max_rad)) << "},\n";
+    }
+
+    cdcr::exporting::CSourceOptions c_options;
+    c_options.description = std::string("model for the QEMU board programs, from ") + argv[1];
+    write_text(dir + "/cdcr_model_image.cpp", cdcr::exporting::format_c_source(image.data(), image.size(), c_options));
+    // In the middle of the training data: only the CRC can tell.
+    image[image.size() / 2] ^= 0xFF;
+    c_options.description = "the same model with one byte flipped";
+    write_text(dir + "/cdcr_model_image_flipped.cpp",
+               cdcr::exporting::format_c_source(image.data(), image.size(), c_options));
 
     std::ostringstream header;
     header << "#pragma once\n"
-           << "// Generated by make_qemu_golden: inputs and host (double) results for the\n"
-           << "// image in cdcr_model_image.cpp.\n\n"
+           << "// Generated by make_qemu_golden from " << argv[1] << ": inputs and host (double)\n"
+           << "// results for the image in cdcr_model_image.cpp.\n\n"
+           << "#include <cstdint>\n\n"
            << "namespace cdcr::qemu_golden {\n\n"
-           << "inline constexpr int kSegments = " << kSegments << ";\n"
-           << "inline constexpr int kCases = " << kCases << ";\n\n"
-           << "inline constexpr float kCablesMm[kCases][4 * kSegments] = {\n" << cables_text.str() << "};\n\n"
-           << "inline constexpr double kPositionMm[kCases][3] = {\n" << position_text.str() << "};\n\n"
+           << "inline constexpr int kSegments = " << segments << ";\n"
+           << "inline constexpr int kCases = " << kCases << ";\n"
+           << "inline constexpr std::uint32_t kTrainingPoints = " << view.training_points << ";\n\n"
+           << "// The image's geometry: backbone length (mm), anchor radius (mm), theta max (rad).\n"
+           << "inline constexpr float kGeometry[kSegments][3] = {\n" << geometry_text.str() << "};\n\n"
+           << "// Cable lengths in the bus's 0.01 mm units, segment by segment.\n"
+           << "inline constexpr std::uint16_t kCablesRaw[kCases][4 * kSegments] = {\n" << cables_text.str() << "};\n\n"
+           << "// (alpha, theta) per segment for the cables above.\n"
+           << "inline constexpr float kJoints[kCases][2 * kSegments] = {\n" << joints_text.str() << "};\n\n"
+           << "inline constexpr double kCompensatedPositionMm[kCases][3] = {\n" << compensated_position.str() << "};\n\n"
            << "// Row-major.\n"
-           << "inline constexpr double kRotation[kCases][9] = {\n" << rotation_text.str() << "};\n\n"
+           << "inline constexpr double kCompensatedRotation[kCases][9] = {\n" << compensated_rotation.str() << "};\n\n"
+           << "inline constexpr double kNominalPositionMm[kCases][3] = {\n" << nominal_position.str() << "};\n\n"
+           << "inline constexpr double kNominalRotation[kCases][9] = {\n" << nominal_rotation.str() << "};\n\n"
            << "}  // namespace cdcr::qemu_golden\n";
     write_text(dir + "/qemu_golden.hpp", header.str());
   } catch (const std::exception& error) {

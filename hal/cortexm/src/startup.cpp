@@ -22,6 +22,7 @@ extern void (*__init_array_end[])();
 int cdcr_cortexm_application_main() __asm__("main");
 [[noreturn]] void cdcr_cortexm_reset_handler();
 [[noreturn]] void cdcr_cortexm_fault_handler();
+void cdcr_cortexm_systick_handler();  // systick.cpp
 }
 
 namespace {
@@ -56,7 +57,8 @@ extern "C" [[noreturn]] void cdcr_cortexm_reset_handler() {
 
 // Exceptions 1..15. MemManage, BusFault and UsageFault are disabled after
 // reset and escalate to HardFault; they share its handler anyway in case
-// something enables them. Nothing here uses interrupts.
+// something enables them. SysTick is the only interrupt in use; a board's
+// CAN controller adds its own entries after these.
 extern "C" __attribute__((section(".vectors"), used)) const Handler cdcr_cortexm_vector_table[16] = {
     reinterpret_cast<Handler>(__stack_top__),
     cdcr_cortexm_reset_handler,
@@ -73,5 +75,5 @@ extern "C" __attribute__((section(".vectors"), used)) const Handler cdcr_cortexm
     cdcr_cortexm_fault_handler,  // DebugMonitor
     nullptr,
     cdcr_cortexm_fault_handler,  // PendSV
-    cdcr_cortexm_fault_handler,  // SysTick
+    cdcr_cortexm_systick_handler,
 };

@@ -29,11 +29,16 @@
 
 namespace cdcr::firmware {
 
-// float kinematics with double GP sums: single-precision work where the FPU
-// is fast, double only where the image's alternating terms need it (see
-// gp_correction.hpp).
+// float kinematics; the GP sums in double where the FPU has it (host,
+// Cortex-M7), in compensated float where it is single precision only
+// (Cortex-M4F), where double arithmetic would be software (see
+// gp_correction.hpp; `cdcr train` reports the fidelity of both).
 using Scalar = float;
+#if defined(__ARM_FP) && !(__ARM_FP & 0x8)
+using Accumulator = model::CompensatedFloat;
+#else
 using Accumulator = double;
+#endif
 using Geometry = model::RobotGeometry<Scalar, kMaxSegments>;
 using Cables = model::CableVector<Scalar, kMaxSegments>;
 using Joints = model::JointVector<Scalar, kMaxSegments>;
@@ -116,7 +121,6 @@ class Runtime {
   void send(const hal::CanFrame& frame);
   void reject_frame(FaultCode code);
   void enter(RuntimeState next);
-  void log(const char* format, ...);
 
   hal::Hal hal_;
   Geometry fallback_geometry_;

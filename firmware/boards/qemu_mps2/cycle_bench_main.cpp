@@ -1,0 +1,228 @@
+// Instruction counts of the runtime's work on the board. Run under QEMU
+// with `-icount shift=10` (tools/bench/run_qemu_bench.sh): every instruction
+// then advances the virtual clock by exactly 2^10 ns, so SysTick ticks of the
+// 25 MHz core clock count instructions, and the counts repeat exactly.
+// QEMU models no pipeline or caches: these are instructions, not cycles.
+//
+// Measured, each over the golden cases:
+//   forward_cycle   Runtime::run_cycle with one cable frame per segment
+//                   waiting: decode, compensated forward path, pose frames
+//   compensated_forward, gp_predict, nominal_forward: its parts
+//   compensated_ik  one compensated IK call (pose target, the runtime's
+//                   options) from one golden case's joints to the next's pose
+// Every count has the cost of reading the counter (an empty measurement)
+// subtracted.
+
+#include <cdcr/cortexm/semihosting.hpp>
+#include <cdcr/cortexm/stack_watermark.hpp>
+#include <cdcr/firmware/runtime.hpp>
+
+#include "board.hpp"
+#include "golden_check.hpp"
+
+namespace {
+
+namespace golden = cdcr::qemu_golden;
+namespace console = cdcr::cortexm;
+namespace model = cdcr::model;
+
+constexpr int kIcountShift = 10;
+// A period far longer than anything measured keeps SysTick exceptions (and
+// their instructions) out of the counts.
+constexpr std::int64_t kCountingPeriodNs = 600'000'000;
+
+cdcr::boards::mps2::Board board;
+cdcr::firmware::Runtime runtime(board.hal(), cdcr::boards::mps2::golden_geometry());
+cdcr::firmware::Correction correction;
+model::ForwardResult<float> forward_result;
+model::IkResult<float> ik_result;
+model::Twist<float> predicted;
+model::Pose<float> nominal_pose;
+
+std::uint32_t ticks_to_instructions(std::uint64_t ticks) {
+  const std::uint64_t ns = ticks * (1'000'000'000u / cdcr::boards::mps2::kCoreClockHz);
+  return static_cast<std::uint32_t>((ns + (1u << (kIcountShift - 1))) >> kIcountShift);
+}
+
+// A result the compiler must assume is read, so the work behind it stays.
+template <typename T>
+void keep(const T& result) {
+  asm volatile("" : : "r"(&result) : "memory");
+}
+
+// Out of line, so that none of the work can be scheduled outside the counted
+// region.
+template <typename Work>
+__attribute__((noinline)) void run_opaque(Work& work) {
+  work();
+}
+
+template <typename Work>
+std::uint64_t count_ticks(Work&& work) {
+  asm volatile("" ::: "memory");
+  const std::uint64_t start = board.timer.now_ticks();
+  asm volatile("" ::: "memory");
+  run_opaque(work);
+  asm volatile("" ::: "memory");
+  const std::uint64_t end = board.timer.now_ticks();
+  asm volatile("" ::: "memory");
+  return end - start;
+}
+
+std::uint64_t overhead_ticks = 0;
+
+template <typename Work>
+std::uint32_t count_instructions(Work&& work) {
+  const std::uint64_t ticks = count_ticks(work);
+  return ticks_to_instructions(ticks > overhead_ticks ? ticks - overhead_ticks : 0);
+}
+
+void sort(std::uint32_t* values, int count) {
+  for (int i = 1; i < count; ++i) {
+    for (int j = i; j > 0 && values[j - 1] > values[j]; --j) {
+      const std::uint32_t t = values[j];
+      values[j] = values[j - 1];
+      values[j - 1] = t;
+    }
+  }
+}
+
+void report(const char* name, std::uint32_t* counts, int count) {
+  sort(counts, count);
+  console::console_write("instructions ");
+  console::console_write(name);
+  console::console_write(" median ");
+  console::console_write_int(static_cast<std::int32_t>(counts[count / 2]));
+  console::console_write(" min ");
+  console::console_write_int(static_cast<std::int32_t>(counts[0]));
+  console::console_write(" max ");
+  console::console_write_int(static_cast<std::int32_t>(counts[count - 1]));
+  console::console_write("\n");
+}
+
+model::CableVector<float> golden_cables(int c) {
+  model::CableVector<float> cables(4 * golden::kSegments);
+  for (int k = 0; k < cables.size(); ++k) {
+    cables[k] = static_cast<float>(golden::kCablesRaw[c][k] * cdcr::firmware::protocol::kLengthScaleMm);
+  }
+  return cables;
+}
+
+model::Pose<float> golden_pose(int c) {
+  model::Pose<float> pose;
+  for (int i = 0; i < 3; ++i) pose.position_mm[i] = static_cast<float>(golden::kCompensatedPositionMm[c][i]);
+  for (int r = 0; r < 3; ++r) {
+    for (int col = 0; col < 3; ++col) pose.rotation(r, col) = static_cast<float>(golden::kCompensatedRotation[c][3 * r + col]);
+  }
+  return pose;
+}
+
+}  // namespace
+
+int main() {
+  cdcr::cortexm::paint_stack();
+  cdcr::cortexm::attach_systick(board.timer);
+  board.timer.start(kCountingPeriodNs);
+  if (runtime.init() != cdcr::firmware::RuntimeState::run) {
+    console::console_write("FAIL: the runtime did not boot into RUN\n");
+    return 1;
+  }
+  const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
+  model::ImageView image{};
+  if (model::parse_image(region.data, region.size_bytes, image, model::ImageCapacity{}) != model::ImageStatus::ok ||
+      correction.bind(image) != model::Status::ok) {
+    console::console_write("FAIL: cannot bind the image\n");
+    return 1;
+  }
+  console::console_write("model: ");
+  console::console_write_int(static_cast<std::int32_t>(image.training_points));
+  console::console_write(" training points, ");
+  console::console_write_int(image.input_dims);
+  console::console_write(" inputs, 6 outputs, ");
+  console::console_write_int(image.segment_count);
+  console::console_write(" segments\n");
+
+  overhead_ticks = count_ticks([] {});
+  const cdcr::firmware::Geometry& geometry = runtime.geometry();
+  constexpr int kCases = golden::kCases;
+  std::uint32_t forward_cycle[kCases], compensated[kCases], gp[kCases], nominal[kCases], ik[kCases],
+      ik_per_iteration[kCases];
+  bool ok = true;
+  int not_converged = 0;
+  for (int c = 0; c < kCases; ++c) {
+    // A cycle without the STATUS heartbeat, which goes out every tenth.
+    const std::uint32_t published = runtime.statistics().poses_published;
+    cdcr::boards::mps2::deliver_cables(board.can, c);
+    const cdcr::hal::TimerTick tick{board.timer.now_ns(), 0};
+    forward_cycle[c] = count_instructions([&] { runtime.run_cycle(tick); });
+    ok = ok && runtime.statistics().poses_published == published + 1;
+    cdcr::hal::CanFrame sent;
+    while (board.can.take_transmitted(sent)) {
+    }
+    if ((runtime.statistics().cycles + 1) % cdcr::firmware::kStatusEveryCycles == 0) {
+      const cdcr::hal::TimerTick skip{board.timer.now_ns(), 0};
+      cdcr::boards::mps2::deliver_cables(board.can, c);
+      runtime.run_cycle(skip);
+      while (board.can.take_transmitted(sent)) {
+      }
+    }
+
+    const model::CableVector<float> cables = golden_cables(c);
+    compensated[c] = count_instructions([&] {
+      model::compensated_forward(cables, geometry, correction, forward_result);
+      keep(forward_result);
+    });
+    const model::JointVector<float> bend = model::bend_from_joints(forward_result.joints);
+    gp[c] = count_instructions([&] {
+      predicted = correction.predict(bend);
+      keep(predicted);
+    });
+    nominal[c] = count_instructions([&] {
+      model::JointVector<float> joints;
+      model::joints_from_cables(cables, geometry, joints);
+      nominal_pose = model::forward_kinematics_bend(model::bend_from_joints(joints), geometry);
+      keep(nominal_pose);
+    });
+
+    model::JointVector<float> start(2 * golden::kSegments);
+    for (int k = 0; k < start.size(); ++k) start[k] = golden::kJoints[c][k];
+    const model::Pose<float> target = golden_pose((c + 1) % kCases);
+    model::IkOptions<float> options;
+    options.max_iterations = cdcr::firmware::kMaxIkIterations;
+    ik[c] = count_instructions([&] {
+      ik_result = model::solve_ik(target, geometry, start, options, correction);
+      keep(ik_result);
+    });
+    if (!ik_result.converged()) ++not_converged;
+    ik_per_iteration[c] = ik_result.iterations > 0 ? ik[c] / static_cast<std::uint32_t>(ik_result.iterations) : ik[c];
+    console::console_write("case ");
+    console::console_write_int(c);
+    console::console_write(": forward_cycle ");
+    console::console_write_int(static_cast<std::int32_t>(forward_cycle[c]));
+    console::console_write(", compensated_ik ");
+    console::console_write_int(static_cast<std::int32_t>(ik[c]));
+    console::console_write(" in ");
+    console::console_write_int(ik_result.iterations);
+    console::console_write(" iterations, position error ");
+    console::console_write_fixed(ik_result.position_error_mm, 5);
+    console::console_write(" mm\n");
+  }
+  report("forward_cycle", forward_cycle, kCases);
+  report("compensated_forward", compensated, kCases);
+  report("gp_predict", gp, kCases);
+  report("nominal_forward", nominal, kCases);
+  report("compensated_ik", ik, kCases);
+  report("compensated_ik_per_iteration", ik_per_iteration, kCases);
+  // The deepest the runtime goes: a compensated IK call.
+  console::console_write("stack: ");
+  console::console_write_int(static_cast<std::int32_t>(cdcr::cortexm::stack_used_bytes()));
+  console::console_write(" of ");
+  console::console_write_int(static_cast<std::int32_t>(cdcr::cortexm::stack_reserved_bytes()));
+  console::console_write(" bytes used\n");
+  if (not_converged > 0) {
+    console::console_write("FAIL: compensated IK did not converge on every case\n");
+    ok = false;
+  }
+  console::console_write(ok ? "PASS\n" : "FAIL\n");
+  return ok ? 0 : 1;
+}

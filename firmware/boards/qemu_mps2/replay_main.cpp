@@ -1,0 +1,199 @@
+// The runtime on the board, replaying the host's golden cases through the
+// CAN mailbox one cycle each, as the drives would send them. With the image
+// intact it must boot into RUN and publish the compensated poses the host
+// computed in double; with a corrupted image (CDCR_REPLAY_EXPECT_DEGRADED) it
+// must boot into DEGRADED, report the image fault on the bus and publish the
+// nominal poses. Prints what it saw and PASS or FAIL; the exit status says
+// the same to ctest.
+
+#include <cdcr/cortexm/semihosting.hpp>
+#include <cdcr/cortexm/stack_watermark.hpp>
+#include <cdcr/firmware/runtime.hpp>
+
+#include "board.hpp"
+#include "golden_check.hpp"
+
+#ifndef CDCR_REPLAY_EXPECT_DEGRADED
+#define CDCR_REPLAY_EXPECT_DEGRADED 0
+#endif
+
+namespace {
+
+namespace golden = cdcr::qemu_golden;
+namespace protocol = cdcr::firmware::protocol;
+namespace console = cdcr::cortexm;
+using cdcr::firmware::FaultCode;
+using cdcr::firmware::RuntimeState;
+
+constexpr bool kExpectDegraded = CDCR_REPLAY_EXPECT_DEGRADED != 0;
+constexpr RuntimeState kExpectedState = kExpectDegraded ? RuntimeState::degraded : RuntimeState::run;
+constexpr FaultCode kExpectedFault = kExpectDegraded ? FaultCode::image_invalid : FaultCode::none;
+
+// Float32 fidelity: the float path against the host's double path.
+constexpr double kPositionToleranceMm = 0.01;
+constexpr double kOrientationToleranceDeg = 0.001;
+// What the pose frames add: 0.01 mm and 1/32767 quaternion steps.
+constexpr double kBusPositionToleranceMm = kPositionToleranceMm + 0.0087;
+constexpr double kBusOrientationToleranceDeg = 0.02;
+
+cdcr::boards::mps2::Board board;
+cdcr::firmware::Runtime runtime(board.hal(), cdcr::boards::mps2::golden_geometry());
+
+struct BusView {
+  double position_mm[3] = {};
+  double quaternion[4] = {1, 0, 0, 0};
+  int pose_frames = 0;
+  bool compensated_flag = false;
+  int status_frames = 0;
+  int reported_state = -1;
+  int reported_fault = -1;
+  int reported_detail = -1;
+};
+
+void drain(BusView& bus) {
+  cdcr::hal::CanFrame frame;
+  while (board.can.take_transmitted(frame)) {
+    switch (frame.id) {
+      case protocol::kPosePositionXyId:
+        bus.position_mm[0] = protocol::get(frame, protocol::signal::position_xy[0]);
+        bus.position_mm[1] = protocol::get(frame, protocol::signal::position_xy[1]);
+        bus.pose_frames += 1;
+        break;
+      case protocol::kPosePositionZId:
+        bus.position_mm[2] = protocol::get(frame, protocol::signal::pose_z[0]);
+        bus.compensated_flag = protocol::get_raw(frame, protocol::signal::pose_z[1]) & protocol::kPoseFlagCompensated;
+        bus.pose_frames += 1;
+        break;
+      case protocol::kPoseOrientationId:
+        for (int k = 0; k < 4; ++k) bus.quaternion[k] = protocol::get(frame, protocol::signal::quaternion[k]);
+        bus.pose_frames += 1;
+        break;
+      case protocol::kStatusId:
+        bus.reported_state = static_cast<int>(protocol::get_raw(frame, protocol::signal::status[0]));
+        bus.reported_fault = static_cast<int>(protocol::get_raw(frame, protocol::signal::status[1]));
+        bus.status_frames += 1;
+        break;
+      case protocol::kStatsId:
+        bus.reported_detail = static_cast<int>(protocol::get_raw(frame, protocol::signal::stats[3]));
+        break;
+      default:
+        break;
+    }
+  }
+}
+
+// The pose as decoded from the bus, for the same comparison.
+cdcr::model::Pose<float> pose_from_bus(const BusView& bus) {
+  cdcr::model::Pose<float> pose;
+  for (int i = 0; i < 3; ++i) pose.position_mm[i] = static_cast<float>(bus.position_mm[i]);
+  const double* q = bus.quaternion;
+  const double n = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+  pose.rotation = Eigen::Quaternion<float>(float(q[0] / n), float(q[1] / n), float(q[2] / n), float(q[3] / n))
+                      .toRotationMatrix();
+  return pose;
+}
+
+bool failed = false;
+
+void check(bool condition, const char* what) {
+  if (condition) return;
+  console::console_write("FAIL: ");
+  console::console_write(what);
+  console::console_write("\n");
+  failed = true;
+}
+
+void write_deviation(const char* label, const cdcr::boards::mps2::PoseDeviation& d) {
+  console::console_write(label);
+  console::console_write_fixed(d.position_mm, 6);
+  console::console_write(" mm, ");
+  console::console_write_fixed(d.orientation_deg, 6);
+  console::console_write(" deg\n");
+}
+
+}  // namespace
+
+int main() {
+  console::paint_stack();
+  cdcr::cortexm::attach_systick(board.timer);
+  board.timer.start(cdcr::boards::mps2::kCyclePeriodNs);
+
+  const RuntimeState state = runtime.init();
+  console::console_write("boot: state ");
+  console::console_write(cdcr::firmware::to_string(state));
+  console::console_write(", fault ");
+  console::console_write_int(static_cast<int>(runtime.boot_fault()));
+  console::console_write(" (");
+  console::console_write(cdcr::firmware::to_string(runtime.boot_fault()));
+  console::console_write("), detail ");
+  console::console_write_int(runtime.boot_fault_detail());
+  console::console_write("\n");
+  check(state == kExpectedState, "unexpected state after boot");
+  check(runtime.boot_fault() == kExpectedFault, "unexpected boot fault");
+  if (kExpectDegraded) {
+    check(runtime.boot_fault_detail() == static_cast<int>(cdcr::model::ImageStatus::checksum_mismatch),
+          "the flipped byte was not caught by the checksum");
+  }
+
+  cdcr::boards::mps2::PoseDeviation worst, worst_bus;
+  BusView bus;
+  // Enough cycles for a STATUS frame to report the state on the bus.
+  const int cycles = golden::kCases > cdcr::firmware::kStatusEveryCycles ? golden::kCases
+                                                                         : cdcr::firmware::kStatusEveryCycles;
+  for (int cycle = 0; cycle < cycles; ++cycle) {
+    const int c = cycle % golden::kCases;
+    const cdcr::hal::TimerTick tick = board.timer.wait_next();
+    cdcr::boards::mps2::deliver_cables(board.can, c);
+    runtime.run_cycle(tick);
+    const int pose_frames_before = bus.pose_frames;
+    drain(bus);
+    check(bus.pose_frames == pose_frames_before + 3, "no pose published for a complete cable set");
+    check(runtime.has_pose() && runtime.latest_pose().compensated == !kExpectDegraded,
+          "pose missing or compensated in the wrong state");
+    check(bus.compensated_flag == !kExpectDegraded, "pose frame's compensated flag is wrong");
+
+    const auto& expected_position = kExpectDegraded ? golden::kNominalPositionMm[c] : golden::kCompensatedPositionMm[c];
+    const auto& expected_rotation = kExpectDegraded ? golden::kNominalRotation[c] : golden::kCompensatedRotation[c];
+    const auto d = cdcr::boards::mps2::deviation(runtime.latest_pose().pose, expected_position, expected_rotation);
+    const auto b = cdcr::boards::mps2::deviation(pose_from_bus(bus), expected_position, expected_rotation);
+    if (!(d.position_mm <= worst.position_mm)) worst.position_mm = d.position_mm;
+    if (!(d.orientation_deg <= worst.orientation_deg)) worst.orientation_deg = d.orientation_deg;
+    if (!(b.position_mm <= worst_bus.position_mm)) worst_bus.position_mm = b.position_mm;
+    if (!(b.orientation_deg <= worst_bus.orientation_deg)) worst_bus.orientation_deg = b.orientation_deg;
+  }
+
+  console::console_write(kExpectDegraded ? "nominal" : "compensated");
+  console::console_write(" poses, ");
+  console::console_write_int(cycles);
+  console::console_write(" cycles over ");
+  console::console_write_int(golden::kCases);
+  console::console_write(" golden cases\n");
+  write_deviation("  largest deviation from the host, runtime pose: ", worst);
+  write_deviation("  largest deviation from the host, decoded from the bus: ", worst_bus);
+  check(worst.position_mm <= kPositionToleranceMm, "position beyond the float32 fidelity target");
+  check(worst.orientation_deg <= kOrientationToleranceDeg, "orientation beyond the float32 fidelity target");
+  check(worst_bus.position_mm <= kBusPositionToleranceMm, "position on the bus beyond tolerance");
+  check(worst_bus.orientation_deg <= kBusOrientationToleranceDeg, "orientation on the bus beyond tolerance");
+
+  console::console_write("bus: STATUS state ");
+  console::console_write_int(bus.reported_state);
+  console::console_write(", fault ");
+  console::console_write_int(bus.reported_fault);
+  console::console_write(", detail ");
+  console::console_write_int(bus.reported_detail);
+  console::console_write("\n");
+  check(bus.status_frames > 0, "no STATUS frame");
+  check(bus.reported_state == static_cast<int>(kExpectedState), "STATUS reports the wrong state");
+  check(bus.reported_fault == static_cast<int>(kExpectedFault), "STATUS reports the wrong fault");
+  check(runtime.statistics().rejected_frames == 0, "frames were rejected");
+
+  console::console_write("stack: ");
+  console::console_write_int(static_cast<int>(console::stack_used_bytes()));
+  console::console_write(" of ");
+  console::console_write_int(static_cast<int>(console::stack_reserved_bytes()));
+  console::console_write(" bytes used\n");
+  check(console::stack_used_bytes() < console::stack_reserved_bytes(), "stack reservation exhausted");
+
+  console::console_write(failed ? "FAIL\n" : "PASS\n");
+  return failed ? 1 : 0;
+}

@@ -1,0 +1,30 @@
+# cmake -DCDCR= -DMAKE_GOLDEN= -DOUT_DIR= -P make_golden_model.cmake
+# The model the board programs carry, made the way a user makes one: the
+# simulated robot's default data set (750 samples, 4 segments), trained on
+# 700 of them, then the image and the host's golden results.
+foreach(variable CDCR MAKE_GOLDEN OUT_DIR)
+  if(NOT ${variable})
+    message(FATAL_ERROR "make_golden_model.cmake: ${variable} is not set")
+  endif()
+endforeach()
+file(MAKE_DIRECTORY ${OUT_DIR})
+
+function(run)
+  execute_process(COMMAND ${ARGN} RESULT_VARIABLE status)
+  if(NOT status EQUAL 0)
+    string(REPLACE ";" " " command "${ARGN}")
+    message(FATAL_ERROR "failed (${status}): ${command}")
+  endif()
+endfunction()
+
+# Training takes seconds; keep a model whose data set has not changed.
+run(${CDCR} simulate --samples 750 --seed 1 --out ${OUT_DIR}/robot.csv.new)
+execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${OUT_DIR}/robot.csv.new ${OUT_DIR}/robot.csv
+                RESULT_VARIABLE changed)
+if(changed OR NOT EXISTS ${OUT_DIR}/model.img)
+  file(RENAME ${OUT_DIR}/robot.csv.new ${OUT_DIR}/robot.csv)
+  run(${CDCR} train --data ${OUT_DIR}/robot.csv --holdout 50 --out ${OUT_DIR}/model.img)
+else()
+  file(REMOVE ${OUT_DIR}/robot.csv.new)
+endif()
+run(${MAKE_GOLDEN} ${OUT_DIR}/model.img ${OUT_DIR})

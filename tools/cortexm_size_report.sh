@@ -1,0 +1,48 @@
+#!/usr/bin/env bash
+# Memory report for Cortex-M ELF files, with the budget a board must fit:
+#   code  .vectors, .text (with .rodata), .ARM.*, .init_array   <= 64 KiB
+#   RAM   .data + .bss + the .stack reservation                  <= 32 KiB
+# The model image (.cdcr_model) is reported on its own: it is flashed
+# separately and sized by the model, not the firmware.
+#
+#   bash tools/cortexm_size_report.sh build-m7/bin/cdcr_qemu_replay.elf [...]
+#
+# Exits 1 if any file is over budget. CDCR_SIZE (default arm-none-eabi-size)
+# names the size tool.
+set -euo pipefail
+
+readonly code_budget=$((64 * 1024))
+readonly ram_budget=$((32 * 1024))
+size_tool=${CDCR_SIZE:-arm-none-eabi-size}
+
+if [[ $# -eq 0 ]]; then
+  echo "usage: $0 FILE.elf..." >&2
+  exit 2
+fi
+command -v "$size_tool" >/dev/null || { echo "$0: $size_tool not found (bash tools/install-deps.sh cross)" >&2; exit 2; }
+
+over=0
+printf '%-34s %8s %8s %8s %8s %8s %10s\n' "file" "code" "data" "bss" "stack" "RAM" "image"
+for elf in "$@"; do
+  [[ -f $elf ]] || { echo "$0: $elf: no such file" >&2; exit 2; }
+  # `size -A` lists one section per line: name, size, address.
+  read -r code data bss stack image < <("$size_tool" -A -d "$elf" | awk '
+    $1 == ".vectors" || $1 == ".text" || $1 ~ /^\.ARM\./ || $1 == ".init_array" { code += $2 }
+    $1 == ".data" { data += $2 }
+    $1 == ".bss" { bss += $2 }
+    $1 == ".stack" { stack += $2 }
+    $1 == ".cdcr_model" { image += $2 }
+    END { print code + 0, data + 0, bss + 0, stack + 0, image + 0 }')
+  ram=$((data + bss + stack))
+  printf '%-34s %8d %8d %8d %8d %8d %10d\n' "$(basename "$elf")" "$code" "$data" "$bss" "$stack" "$ram" "$image"
+  if ((code > code_budget)); then
+    echo "  over budget: code $code bytes > $code_budget" >&2
+    over=1
+  fi
+  if ((ram > ram_budget)); then
+    echo "  over budget: RAM $ram bytes > $ram_budget" >&2
+    over=1
+  fi
+done
+echo "budget: code <= $code_budget bytes, RAM (data + bss + stack) <= $ram_budget bytes"
+exit $over
