@@ -10,6 +10,8 @@
 //   compensated_forward, gp_predict, nominal_forward: its parts
 //   compensated_ik  one compensated IK call (pose target, the runtime's
 //                   options) from one golden case's joints to the next's pose
+//   ik_cycle        Runtime::run_cycle with cable frames and a pose target
+//                   waiting: the forward path plus the runtime's IK call
 // Every count has the cost of reading the counter (an empty measurement)
 // subtracted.
 
@@ -117,6 +119,32 @@ model::Pose<float> golden_pose(int c) {
   return pose;
 }
 
+// The three target frames of a pose target, as a planner sends them.
+void deliver_pose_target(const model::Pose<float>& target, std::uint8_t sequence) {
+  namespace protocol = cdcr::firmware::protocol;
+  Eigen::Quaternion<float> q(target.rotation);
+  q.normalize();
+  cdcr::hal::CanFrame frame = protocol::make_frame(protocol::kTargetOrientationId, 8);
+  const float components[4] = {q.w(), q.x(), q.y(), q.z()};
+  for (int k = 0; k < 4; ++k) protocol::put(frame, protocol::signal::quaternion[k], components[k]);
+  board.can.deliver(frame);
+  frame = protocol::make_frame(protocol::kTargetPositionXyId, 8);
+  protocol::put(frame, protocol::signal::position_xy[0], target.position_mm.x());
+  protocol::put(frame, protocol::signal::position_xy[1], target.position_mm.y());
+  board.can.deliver(frame);
+  frame = protocol::make_frame(protocol::kTargetPositionZId, 6);
+  protocol::put(frame, protocol::signal::target_z[0], target.position_mm.z());
+  protocol::put_raw(frame, protocol::signal::target_z[1], static_cast<std::int64_t>(protocol::TargetMode::pose));
+  protocol::put_raw(frame, protocol::signal::target_z[2], sequence);
+  board.can.deliver(frame);
+}
+
+void drain_transmitted() {
+  cdcr::hal::CanFrame sent;
+  while (board.can.take_transmitted(sent)) {
+  }
+}
+
 }  // namespace
 
 int main() {
@@ -146,7 +174,7 @@ int main() {
   const cdcr::firmware::Geometry& geometry = runtime.geometry();
   constexpr int kCases = golden::kCases;
   std::uint32_t forward_cycle[kCases], compensated[kCases], gp[kCases], nominal[kCases], ik[kCases],
-      ik_per_iteration[kCases];
+      ik_per_iteration[kCases], ik_cycle[kCases];
   bool ok = true;
   int not_converged = 0;
   for (int c = 0; c < kCases; ++c) {
@@ -156,15 +184,22 @@ int main() {
     const cdcr::hal::TimerTick tick{board.timer.now_ns(), 0};
     forward_cycle[c] = count_instructions([&] { runtime.run_cycle(tick); });
     ok = ok && runtime.statistics().poses_published == published + 1;
-    cdcr::hal::CanFrame sent;
-    while (board.can.take_transmitted(sent)) {
-    }
-    if ((runtime.statistics().cycles + 1) % cdcr::firmware::kStatusEveryCycles == 0) {
+    drain_transmitted();
+    // The next cycle carries a target too.
+    cdcr::boards::mps2::deliver_cables(board.can, c);
+    deliver_pose_target(golden_pose((c + 1) % kCases), static_cast<std::uint8_t>(c));
+    const cdcr::hal::TimerTick target_tick{board.timer.now_ns(), 0};
+    ik_cycle[c] = count_instructions([&] { runtime.run_cycle(target_tick); });
+    ok = ok && runtime.last_ik_report().sequence == c &&
+         runtime.last_ik_report().outcome == cdcr::firmware::protocol::IkOutcome::converged;
+    drain_transmitted();
+    // Keep the STATUS heartbeat (every tenth cycle) out of the counted ones.
+    while ((runtime.statistics().cycles + 1) % cdcr::firmware::kStatusEveryCycles == 0 ||
+           (runtime.statistics().cycles + 2) % cdcr::firmware::kStatusEveryCycles == 0) {
       const cdcr::hal::TimerTick skip{board.timer.now_ns(), 0};
       cdcr::boards::mps2::deliver_cables(board.can, c);
       runtime.run_cycle(skip);
-      while (board.can.take_transmitted(sent)) {
-      }
+      drain_transmitted();
     }
 
     const model::CableVector<float> cables = golden_cables(c);
@@ -213,7 +248,8 @@ int main() {
   report("nominal_forward", nominal, kCases);
   report("compensated_ik", ik, kCases);
   report("compensated_ik_per_iteration", ik_per_iteration, kCases);
-  // The deepest the runtime goes: a compensated IK call.
+  report("ik_cycle", ik_cycle, kCases);
+  // The deepest the runtime goes: a cycle with a compensated IK call.
   console::console_write("stack: ");
   console::console_write_int(static_cast<std::int32_t>(cdcr::cortexm::stack_used_bytes()));
   console::console_write(" of ");

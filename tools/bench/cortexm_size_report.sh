@@ -5,7 +5,7 @@
 # The model image (.cdcr_model) is reported on its own: it is flashed
 # separately and sized by the model, not the firmware.
 #
-#   bash tools/cortexm_size_report.sh build-m7/bin/cdcr_qemu_replay.elf [...]
+#   bash tools/bench/cortexm_size_report.sh build-m7/bin/cdcr_qemu_replay.elf [...]
 #
 # Exits 1 if any file is over budget. CDCR_SIZE (default arm-none-eabi-size)
 # names the size tool.
@@ -22,7 +22,7 @@ fi
 command -v "$size_tool" >/dev/null || { echo "$0: $size_tool not found (bash tools/install-deps.sh cross)" >&2; exit 2; }
 
 over=0
-printf '%-34s %8s %8s %8s %8s %8s %10s\n' "file" "code" "data" "bss" "stack" "RAM" "image"
+printf '%-40s %8s %8s %8s %8s %8s %10s\n' "file" "code" "data" "bss" "stack" "RAM" "image"
 for elf in "$@"; do
   [[ -f $elf ]] || { echo "$0: $elf: no such file" >&2; exit 2; }
   # `size -A` lists one section per line: name, size, address.
@@ -34,7 +34,9 @@ for elf in "$@"; do
     $1 == ".cdcr_model" { image += $2 }
     END { print code + 0, data + 0, bss + 0, stack + 0, image + 0 }')
   ram=$((data + bss + stack))
-  printf '%-34s %8d %8d %8d %8d %8d %10d\n' "$(basename "$elf")" "$code" "$data" "$bss" "$stack" "$ram" "$image"
+  # The build directory names the board: cross-m7/cdcr_mps2_firmware.elf.
+  label="$(basename "$(dirname "$(dirname "$elf")")")/$(basename "$elf")"
+  printf '%-40s %8d %8d %8d %8d %8d %10d\n' "$label" "$code" "$data" "$bss" "$stack" "$ram" "$image"
   if ((code > code_budget)); then
     echo "  over budget: code $code bytes > $code_budget" >&2
     over=1
