@@ -38,8 +38,9 @@ inline float kernel_exp(float x) {
   constexpr float kShifter = 12582912.0f;  // 1.5 * 2^23: adding it rounds to an integer
   constexpr float kLn2High = 0.693359375f;  // few mantissa bits, so k * kLn2High is exact
   constexpr float kLn2Low = -2.12194440e-4f;
-#if defined(__ARM_FEATURE_NUMERIC_MAXMIN)
-  // One VMAXNM (Cortex-M7): the clamped value's e^-86.5 is as good as 0 here.
+#if defined(__ARM_FEATURE_NUMERIC_MAXMIN) || (defined(__ARM_ARCH_7EM__) && defined(__ARM_FP) && (__ARM_FP & 0x8))
+  // One VMAXNM (FPv5, as on the Cortex-M7): the clamped value's e^-86.5 is
+  // as good as 0 here.
   x = __builtin_fmaxf(x, kLowest);
 #else
   if (!(x >= kLowest)) return 0.0f;
