@@ -1,4 +1,4 @@
-# cmake -DSOURCE_DIR= -DBINARY_DIR= -DTOOLCHAIN= -DGOLDEN_DIR= -DTARGETS= -P build_cross.cmake
+# cmake -DSOURCE_DIR= -DBINARY_DIR= -DTOOLCHAIN= -DGOLDEN_DIR= -DTARGETS= [-DBUILD_TYPE=Release] -P build_cross.cmake
 # Configures the cross build of the tree once and rebuilds TARGETS.
 foreach(variable SOURCE_DIR BINARY_DIR TOOLCHAIN GOLDEN_DIR TARGETS)
   if(NOT ${variable})
@@ -6,9 +6,13 @@ foreach(variable SOURCE_DIR BINARY_DIR TOOLCHAIN GOLDEN_DIR TARGETS)
   endif()
 endforeach()
 
+if(NOT BUILD_TYPE)
+  set(BUILD_TYPE Release)
+endif()
+
 execute_process(
   COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${BINARY_DIR} -DCMAKE_TOOLCHAIN_FILE=${TOOLCHAIN}
-          -DCMAKE_BUILD_TYPE=Release -DCDCR_QEMU_GOLDEN_DIR=${GOLDEN_DIR}
+          -DCMAKE_BUILD_TYPE=${BUILD_TYPE} -DCDCR_QEMU_GOLDEN_DIR=${GOLDEN_DIR}
   RESULT_VARIABLE configure_result)
 if(NOT configure_result EQUAL 0)
   message(FATAL_ERROR "configuring the cross build in ${BINARY_DIR} failed")

@@ -29,6 +29,17 @@
 
 namespace cdcr::model {
 
+// The loops over a training point's inputs and outputs have a handful of
+// iterations known at compile time; unrolled, their values stay in registers
+// at any optimisation level a board build uses (-O2 does not unroll them).
+#if defined(__clang__)
+#define CDCR_UNROLL_SMALL_LOOP _Pragma("unroll")
+#elif defined(__GNUC__)
+#define CDCR_UNROLL_SMALL_LOOP _Pragma("GCC unroll 16")
+#else
+#define CDCR_UNROLL_SMALL_LOOP
+#endif
+
 namespace detail {
 
 // Consecutive floats from flash or RAM into FPU registers. On a Cortex-M
@@ -67,6 +78,7 @@ inline void load_block(const float*& from, float (&to)[Count]) {
         : "m"(*reinterpret_cast<const float(*)[8]>(from)));
   }
   const float loaded[8] = {r0, r1, r2, r3, r4, r5, r6, r7};
+  CDCR_UNROLL_SMALL_LOOP
   for (int i = 0; i < Count; ++i) to[i] = loaded[i];
 }
 #undef CDCR_VLDM_OUT
@@ -241,6 +253,7 @@ class GpCorrection {
     if constexpr (detail::kHasBlockLoads && std::is_same_v<S, float> && Dims > 0) {
       float row[Dims];
       detail::load_block<Dims>(zi, row);
+      CDCR_UNROLL_SMALL_LOOP
       for (int d = 0; d < Dims; ++d) {
         const S difference = query[d] - row[d];
         distance_sq = multiply_add(difference, difference, distance_sq);
@@ -256,8 +269,10 @@ class GpCorrection {
     if constexpr (detail::kHasBlockLoads && std::is_same_v<S, float>) {
       float alpha[kImageOutputs];
       detail::load_block<kImageOutputs>(a, alpha);
+      CDCR_UNROLL_SMALL_LOOP
       for (int k = 0; k < kImageOutputs; ++k) block[k] = multiply_add(r, alpha[k], block[k]);
     } else {
+      CDCR_UNROLL_SMALL_LOOP
       for (int k = 0; k < kImageOutputs; ++k) block[k] = multiply_add(r, S(a[k]), block[k]);
       a += kImageOutputs;
     }
@@ -303,6 +318,7 @@ class GpCorrection {
           if constexpr (detail::kHasBlockLoads && std::is_same_v<S, float> && Dims > 0) {
             float row[Dims];
             detail::load_block<Dims>(row_pointer, row);
+            CDCR_UNROLL_SMALL_LOOP
             for (int d = 0; d < Dims; ++d) {
               first[d] = multiply_add(w_first, row[d], first[d]);
               second[d] = multiply_add(w_second, row[d], second[d]);

@@ -217,11 +217,13 @@ IkResult<S, Max> solve(const Pose<S>& target, const RobotGeometry<S, Max>& geome
       rows_current = true;
     }
 
-    Normal normal = rows * rows.transpose();
+    // Coefficient-wise products: Eigen's general product paths can fall back
+    // to heap workspace, which a board build must not link.
+    Normal normal = rows.lazyProduct(rows.transpose());
     const S scale = normal.trace() / S(Rows);
     normal.diagonal().array() += damping * scale + std::numeric_limits<S>::min();
     const Residual y = normal.ldlt().solve(residual);
-    JointVector<S, Max> trial = bend + rows.transpose() * y;
+    JointVector<S, Max> trial = bend + rows.transpose().lazyProduct(y);
     project_onto_limits(trial, geometry);
 
     Pose<S> trial_tip;
