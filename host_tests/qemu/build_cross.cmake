@@ -13,6 +13,7 @@ endif()
 execute_process(
   COMMAND ${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${BINARY_DIR} -DCMAKE_TOOLCHAIN_FILE=${TOOLCHAIN}
           -DCMAKE_BUILD_TYPE=${BUILD_TYPE} -DCDCR_QEMU_GOLDEN_DIR=${GOLDEN_DIR}
+          -DCDCR_MODEL_IMAGE_C=${GOLDEN_DIR}/cdcr_model_image.cpp
   RESULT_VARIABLE configure_result)
 if(NOT configure_result EQUAL 0)
   message(FATAL_ERROR "configuring the cross build in ${BINARY_DIR} failed")

@@ -1,11 +1,13 @@
 #pragma once
 // exp(x) for x <= 0, the one transcendental function of the GP correction's
 // inner loop. In double it is std::exp (the trainer, the host's reference
-// path). In float it is a short branch-free polynomial: newlib's expf checks
-// for overflow, NaN and errno on every call and costs a third of the loop on
-// a Cortex-M, for arguments that here are always finite and non-positive.
+// path). In float on a Cortex-M FPU it is polynomial_exp below: newlib's expf
+// checks for overflow, NaN and errno on every call and costs a third of the
+// loop there, for arguments that here are always finite and non-positive.
+// Elsewhere (x86-64, AArch64 hosts) the C library's expf is already faster
+// than the polynomial, and within 1 ulp.
 //
-// Float method: x = k ln2 + r with |r| <= ln2/2 (k rounded with the 1.5 * 2^23
+// polynomial_exp: x = k ln2 + r with |r| <= ln2/2 (k rounded with the 1.5 * 2^23
 // shifter, ln2 split in two so k ln2 is exact), e^r from the degree-7
 // minimax-style polynomial below (Cephes' expf coefficients), and 2^k put
 // into the exponent bits. Relative error below 2 ulp over [-87, 0] (tested
@@ -32,7 +34,7 @@ inline S multiply_add(S a, S b, S c) {
 #endif
 }
 
-inline float kernel_exp(float x) {
+inline float polynomial_exp(float x) {
   constexpr float kLowest = -86.5f;  // 2^k stays a normal float
   constexpr float kLog2e = 1.44269504088896341f;
   constexpr float kShifter = 12582912.0f;  // 1.5 * 2^23: adding it rounds to an integer
@@ -66,6 +68,14 @@ inline float kernel_exp(float x) {
   float result;
   std::memcpy(&result, &p_bits, sizeof(result));
   return result;
+}
+
+inline float kernel_exp(float x) {
+#if defined(__arm__) && defined(__ARM_FP)
+  return polynomial_exp(x);
+#else
+  return std::exp(x);
+#endif
 }
 
 inline double kernel_exp(double x) { return std::exp(x); }
