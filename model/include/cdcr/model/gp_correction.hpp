@@ -5,15 +5,16 @@
 //
 // Per cycle the cost is one pass over the N training points: D differences
 // and multiply-adds for the squared distance, one exp (kernel_exp.hpp), and
-// 6 multiply-adds into the output sums. Everything that does not depend on the query
-// (input normalisation combined with the length scales, output scaling
-// combined with the signal variance) is folded once in bind().
+// 6 multiply-adds into the output sums. Everything that does not depend on
+// the query (input normalisation combined with the length scales, output
+// scaling combined with the signal variance) is folded once in bind().
 //
 // Accumulator is the type of the six running sums. The terms k_i alpha_i can
 // be large with alternating signs, so the sums are where single precision
-// loses digits first; double accumulation costs the same instruction count on
-// an FPU with double support (host, Cortex-M7), and a compensated float sum
-// serves FPUs without it.
+// loses digits first: the terms are added in S over blocks of kBlockPoints
+// training points, and each block into the Accumulator, double where the FPU
+// has it (host, Cortex-M7) and a compensated float sum where it does not
+// (Cortex-M4F).
 
 #include <array>
 #include <cmath>
@@ -46,7 +47,8 @@ namespace detail {
 // with an FPU, GCC issues one VLDR per float; VLDMIA moves a whole training
 // point (or its six alphas) in one instruction, about a fifth of the loop's
 // instructions. The registers are fixed (s16 up) only at the load; the
-// compiler allocates everything else around them.
+// compiler allocates everything else around them. The image's blocks are
+// 8-byte aligned, more than VLDMIA's word alignment needs.
 #if defined(__GNUC__) && !defined(__clang__) && defined(__arm__) && defined(__ARM_FP) && (__ARM_FP & 0x4)
 inline constexpr bool kHasBlockLoads = true;
 
