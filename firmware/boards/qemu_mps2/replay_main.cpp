@@ -38,6 +38,32 @@ constexpr double kBusOrientationToleranceDeg = 0.02;
 
 cdcr::boards::mps2::Board board;
 cdcr::firmware::Runtime runtime(board.hal(), cdcr::boards::mps2::golden_geometry());
+cdcr::firmware::Correction correction;
+
+// The GP mean as the forward path computes it (the board's fastest loop, in
+// assembly on the Cortex-M7) against the mean the gradient pass computes with
+// the portable loop: the same operations in the same order, so the same bits.
+int fast_and_portable_mean_differences() {
+  const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
+  cdcr::model::ImageView image{};
+  if (cdcr::model::parse_image(region.data, region.size_bytes, image, cdcr::model::ImageCapacity{}) !=
+          cdcr::model::ImageStatus::ok ||
+      correction.bind(image) != cdcr::model::Status::ok) {
+    return -1;
+  }
+  int differences = 0;
+  for (int c = 0; c < golden::kCases; ++c) {
+    cdcr::firmware::Joints joints(2 * golden::kSegments);
+    for (int k = 0; k < joints.size(); ++k) joints[k] = golden::kJoints[c][k];
+    const cdcr::firmware::Joints bend = cdcr::model::bend_from_joints(joints);
+    const cdcr::model::Twist<float> fast = correction.predict(bend);
+    cdcr::model::Twist<float> portable;
+    cdcr::model::Jacobian<float> gradient;
+    correction.predict_with_gradient(bend, portable, gradient);
+    for (int k = 0; k < 6; ++k) differences += fast[k] != portable[k];
+  }
+  return differences;
+}
 
 struct BusView {
   double position_mm[3] = {};
@@ -133,6 +159,16 @@ int main() {
   if (kExpectDegraded) {
     check(runtime.boot_fault_detail() == static_cast<int>(cdcr::model::ImageStatus::checksum_mismatch),
           "the flipped byte was not caught by the checksum");
+  }
+
+  if (!kExpectDegraded) {
+    const int differences = fast_and_portable_mean_differences();
+    console::console_write("GP mean, fast loop against the portable one: ");
+    console::console_write_int(differences);
+    console::console_write(" differing outputs of ");
+    console::console_write_int(6 * golden::kCases);
+    console::console_write("\n");
+    check(differences == 0, "the fast GP loop and the portable one disagree");
   }
 
   cdcr::boards::mps2::PoseDeviation worst, worst_bus;

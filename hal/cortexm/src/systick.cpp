@@ -50,6 +50,7 @@ std::uint64_t SysTickTimer::now_ticks() const {
 
 std::int64_t SysTickTimer::now_ns() const {
   const std::uint64_t ticks = now_ticks();
+  if (ns_per_tick_ != 0) return static_cast<std::int64_t>(ticks * ns_per_tick_);
   // Split so that the product stays within 64 bits for centuries of uptime.
   const std::uint64_t seconds = ticks / core_clock_hz_;
   const std::uint64_t rest = ticks % core_clock_hz_;

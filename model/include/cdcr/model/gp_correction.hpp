@@ -4,7 +4,7 @@
 // analytic gradient for compensated inverse kinematics.
 //
 // Per cycle the cost is one pass over the N training points: D differences
-// and multiply-adds for the squared distance, one exp (kernel_exp.hpp), and
+// and multiply-adds for the squared distance, one exp (gaussian() in kernel_exp.hpp), and
 // 6 multiply-adds into the output sums. Everything that does not depend on
 // the query (input normalisation combined with the length scales, output
 // scaling combined with the signal variance) is folded once in bind().
@@ -23,6 +23,7 @@
 
 #include "cdcr/model/chain.hpp"
 #include "cdcr/model/flash_image.hpp"
+#include "cdcr/model/gp_mean_fpv5.hpp"
 #include "cdcr/model/input_encoding.hpp"
 #include "cdcr/model/kernel_exp.hpp"
 #include "cdcr/model/status.hpp"
@@ -120,7 +121,7 @@ class GpCorrection {
  public:
   static constexpr int kMaxInputs = 2 * MaxSegments;
   // Training points summed in S before a sum goes into the accumulator.
-  static constexpr std::uint32_t kBlockPoints = 4;
+  static constexpr std::uint32_t kBlockPoints = 8;
   using Input = Eigen::Matrix<S, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxInputs, 1>;
 
   // Takes a view from parse_image(); the image bytes must outlive this object.
@@ -235,6 +236,12 @@ class GpCorrection {
     const float* zi = inputs_;
     const float* a = alpha_;
     const std::uint32_t full_blocks = training_points_ / kBlockPoints;
+#if defined(CDCR_GP_MEAN_FPV5)
+    if constexpr (Dims == 8 && std::is_same_v<S, float> && std::is_same_v<Accumulator, double> &&
+                  kBlockPoints == detail::kFpv5BlockPoints) {
+      if (full_blocks > 0) detail::gp_mean_blocks_fpv5(query, zi, a, full_blocks, sums);
+    } else
+#endif
     for (std::uint32_t b = 0; b < full_blocks; ++b) {
       S block[kImageOutputs] = {};
       for (std::uint32_t j = 0; j < kBlockPoints; ++j) add_point<Dims>(query, dims, zi, a, block);
@@ -267,7 +274,7 @@ class GpCorrection {
       }
       zi += dims;
     }
-    const S r = kernel_exp(S(-0.5) * distance_sq);
+    const S r = gaussian(distance_sq);
     if constexpr (detail::kHasBlockLoads && std::is_same_v<S, float>) {
       float alpha[kImageOutputs];
       detail::load_block<kImageOutputs>(a, alpha);

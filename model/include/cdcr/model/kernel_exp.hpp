@@ -1,19 +1,22 @@
 #pragma once
-// exp(x) for x <= 0, the one transcendental function of the GP correction's
-// inner loop. In double it is std::exp (the trainer, the host's reference
-// path). In float on a Cortex-M FPU it is polynomial_exp below: newlib's expf
-// checks for overflow, NaN and errno on every call and costs a third of the
-// loop there, for arguments that here are always finite and non-positive.
-// Elsewhere (x86-64, AArch64 hosts) the C library's expf is already faster
-// than the polynomial, and within 1 ulp.
+// The squared-exponential kernel's one transcendental function,
+// gaussian(y) = exp(-y / 2) for a squared distance y >= 0, evaluated N times
+// per cycle by the GP correction. In double it is std::exp (the trainer, the
+// host's reference path). In float on a Cortex-M FPU it is
+// polynomial_gaussian below: newlib's expf checks for overflow, NaN and errno
+// on every call and cost a third of the loop there, for arguments that here
+// are always finite and non-positive. Elsewhere (x86-64, AArch64 hosts) the C
+// library's expf is faster than the polynomial, and within 1 ulp.
 //
-// polynomial_exp: x = k ln2 + r with |r| <= ln2/2 (k rounded with the 1.5 * 2^23
-// shifter, ln2 split in two so k ln2 is exact), e^r from the degree-7
-// minimax-style polynomial below (Cephes' expf coefficients), and 2^k put
-// into the exponent bits. Relative error below 2 ulp over [-87, 0] (tested
-// against std::exp in host_tests/model/kernel_exp_test.cpp); below -86.5
-// (e^-86.5 = 2.7e-38, the bottom of the normal floats) the result is 0, or
-// e^-86.5 where the FPU clamps in one instruction.
+// polynomial_gaussian: y clamped to 173 (e^-86.5, the bottom of the normal
+// floats; beyond it every term is negligible), k = round(-y log2(e) / 2) with
+// ties to even, v = y + 2 k ln 2 (|v| <= ln 2), exp(-v / 2) from a degree-6
+// polynomial fitted for relative error (3e-9 in exact arithmetic), and 2^k
+// put into the exponent bits. Within 1.5 ulp of exp(-y/2) for y <= 40 and 5
+// ulp down to e^-86.5, where k ln 2 carries the float rounding of ln 2
+// (tested against std::exp in host_tests/model/kernel_exp_test.cpp). The Cortex-M7 assembly
+// loop (gp_mean_fpv5.hpp) performs the same operations in the same order and
+// so gives the same bits.
 
 #include <cmath>
 #include <cstdint>
@@ -34,50 +37,52 @@ inline S multiply_add(S a, S b, S c) {
 #endif
 }
 
-inline float polynomial_exp(float x) {
-  constexpr float kLowest = -86.5f;  // 2^k stays a normal float
-  constexpr float kLog2e = 1.44269504088896341f;
-  constexpr float kShifter = 12582912.0f;  // 1.5 * 2^23: adding it rounds to an integer
-  constexpr float kLn2High = 0.693359375f;  // few mantissa bits, so k * kLn2High is exact
-  constexpr float kLn2Low = -2.12194440e-4f;
-#if defined(__ARM_FEATURE_NUMERIC_MAXMIN) || (defined(__ARM_ARCH_7EM__) && defined(__ARM_FP) && (__ARM_FP & 0x8))
-  // One VMAXNM (FPv5, as on the Cortex-M7): the clamped value's e^-86.5 is
-  // as good as 0 here.
-  x = __builtin_fmaxf(x, kLowest);
-#else
-  if (!(x >= kLowest)) return 0.0f;
-#endif
-  const float shifted = multiply_add(x, kLog2e, kShifter);
-  const float k = shifted - kShifter;
-  float r = multiply_add(k, -kLn2High, x);
-  r = multiply_add(k, -kLn2Low, r);
-  float p = 1.9875691500e-4f;
-  p = multiply_add(p, r, 1.3981999507e-3f);
-  p = multiply_add(p, r, 8.3334519073e-3f);
-  p = multiply_add(p, r, 4.1665795894e-2f);
-  p = multiply_add(p, r, 1.6666665459e-1f);
-  p = multiply_add(p, r, 5.0000001201e-1f);
-  p = multiply_add(p, r * r, r + 1.0f);
-  // k is the integer in the low mantissa bits of `shifted`.
-  std::int32_t k_bits;
-  std::memcpy(&k_bits, &shifted, sizeof(k_bits));
-  std::int32_t k_integer = k_bits - 0x4B400000;  // the bits of kShifter
-  std::int32_t p_bits;
-  std::memcpy(&p_bits, &p, sizeof(p_bits));
-  p_bits += static_cast<std::int32_t>(static_cast<std::uint32_t>(k_integer) << 23);
+namespace gaussian_constants {
+inline constexpr float kClamp = 173.0f;
+inline constexpr float kMinusHalfLog2e = -0.721347520f;  // -log2(e) / 2
+inline constexpr float kTwoLn2 = 1.38629436f;
+// exp(-v/2) = 1 + v (-1/2 + v (b2 + b3 v + v^2 (b4 + b5 v + b6 v^2)))
+inline constexpr float kB2 = 0.124999985f;
+inline constexpr float kB3 = -0.0208331496f;
+inline constexpr float kB4 = 0.00260427454f;
+inline constexpr float kB5 = -0.000261524139f;
+inline constexpr float kB6 = 2.1585045e-05f;
+}  // namespace gaussian_constants
+
+// Fused multiply-adds throughout (std::fma is one VFMA on the boards), so
+// that a host computes the same bits as a board when it tests this.
+inline float polynomial_gaussian(float distance_sq) {
+  using namespace gaussian_constants;
+  constexpr float kShifter = 12582912.0f;  // 1.5 * 2^23: adding it rounds to an integer, ties to even
+  // Also maps NaN to the clamp, as the FPU's VMINNM does.
+  const float y = distance_sq < kClamp ? distance_sq : kClamp;
+  const float z = y * kMinusHalfLog2e;
+  const float k = (z + kShifter) - kShifter;
+  const auto k_integer = static_cast<std::int32_t>(k);
+  const float v = std::fma(k, kTwoLn2, y);
+  const float v2 = v * v;
+  const float b = std::fma(v, kB3, kB2);
+  float c = std::fma(v, kB5, kB4);
+  c = std::fma(v2, kB6, c);
+  const float e = std::fma(v2, c, b);
+  const float d = std::fma(v, e, -0.5f);
+  const float p = std::fma(v, d, 1.0f);
+  std::int32_t bits;
+  std::memcpy(&bits, &p, sizeof(bits));
+  bits += static_cast<std::int32_t>(static_cast<std::uint32_t>(k_integer) << 23);
   float result;
-  std::memcpy(&result, &p_bits, sizeof(result));
+  std::memcpy(&result, &bits, sizeof(result));
   return result;
 }
 
-inline float kernel_exp(float x) {
+inline float gaussian(float distance_sq) {
 #if defined(__arm__) && defined(__ARM_FP)
-  return polynomial_exp(x);
+  return polynomial_gaussian(distance_sq);
 #else
-  return std::exp(x);
+  return std::exp(-0.5f * distance_sq);
 #endif
 }
 
-inline double kernel_exp(double x) { return std::exp(x); }
+inline double gaussian(double distance_sq) { return std::exp(-0.5 * distance_sq); }
 
 }  // namespace cdcr::model
