@@ -39,6 +39,7 @@ void SysTickTimer::start(std::int64_t period_ns) {
 }
 
 std::uint64_t SysTickTimer::now_ticks() const {
+  if (reload_ticks_ == 0) return 0;  // not started: time stands at 0
   // The exception may land between the two reads; a period count that moved
   // means the counter reloaded in between, so read again.
   for (;;) {

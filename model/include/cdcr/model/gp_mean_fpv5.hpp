@@ -8,8 +8,8 @@
 // constants (s14, s15, s24-s29) stay in registers for the whole loop, each
 // training point and its alphas arrive with one VLDM each, and the block's
 // first point initialises the sums. That is 44 instructions per training
-// point where GCC's allocation of the same C++ needed 57 (constants reloaded
-// from the literal pool on every point).
+// point where GCC's code for the C++ loop needed 57 (constants reloaded from
+// the literal pool on every point).
 
 #include <cstdint>
 
