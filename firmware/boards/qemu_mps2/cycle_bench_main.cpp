@@ -15,6 +15,8 @@
 // Every count has the cost of reading the counter (an empty measurement)
 // subtracted.
 
+#include <algorithm>
+
 #include <cdcr/cortexm/semihosting.hpp>
 #include <cdcr/cortexm/stack_watermark.hpp>
 #include <cdcr/firmware/runtime.hpp>
@@ -79,18 +81,8 @@ std::uint32_t count_instructions(Work&& work) {
   return ticks_to_instructions(ticks > overhead_ticks ? ticks - overhead_ticks : 0);
 }
 
-void sort(std::uint32_t* values, int count) {
-  for (int i = 1; i < count; ++i) {
-    for (int j = i; j > 0 && values[j - 1] > values[j]; --j) {
-      const std::uint32_t t = values[j];
-      values[j] = values[j - 1];
-      values[j - 1] = t;
-    }
-  }
-}
-
 void report(const char* name, std::uint32_t* counts, int count) {
-  sort(counts, count);
+  std::sort(counts, counts + count);
   console::console_write("instructions ");
   console::console_write(name);
   console::console_write(" median ");
@@ -111,12 +103,7 @@ model::CableVector<float> golden_cables(int c) {
 }
 
 model::Pose<float> golden_pose(int c) {
-  model::Pose<float> pose;
-  for (int i = 0; i < 3; ++i) pose.position_mm[i] = static_cast<float>(golden::kCompensatedPositionMm[c][i]);
-  for (int r = 0; r < 3; ++r) {
-    for (int col = 0; col < 3; ++col) pose.rotation(r, col) = static_cast<float>(golden::kCompensatedRotation[c][3 * r + col]);
-  }
-  return pose;
+  return cdcr::boards::mps2::golden_pose<float>(golden::kCompensatedPositionMm[c], golden::kCompensatedRotation[c]);
 }
 
 // The three target frames of a pose target, as a planner sends them.

@@ -2,48 +2,41 @@
 // Comparing a pose the board computed with the host's double result, and
 // feeding a golden case to the runtime the way the bus would.
 
-#include <cmath>
 #include <cstdint>
 
 #include <cdcr/firmware/protocol.hpp>
-#include <cdcr/model/se3.hpp>
+#include <cdcr/model/compensation.hpp>
 
 #include "board.hpp"
 #include "qemu_golden.hpp"
 
 namespace cdcr::boards::mps2 {
 
+// A pose of the golden header: position in mm, rotation row-major.
+template <typename S>
+model::Pose<S> golden_pose(const double (&position_mm)[3], const double (&rotation)[9]) {
+  model::Pose<S> pose;
+  for (int i = 0; i < 3; ++i) pose.position_mm[i] = static_cast<S>(position_mm[i]);
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) pose.rotation(r, c) = static_cast<S>(rotation[3 * r + c]);
+  }
+  return pose;
+}
+
 struct PoseDeviation {
   double position_mm = 0;
   double orientation_deg = 0;
 };
 
-// The angle of R_expected^T R from atan2(|skew part|, (trace - 1) / 2): acos
-// of the trace alone would read float rounding in R (not quite orthonormal)
-// as hundredths of a degree.
-inline PoseDeviation deviation(const model::Pose<float>& pose, const double (&expected_position_mm)[3],
-                               const double (&expected_rotation)[9]) {
+// The board's float pose against the host's double one, measured in double
+// (eq. 20, as the accuracy figures are).
+inline PoseDeviation deviation(const model::Pose<float>& pose, const model::Pose<double>& expected) {
   constexpr double kDegPerRad = 57.295779513082320876;
-  PoseDeviation d;
-  double sq = 0;
-  for (int i = 0; i < 3; ++i) {
-    const double e = static_cast<double>(pose.position_mm[i]) - expected_position_mm[i];
-    sq += e * e;
-  }
-  d.position_mm = std::sqrt(sq);
-  double m[3][3];
-  for (int i = 0; i < 3; ++i) {
-    for (int j = 0; j < 3; ++j) {
-      m[i][j] = 0;
-      for (int k = 0; k < 3; ++k) m[i][j] += expected_rotation[3 * k + i] * static_cast<double>(pose.rotation(k, j));
-    }
-  }
-  const double wx = 0.5 * (m[2][1] - m[1][2]);
-  const double wy = 0.5 * (m[0][2] - m[2][0]);
-  const double wz = 0.5 * (m[1][0] - m[0][1]);
-  const double cos_angle = 0.5 * (m[0][0] + m[1][1] + m[2][2] - 1.0);
-  d.orientation_deg = std::atan2(std::sqrt(wx * wx + wy * wy + wz * wz), cos_angle) * kDegPerRad;
-  return d;
+  model::Pose<double> widened;
+  widened.position_mm = pose.position_mm.cast<double>();
+  widened.rotation = pose.rotation.cast<double>();
+  const model::PoseError<double> error = model::pose_error(widened, expected);
+  return {error.position_mm, error.orientation_rad * kDegPerRad};
 }
 
 // One cable feedback frame per segment, as the drives send them.

@@ -188,10 +188,12 @@ int main() {
           "pose missing or compensated in the wrong state");
     check(bus.compensated_flag == !kExpectDegraded, "pose frame's compensated flag is wrong");
 
-    const auto& expected_position = kExpectDegraded ? golden::kNominalPositionMm[c] : golden::kCompensatedPositionMm[c];
-    const auto& expected_rotation = kExpectDegraded ? golden::kNominalRotation[c] : golden::kCompensatedRotation[c];
-    const auto d = cdcr::boards::mps2::deviation(runtime.latest_pose().pose, expected_position, expected_rotation);
-    const auto b = cdcr::boards::mps2::deviation(pose_from_bus(bus), expected_position, expected_rotation);
+    const cdcr::model::Pose<double> expected =
+        kExpectDegraded
+            ? cdcr::boards::mps2::golden_pose<double>(golden::kNominalPositionMm[c], golden::kNominalRotation[c])
+            : cdcr::boards::mps2::golden_pose<double>(golden::kCompensatedPositionMm[c], golden::kCompensatedRotation[c]);
+    const auto d = cdcr::boards::mps2::deviation(runtime.latest_pose().pose, expected);
+    const auto b = cdcr::boards::mps2::deviation(pose_from_bus(bus), expected);
     if (!(d.position_mm <= worst.position_mm)) worst.position_mm = d.position_mm;
     if (!(d.orientation_deg <= worst.orientation_deg)) worst.orientation_deg = d.orientation_deg;
     if (!(b.position_mm <= worst_bus.position_mm)) worst_bus.position_mm = b.position_mm;
