@@ -5,26 +5,17 @@
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <string>
 #include <string_view>
 
 #include "dataset/csv_dataset.hpp"
+#include "fuzz_checks.hpp"
 
 namespace {
 
+using cdcr::fuzz::check_rejection;
+using cdcr::fuzz::require;
 using namespace cdcr::dataset;
-
-void require(bool condition) {
-  if (!condition) std::abort();
-}
-
-void check_rejection(const DatasetError& e) {
-  const std::string what = e.what();
-  require(e.line() >= 0);
-  require(what.find_first_of("\r\n") == std::string::npos);
-  if (e.line() > 0) require(what.rfind("line " + std::to_string(e.line()) + ": ", 0) == 0);
-}
 
 void check_accepted(const Dataset& data, std::string_view text, PoseColumns poses) {
   require(data.segment_count >= 1 && data.segment_count <= 8);

@@ -6,7 +6,6 @@
 
 #include <cstddef>
 #include <cstdint>
-#include <cstdlib>
 #include <cstring>
 #include <limits>
 #include <vector>
@@ -14,14 +13,12 @@
 #include "cdcr/model/crc32.hpp"
 #include "cdcr/model/flash_image.hpp"
 #include "cdcr/model/gp_correction.hpp"
+#include "fuzz_checks.hpp"
 
 namespace {
 
+using cdcr::fuzz::require;
 using namespace cdcr::model;
-
-void require(bool condition) {
-  if (!condition) std::abort();
-}
 
 bool inside(const void* begin, std::size_t bytes, const std::uint8_t* image, std::size_t image_size) {
   const auto* p = static_cast<const std::uint8_t*>(begin);
