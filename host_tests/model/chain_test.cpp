@@ -16,11 +16,13 @@
 
 #include "cdcr/model/kinematics.hpp"
 
+#include "../support/scalar_types.hpp"
+
 namespace cdcr::model {
 namespace {
 
-using Real = long double;
-constexpr Real kPi = 3.141592653589793238462643383279502884L;
+using test_support::kPi;
+using test_support::Real;
 
 // Relative error bounds. Forward kinematics and the Jacobians are a few
 // dozen operations per segment, so the observed error is a few tens of
@@ -29,10 +31,6 @@ constexpr Real kPi = 3.141592653589793238462643383279502884L;
 template <typename S> struct Tolerance;
 template <> struct Tolerance<float> { static constexpr Real relative = 1e-5L; };
 template <> struct Tolerance<double> { static constexpr Real relative = 1e-12L; };
-
-struct ScalarNames {
-  template <typename S> static std::string GetName(int) { return std::is_same_v<S, float> ? "float" : "double"; }
-};
 
 template <typename S>
 class Chain : public ::testing::Test {
@@ -65,8 +63,7 @@ class Chain : public ::testing::Test {
   }
 };
 
-using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(Chain, Scalars, ScalarNames);
+TYPED_TEST_SUITE(Chain, test_support::Scalars, test_support::ScalarNames);
 
 template <typename S>
 RobotGeometry<Real> to_real(const RobotGeometry<S>& geometry) {

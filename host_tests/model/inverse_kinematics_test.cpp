@@ -35,6 +35,8 @@
 
 #include "cdcr/model/kinematics.hpp"
 
+#include "../support/scalar_types.hpp"
+
 namespace cdcr::model {
 
 void PrintTo(Status status, std::ostream* os) { *os << to_string(status); }
@@ -203,12 +205,7 @@ void expect_position_reached(const IkResult<S>& result, const RobotGeometry<S>& 
   EXPECT_EQ(result.orientation_error_rad, S(0));
 }
 
-struct ScalarNames {
-  template <typename S> static std::string GetName(int) { return std::is_same_v<S, float> ? "float" : "double"; }
-};
-
-using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(InverseKinematics, Scalars, ScalarNames);
+TYPED_TEST_SUITE(InverseKinematics, test_support::Scalars, test_support::ScalarNames);
 
 TYPED_TEST(InverseKinematics, PaperWorkspacePoseTargetsFromPerturbedGuess) {
   using S = TypeParam;

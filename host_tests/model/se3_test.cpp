@@ -18,11 +18,13 @@
 
 #include "cdcr/model/se3.hpp"
 
+#include "../support/scalar_types.hpp"
+
 namespace cdcr::model {
 namespace {
 
-using Real = long double;
-constexpr Real kPi = 3.141592653589793238462643383279502884L;
+using test_support::kPi;
+using test_support::Real;
 
 // Error bounds relative to the size of the compared quantity (a rotation
 // entry, or a translation divided by max(1 mm, its norm)). The worst observed
@@ -41,10 +43,6 @@ template <> struct Tolerance<double> {
   // The left Jacobian truncates its series after ten terms; for rotations up
   // to 0.3 rad the omitted term is about 0.3^10 / 11! = 1.5e-13 relative.
   static constexpr Real jacobian = 2e-12L;
-};
-
-struct ScalarNames {
-  template <typename S> static std::string GetName(int) { return std::is_same_v<S, float> ? "float" : "double"; }
 };
 
 template <typename S>
@@ -83,8 +81,7 @@ class Se3 : public ::testing::Test {
   }
 };
 
-using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(Se3, Scalars, ScalarNames);
+TYPED_TEST_SUITE(Se3, test_support::Scalars, test_support::ScalarNames);
 
 // Distance between two poses: largest rotation-entry difference, or
 // position difference relative to max(1 mm, |p|), whichever is larger.

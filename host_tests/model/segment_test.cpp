@@ -21,20 +21,18 @@
 
 #include "cdcr/model/segment.hpp"
 
+#include "../support/scalar_types.hpp"
+
 namespace cdcr::model {
 namespace {
 
-using Real = long double;
-constexpr Real kPi = 3.141592653589793238462643383279502884L;
+using test_support::kPi;
+using test_support::Real;
 
 // Relative error bounds, a few tens of roundings of the tested type.
 template <typename S> struct Tolerance;
 template <> struct Tolerance<float> { static constexpr Real relative = 1e-5L; };
 template <> struct Tolerance<double> { static constexpr Real relative = 1e-12L; };
-
-struct ScalarNames {
-  template <typename S> static std::string GetName(int) { return std::is_same_v<S, float> ? "float" : "double"; }
-};
 
 // Segment shapes from slender (small r / L, where the cable differences are
 // small and joints_from_cables amplifies rounding most) to the prototype.
@@ -77,8 +75,7 @@ class Segment : public ::testing::Test {
   }
 };
 
-using Scalars = ::testing::Types<float, double>;
-TYPED_TEST_SUITE(Segment, Scalars, ScalarNames);
+TYPED_TEST_SUITE(Segment, test_support::Scalars, test_support::ScalarNames);
 
 template <typename S>
 SegmentGeometry<S> cast_geometry(const SegmentGeometry<double>& g) {
