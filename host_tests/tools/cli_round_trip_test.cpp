@@ -2,13 +2,8 @@
 // kinematics must reproduce Table 1 of the paper, and the inverse kinematics
 // must return cable lengths that drive the model back to its target.
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <array>
 #include <cstdio>
-#include <fstream>
-#include <iterator>
 #include <string>
 #include <vector>
 
@@ -16,34 +11,14 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "../support/run_cdcr.hpp"
+
 namespace {
 
 using nlohmann::json;
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-CliRun run_cdcr(const std::string& arguments) {
-  static int run_count = 0;
-  const std::string err_path =
-      testing::TempDir() + "cdcr_stderr_" + std::to_string(getpid()) + "_" + std::to_string(run_count++);
-  const std::string command = "'" CDCR_CLI_PATH "' " + arguments + " 2>'" + err_path + "'";
-  CliRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buffer{};
-  std::size_t count = 0;
-  while ((count = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), count);
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream err_file(err_path);
-  run.err.assign(std::istreambuf_iterator<char>(err_file), std::istreambuf_iterator<char>());
-  std::remove(err_path.c_str());
-  return run;
-}
+using cdcr::test_support::CliRun;
+using cdcr::test_support::run_cdcr;
 
 std::string join(const std::vector<double>& values) {
   std::string text;

@@ -3,7 +3,6 @@
 // image, one damaged image per parser status with the check it must name,
 // and each export format checked against its library encoder and objcopy.
 
-#include <sys/wait.h>
 
 #include <cmath>
 #include <cstdint>
@@ -27,6 +26,7 @@
 #include "export/image_writer.hpp"
 #include "image_report.hpp"
 
+#include "../support/run_cdcr.hpp"
 #include "../support/synthetic_trained_model.hpp"
 
 namespace cdcr::cli {
@@ -61,11 +61,7 @@ void reseal(Bytes& image) {
   put<std::uint32_t>(image, total - 4, model::crc32(image.data(), total - 4));
 }
 
-struct CliResult {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
+using CliResult = cdcr::test_support::CliRun;
 
 class ImageCli : public ::testing::Test {
  protected:
@@ -82,16 +78,7 @@ class ImageCli : public ::testing::Test {
     return path;
   }
 
-  CliResult cdcr(const std::string& arguments) const {
-    const std::string command = "'" CDCR_CLI_PATH "' " + arguments + " > '" + (dir / "stdout").string() + "' 2> '" +
-                                (dir / "stderr").string() + "'";
-    const int status = std::system(command.c_str());
-    CliResult run;
-    run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-    run.out = read_text(dir / "stdout");
-    run.err = read_text(dir / "stderr");
-    return run;
-  }
+  static CliResult cdcr(const std::string& arguments) { return test_support::run_cdcr(arguments); }
 
   static std::string quoted(const fs::path& path) { return "'" + path.string() + "'"; }
 

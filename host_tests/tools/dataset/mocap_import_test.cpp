@@ -2,14 +2,11 @@
 // end-platform poses in the camera frame must give back the end platform in
 // the base frame (eq. 21); damaged captures must be refused with the line.
 
-#include <sys/wait.h>
 #include <unistd.h>
 
-#include <array>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
-#include <iterator>
 #include <optional>
 #include <ostream>
 #include <random>
@@ -23,6 +20,8 @@
 #include "dataset/csv_dataset.hpp"
 #include "dataset/mocap_import.hpp"
 #include "import_mocap_command.hpp"
+
+#include "../../support/run_cdcr.hpp"
 
 namespace {
 
@@ -539,28 +538,8 @@ TEST(ImportMocapCommand, RefusalsAreInputErrorsNamingTheFile) {
   }
 }
 
-struct CliRun {
-  int exit_code = -1;
-  std::string out;
-  std::string err;
-};
-
-CliRun run_cdcr(const std::string& arguments) {
-  const std::string err_path = testing::TempDir() + "cdcr_import_stderr_" + std::to_string(getpid());
-  const std::string command = "'" CDCR_CLI_PATH "' " + arguments + " 2>'" + err_path + "'";
-  CliRun run;
-  FILE* pipe = popen(command.c_str(), "r");
-  if (pipe == nullptr) return run;
-  std::array<char, 4096> buffer{};
-  std::size_t count = 0;
-  while ((count = std::fread(buffer.data(), 1, buffer.size(), pipe)) > 0) run.out.append(buffer.data(), count);
-  const int status = pclose(pipe);
-  run.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-  std::ifstream err_file(err_path);
-  run.err.assign(std::istreambuf_iterator<char>(err_file), std::istreambuf_iterator<char>());
-  std::remove(err_path.c_str());
-  return run;
-}
+using cdcr::test_support::CliRun;
+using cdcr::test_support::run_cdcr;
 
 TEST(ImportMocapCommand, ThroughTheExecutable) {
   const KnownCapture k = capture_with_lost_frames(4, {}, {1});
