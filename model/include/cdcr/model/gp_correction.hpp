@@ -122,6 +122,8 @@ class GpCorrection {
   static constexpr int kMaxInputs = 2 * MaxSegments;
   // Training points summed in S before a sum goes into the accumulator.
   static constexpr std::uint32_t kBlockPoints = 8;
+  // Large enough for any whole evaluation in one slice.
+  static constexpr std::uint32_t kMaxUnitsPerSlice = 0xFFFFFFFFu / 4;
   using Input = Eigen::Matrix<S, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxInputs, 1>;
 
   // Takes a view from parse_image(); the image bytes must outlive this object.
@@ -147,44 +149,117 @@ class GpCorrection {
   int input_dims() const { return input_dims_; }
   InputEncoding encoding() const { return encoding_; }
 
+  std::uint32_t training_points() const { return training_points_; }
+
   // The error twist eps (v, omega) for a stacked bend vector.
   Twist<S> predict(const JointVector<S, MaxSegments>& bend) const {
     S z[kMaxInputs];
     kernel_coordinates(bend, z);
     Accumulator sums[kImageOutputs] = {};
-    with_input_count([&](auto dims) { accumulate_mean<decltype(dims)::value>(z, sums); });
+    with_input_count([&](auto dims) { accumulate_mean<decltype(dims)::value>(z, 0, training_points_, sums); });
     return outputs(sums);
   }
 
   // eps and d(eps)/d(bend), 6 x D.
   void predict_with_gradient(const JointVector<S, MaxSegments>& bend, Twist<S>& eps,
                              Jacobian<S, MaxSegments>& d_eps_d_bend) const {
-    S z[kMaxInputs];
-    kernel_coordinates(bend, z);
+    Evaluation evaluation;
+    if (begin_evaluation(bend, evaluation, true) != Status::ok) return;
+    while (!evaluation_finished(evaluation)) continue_evaluation(evaluation, kMaxUnitsPerSlice);
+    evaluation_result(evaluation, eps, d_eps_d_bend);
+  }
+
+  // The mean, and optionally its gradient, in slices, for a caller that
+  // spreads one evaluation over several fixed-rate cycles (the resumable IK
+  // solver). The slices add the same blocks in the same order as a whole
+  // pass, so the result has the same bits. Work is counted in units: a
+  // training point of the mean is one unit, of the mean with the gradient
+  // kGradientPointUnits (the ratio of their instruction counts, measured on
+  // the Cortex-M boards).
+  static constexpr std::uint32_t kGradientPointUnits = 3;
+  // The gradient pass goes over chunks of this many training points.
+  static constexpr std::uint32_t kChunkPoints = 8 * kBlockPoints;
+
+  struct Evaluation {
+    S z[kMaxInputs] = {};
     Accumulator sums[kImageOutputs] = {};
+    // sum_i alpha_ik r_i z_i, for the gradient.
+    S weighted[kImageOutputs][kMaxInputs] = {};
+    JointVector<S, MaxSegments> bend;
+    std::uint32_t next_point = 0;
+    bool with_gradient = false;
+  };
+
+  Status begin_evaluation(const JointVector<S, MaxSegments>& bend, Evaluation& evaluation,
+                          bool with_gradient = false) const {
+    if (!bound() || bend.size() != input_dims_) return Status::correction_failed;
+    kernel_coordinates(bend, evaluation.z);
+    for (auto& sum : evaluation.sums) sum = Accumulator{};
+    for (auto& row : evaluation.weighted) {
+      for (auto& value : row) value = S(0);
+    }
+    evaluation.bend = bend;
+    evaluation.next_point = 0;
+    evaluation.with_gradient = with_gradient;
+    return Status::ok;
+  }
+
+  // Adds training points worth at most max_units, in whole blocks (chunks
+  // with the gradient; the ragged end only together with the rest); returns
+  // the units spent, 0 when not even one block fits.
+  std::uint32_t continue_evaluation(Evaluation& evaluation, std::uint32_t max_units) const {
+    const std::uint32_t unit = evaluation.with_gradient ? kGradientPointUnits : 1;
+    const std::uint32_t granule = evaluation.with_gradient ? kChunkPoints : kBlockPoints;
+    const std::uint32_t left = training_points_ - evaluation.next_point;
+    const std::uint32_t affordable = max_units / unit;
+    std::uint32_t count = left;
+    if (affordable < left) {
+      count = affordable / granule * granule;
+      if (count == 0) return 0;
+    }
+    with_input_count([&](auto dims) {
+      constexpr int kDims = decltype(dims)::value;
+      if (evaluation.with_gradient) {
+        accumulate_mean_and_gradient<kDims>(evaluation.z, evaluation.next_point, count, evaluation.sums,
+                                            evaluation.weighted);
+      } else {
+        accumulate_mean<kDims>(evaluation.z, evaluation.next_point, count, evaluation.sums);
+      }
+    });
+    evaluation.next_point += count;
+    return count * unit;
+  }
+
+  bool evaluation_finished(const Evaluation& evaluation) const {
+    return evaluation.next_point >= training_points_;
+  }
+  bool evaluation_has_gradient(const Evaluation& evaluation) const { return evaluation.with_gradient; }
+
+  Twist<S> evaluation_result(const Evaluation& evaluation) const { return outputs(evaluation.sums); }
+
+  // eps and, for an evaluation with the gradient, d(eps)/d(bend) (6 x D).
+  void evaluation_result(const Evaluation& evaluation, Twist<S>& eps, Jacobian<S, MaxSegments>& d_eps_d_bend) const {
+    eps = outputs(evaluation.sums);
+    const int dims = input_dims_;
+    d_eps_d_bend.setZero(6, dims);
+    if (!evaluation.with_gradient) return;
     // d/dz of sum_i alpha_ik r_i = sum_i alpha_ik r_i (z_i - z)
     //                            = sum_i alpha_ik r_i z_i - z sum_i alpha_ik r_i.
     // The first sum is `weighted`; the second is the mean's own sum. The
     // gradient only steers the IK iteration, so S sums are enough for it.
-    S weighted[kImageOutputs][kMaxInputs] = {};
-    with_input_count([&](auto dims) { accumulate_mean_and_gradient<decltype(dims)::value>(z, sums, weighted); });
-    const int dims = input_dims_;
-    S dz[kImageOutputs][kMaxInputs];
-    for (int k = 0; k < kImageOutputs; ++k) {
-      const S total = value_of(sums[k]);
-      for (int d = 0; d < dims; ++d) dz[k][d] = weighted[k][d] - z[d] * total;
-    }
-    eps = outputs(sums);
     // Chain rule: eps_k = mean_k + gain_k sum(...), z_d = (x_d - mean_d) gain_d,
     // and x = encode(bend) block by block.
     Eigen::Matrix<S, kImageOutputs, Eigen::Dynamic, Eigen::ColMajor, kImageOutputs, kMaxInputs> scaled(kImageOutputs,
                                                                                                       dims);
     for (int k = 0; k < kImageOutputs; ++k) {
-      for (int d = 0; d < dims; ++d) scaled(k, d) = dz[k][d] * output_gain_[k] * input_gain_[d];
+      const S total = value_of(evaluation.sums[k]);
+      for (int d = 0; d < dims; ++d) {
+        scaled(k, d) = (evaluation.weighted[k][d] - evaluation.z[d] * total) * output_gain_[k] * input_gain_[d];
+      }
     }
-    d_eps_d_bend.setZero(6, dims);
     for (int s = 0; s < dims / 2; ++s) {
-      const Eigen::Matrix<S, 2, 2> jacobian = encoding_jacobian_block<S>(encoding_, bend.template segment<2>(2 * s));
+      const Eigen::Matrix<S, 2, 2> jacobian =
+          encoding_jacobian_block<S>(encoding_, evaluation.bend.template segment<2>(2 * s));
       d_eps_d_bend.template middleCols<2>(2 * s) = scaled.template middleCols<2>(2 * s) * jacobian;
     }
   }
@@ -229,16 +304,18 @@ class GpCorrection {
   // into the accumulator, which keeps the accumulator's cost (a conversion to
   // double, or a compensated sum) out of the per-point work; a block's float
   // sum loses no more than a few ulp of its largest terms.
+  // Points [first, first + count): first is a multiple of kBlockPoints, and
+  // count is too unless the range ends at the last point.
   template <int Dims>
-  void accumulate_mean(const S* z, Accumulator* sums) const {
+  void accumulate_mean(const S* z, std::uint32_t first, std::uint32_t count, Accumulator* sums) const {
     const int dims = Dims > 0 ? Dims : input_dims_;
     // A copy the loop owns: through `z` GCC reloads the query on the
     // Cortex-M4F (about 700 instructions more per call, measured).
     S query[kMaxInputs];
     for (int d = 0; d < dims; ++d) query[d] = z[d];
-    const float* zi = inputs_;
-    const float* a = alpha_;
-    const std::uint32_t full_blocks = training_points_ / kBlockPoints;
+    const float* zi = inputs_ + std::size_t(first) * std::size_t(dims);
+    const float* a = alpha_ + std::size_t(first) * kImageOutputs;
+    const std::uint32_t full_blocks = count / kBlockPoints;
 #if defined(CDCR_GP_MEAN_FPV5)
     if constexpr (Dims == 8 && std::is_same_v<S, float> && std::is_same_v<Accumulator, double> &&
                   kBlockPoints == detail::kFpv5BlockPoints) {
@@ -250,10 +327,9 @@ class GpCorrection {
       for (std::uint32_t j = 0; j < kBlockPoints; ++j) add_point<Dims>(query, dims, zi, a, block);
       for (int k = 0; k < kImageOutputs; ++k) accumulate(sums[k], block[k]);
     }
+    if (full_blocks * kBlockPoints == count) return;
     S rest[kImageOutputs] = {};
-    for (std::uint32_t i = full_blocks * kBlockPoints; i < training_points_; ++i) {
-      add_point<Dims>(query, dims, zi, a, rest);
-    }
+    for (std::uint32_t i = full_blocks * kBlockPoints; i < count; ++i) add_point<Dims>(query, dims, zi, a, rest);
     for (int k = 0; k < kImageOutputs; ++k) accumulate(sums[k], rest[k]);
   }
 
@@ -295,15 +371,16 @@ class GpCorrection {
   // training points: one pass computes the chunk's kernel values and the
   // mean's terms (add_point), then one pass per pair of outputs adds
   // alpha_ik r_i z_i for both, so that a pair's 2 D sums stay in registers.
+  // Points [first, first + points): first is a multiple of kChunkPoints.
   template <int Dims>
-  void accumulate_mean_and_gradient(const S* query, Accumulator* sums,
+  void accumulate_mean_and_gradient(const S* query, std::uint32_t first, std::uint32_t points, Accumulator* sums,
                                     S (&weighted)[kImageOutputs][kMaxInputs]) const {
-    static constexpr std::uint32_t kChunkPoints = 8 * kBlockPoints;
     const int dims = Dims > 0 ? Dims : input_dims_;
-    const float* zi = inputs_;
-    const float* a = alpha_;
-    for (std::uint32_t begin = 0; begin < training_points_; begin += kChunkPoints) {
-      const std::uint32_t count = training_points_ - begin < kChunkPoints ? training_points_ - begin : kChunkPoints;
+    const float* zi = inputs_ + std::size_t(first) * std::size_t(dims);
+    const float* a = alpha_ + std::size_t(first) * kImageOutputs;
+    const std::uint32_t end_point = first + points;
+    for (std::uint32_t begin = first; begin < end_point; begin += kChunkPoints) {
+      const std::uint32_t count = end_point - begin < kChunkPoints ? end_point - begin : kChunkPoints;
       const float* chunk_inputs = zi;
       const float* chunk_alpha = a;
       S r[kChunkPoints];

@@ -1,0 +1,753 @@
+#pragma once
+// Inverse kinematics as a resumable solver: a target pose (or position) to
+// joint variables, in slices of bounded work, with the whole state inside
+// the object so that it can live in static memory and continue over as many
+// fixed-rate cycles as a solve needs.
+//
+// Method: a fixed point on the corrected target, accelerated by secant
+// updates of the correction's slope.
+//   * The compensated model is T_c(b) = exp(eps(b)) T(b): nominal kinematics
+//     T and a correction eps (the GP mean of the tip error twist) of the bend
+//     vector b. eps is the expensive part: one evaluation is a pass over
+//     every training point. Its analytic gradient costs several passes more.
+//   * Each outer iteration evaluates eps once, at the current point b_k
+//     (sliced: an evaluation may span several cycles), and checks the
+//     compensated residual there: that is the convergence test, on the exact
+//     model.
+//   * Between evaluations, a damped least-squares (Levenberg-Marquardt)
+//     iteration solves the cheap linearised model
+//         exp(eps_k + E (b - b_k)) T(b) = target
+//     with the analytic nominal Jacobian. E (6 x D) is the correction's
+//     slope: its analytic gradient where one was evaluated, updated by
+//     Broyden's secant rule from the evaluations made since. With E = 0 this
+//     is the plain fixed point b = IK_nominal(exp(-eps_k) target).
+//   * The gradient costs a few mean evaluations (kGradientPointUnits per
+//     training point for the GP), so it is evaluated only where the slope is
+//     unknown (a cold start) or where the last outer iteration contracted
+//     the residual poorly (the secant slope has gone stale); the next
+//     evaluation then computes the mean and the gradient in one pass.
+//   * E survives from one target to the next, so a target streamed along a
+//     path starts with the slope known and usually needs one mean evaluation.
+//   * The limit theta_i <= theta_max is a disc in each segment's bend plane.
+//     A segment that a step would carry outside joins the active set: it then
+//     moves only along the limit circle (one tangential coordinate), and it
+//     leaves the set when the cost's descent direction points back inside.
+//     Steps are never projected, so a solution on the limit is reached at the
+//     LM rate instead of crawling along the boundary.
+//   * A start that stalls (the outer residual stops decreasing, or the LM
+//     damping blows up away from the target) is restarted from the next
+//     start in a fixed list, up to a bound.
+//
+// Work is counted in units: one unit is one training point of a correction
+// evaluation; a nominal LM iteration and the outer bookkeeping cost the
+// fixed number of units in IkWorkCosts. run(budget) does whole steps while
+// their cost fits in what is left of the budget and returns what it spent, so
+// a caller bounds a cycle's IK work by the budget it passes.
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <type_traits>
+#include <utility>
+
+#include <Eigen/Cholesky>
+
+#include "cdcr/model/chain.hpp"
+#include "cdcr/model/geometry.hpp"
+#include "cdcr/model/se3.hpp"
+#include "cdcr/model/status.hpp"
+#include "cdcr/model/types.hpp"
+
+namespace cdcr::model {
+
+enum class IkTargetKind : std::uint8_t { position, pose };
+
+enum class IkSolveState : std::uint8_t {
+  idle,           // no target
+  running,        // work left; call run() again
+  converged,      // tolerance reached on the compensated model
+  not_converged,  // a bound was reached first; best() holds the best point found
+  failed,         // the model refused an input (see status())
+};
+
+template <typename S>
+struct IkSolverOptions {
+  S position_tolerance_mm = std::is_same_v<S, float> ? S(2e-3) : S(1e-9);
+  S orientation_tolerance_rad = std::is_same_v<S, float> ? S(2e-5) : S(1e-11);
+  // Converts the orientation residual to millimetres so that one step weighs
+  // both parts; zero means the mean backbone length (1 rad of bend moves a
+  // segment tip by about that much).
+  S orientation_weight_mm_per_rad = S(0);
+  S initial_damping = S(1e-3);
+  // Correction evaluations per solve (each is one outer iteration).
+  int max_corrections = 40;
+  // Nominal LM iterations per solve, over all outer iterations and restarts.
+  int max_iterations = 400;
+  // Nominal LM iterations between two correction evaluations.
+  int max_inner_iterations = 12;
+  // Starts after the first one, when a start stalls further than
+  // restart_above_mm from the target.
+  int max_restarts = 3;
+  S restart_above_mm = S(1);
+  // Learn the correction's slope from the evaluations (Broyden).
+  bool secant_updates = true;
+  // Evaluate the correction's gradient (when it offers one) at a cold start
+  // and after an outer iteration whose squared residual fell by less than
+  // this factor. Zero: never (the fixed point with secant updates only).
+  S gradient_refresh_ratio = S(0.1);
+};
+
+// What run() charges for each kind of step, in units of one training point
+// of a correction evaluation. Firmware builds measure these on their core.
+struct IkWorkCosts {
+  std::uint32_t nominal_iteration = 160;
+  std::uint32_t outer_step = 60;
+};
+
+// Corrections the solver can evaluate in slices. A correction type provides
+//   using Evaluation = ...;   // the state of one evaluation in progress
+//   Status begin_evaluation(const JointVector<S, Max>& bend, Evaluation&, bool with_gradient) const;
+//   std::uint32_t continue_evaluation(Evaluation&, std::uint32_t max_units) const;  // units spent
+//   bool evaluation_finished(const Evaluation&) const;
+//   bool evaluation_has_gradient(const Evaluation&) const;
+//   void evaluation_result(const Evaluation&, Twist<S>& eps, Jacobian<S, Max>& d_eps_d_bend) const;
+// (GpCorrection does: a unit is a training point of the mean.) Any other
+// correction callable as Status(bend, eps, d_eps_d_bend) (with a gradient),
+// or offering Status value(bend, eps) (without), is evaluated whole, as one
+// unit.
+template <typename Correction, typename = void>
+struct is_sliced_correction : std::false_type {};
+template <typename Correction>
+struct is_sliced_correction<Correction, std::void_t<typename Correction::Evaluation>> : std::true_type {};
+
+// The identity correction: the nominal model.
+struct NoCorrection {
+  template <typename Bend, typename S>
+  Status value(const Bend&, Twist<S>& eps) const {
+    eps.setZero();
+    return Status::ok;
+  }
+};
+
+namespace detail {
+
+template <typename Correction, typename Bend, typename TwistType, typename = void>
+struct has_value_only : std::false_type {};
+template <typename Correction, typename Bend, typename TwistType>
+struct has_value_only<Correction, Bend, TwistType,
+                      std::void_t<decltype(std::declval<const Correction&>().value(std::declval<const Bend&>(),
+                                                                                   std::declval<TwistType&>()))>>
+    : std::true_type {};
+
+template <typename Correction, typename Bend, typename TwistType, typename DerivativeType, typename = void>
+struct has_gradient : std::false_type {};
+template <typename Correction, typename Bend, typename TwistType, typename DerivativeType>
+struct has_gradient<Correction, Bend, TwistType, DerivativeType,
+                    std::void_t<decltype(std::declval<const Correction&>()(std::declval<const Bend&>(),
+                                                                           std::declval<TwistType&>(),
+                                                                           std::declval<DerivativeType&>()))>>
+    : std::true_type {};
+
+// Adapts a correction that is evaluated in one call to the sliced interface.
+template <typename S, int Max, typename Correction>
+struct WholeEvaluation {
+  static constexpr bool kHasGradient = has_gradient<Correction, JointVector<S, Max>, Twist<S>, Jacobian<S, Max>>::value;
+  const Correction* correction = nullptr;
+
+  struct Evaluation {
+    JointVector<S, Max> bend;
+    Twist<S> eps = Twist<S>::Zero();
+    Jacobian<S, Max> d_eps;
+    bool finished = false;
+    bool with_gradient = false;
+  };
+
+  Status begin_evaluation(const JointVector<S, Max>& bend, Evaluation& evaluation, bool with_gradient) const {
+    evaluation.bend = bend;
+    evaluation.finished = false;
+    evaluation.with_gradient = with_gradient && kHasGradient;
+    return Status::ok;
+  }
+  Status finish(Evaluation& evaluation) const {
+    evaluation.finished = true;
+    evaluation.d_eps.setZero(6, evaluation.bend.size());
+    if constexpr (kHasGradient) {
+      if (evaluation.with_gradient || !has_value_only<Correction, JointVector<S, Max>, Twist<S>>::value) {
+        const Status s = (*correction)(evaluation.bend, evaluation.eps, evaluation.d_eps);
+        if (s == Status::ok && evaluation.d_eps.cols() != evaluation.bend.size()) return Status::correction_failed;
+        return s;
+      }
+    }
+    if constexpr (has_value_only<Correction, JointVector<S, Max>, Twist<S>>::value) {
+      return correction->value(evaluation.bend, evaluation.eps);
+    } else {
+      return Status::correction_failed;
+    }
+  }
+  bool evaluation_finished(const Evaluation& evaluation) const { return evaluation.finished; }
+  bool evaluation_has_gradient(const Evaluation& evaluation) const { return evaluation.with_gradient; }
+  void evaluation_result(const Evaluation& evaluation, Twist<S>& eps, Jacobian<S, Max>& d_eps) const {
+    eps = evaluation.eps;
+    d_eps = evaluation.d_eps;
+  }
+};
+
+}  // namespace detail
+
+template <typename S, int Max, typename Correction = NoCorrection>
+class IkSolver {
+  static constexpr bool kSliced = is_sliced_correction<Correction>::value;
+  using Evaluator = std::conditional_t<kSliced, Correction, detail::WholeEvaluation<S, Max, Correction>>;
+
+ public:
+  using Joints = JointVector<S, Max>;
+  using Residual = Eigen::Matrix<S, 6, 1>;
+  static constexpr int kMaxColumns = 2 * Max;
+  // Secant steps shorter than this (rad of bend) are not learned from.
+  static constexpr S kMinSecantStep = std::is_same_v<S, float> ? S(1e-4) : S(1e-8);
+
+  IkSolver() = default;
+  IkSolver(const IkSolver&) = delete;
+  IkSolver& operator=(const IkSolver&) = delete;
+
+  // Binds the geometry and the correction (both must outlive the solver) and
+  // forgets every target and the learned slope.
+  void configure(const RobotGeometry<S, Max>& geometry, const Correction& correction,
+                 const IkSolverOptions<S>& options = {}, const IkWorkCosts& costs = {}) {
+    geometry_ = &geometry;
+    if constexpr (kSliced) {
+      evaluator_ = &correction;
+    } else {
+      whole_.correction = &correction;
+      evaluator_ = &whole_;
+    }
+    options_ = options;
+    costs_ = costs;
+    weight_ = options.orientation_weight_mm_per_rad;
+    if (!(weight_ > S(0))) {
+      weight_ = S(0);
+      for (int i = 0; i < geometry.segment_count; ++i) weight_ += geometry.segments[i].backbone_length_mm;
+      weight_ /= S(geometry.segment_count);
+    }
+    state_ = IkSolveState::idle;
+    slope_known_ = false;
+    have_warm_start_ = false;
+  }
+
+  // Starts a solve, abandoning any running one, from initial_joints ((alpha,
+  // theta) pairs within the limits) with no knowledge of the correction.
+  Status start(const Pose<S>& target, IkTargetKind kind, const Joints& initial_joints) {
+    if (const Status s = reset(target, kind); s != Status::ok) return s;
+    if (const Status s = check_joints(initial_joints, *geometry_); s != Status::ok) return fail(s);
+    slope_known_ = false;
+    const Joints bend = bend_from_joints(initial_joints);
+    best_bend_ = bend;
+    state_ = IkSolveState::running;
+    begin_outer(bend);
+    return status_;
+  }
+
+  // Starts a solve from the best point of the previous one (a target near
+  // the last, as along a streamed path): the correction there is known, and
+  // the slope learned so far is kept. Without a previous point, as start().
+  Status start_warm(const Pose<S>& target, IkTargetKind kind, const Joints& fallback_joints) {
+    if (!have_warm_start_ || warm_bend_.size() != 2 * geometry_->segment_count) {
+      return start(target, kind, fallback_joints);
+    }
+    if (const Status s = reset(target, kind); s != Status::ok) return s;
+    best_bend_ = warm_bend_;
+    point_ = warm_bend_;
+    point_eps_ = warm_eps_;
+    point_has_gradient_ = false;
+    state_ = IkSolveState::running;
+    phase_ = Phase::outer_step;
+    return status_;
+  }
+
+  // Does whole steps while their cost fits in `budget` units; returns the
+  // units spent (0 when nothing fits or nothing is left to do). A correction
+  // evaluation is sliced to fit; a nominal iteration runs only when its whole
+  // cost fits.
+  std::uint32_t run(std::uint32_t budget) {
+    std::uint32_t spent = 0;
+    while (state_ == IkSolveState::running) {
+      const std::uint32_t left = budget - spent;
+      if (phase_ == Phase::evaluate) {
+        if (left == 0) break;
+        const std::uint32_t used = continue_correction(left);
+        spent += used;
+        if (state_ != IkSolveState::running) break;
+        if (!evaluator_->evaluation_finished(evaluation_)) {
+          if (used == 0) break;  // the next slice does not fit
+          continue;
+        }
+        point_has_gradient_ = evaluator_->evaluation_has_gradient(evaluation_);
+        evaluator_->evaluation_result(evaluation_, point_eps_, point_gradient_);
+        ++corrections_;
+        phase_ = Phase::outer_step;
+        continue;
+      }
+      if (phase_ == Phase::outer_step) {
+        if (left < costs_.outer_step) break;
+        spent += costs_.outer_step;
+        outer_step();
+        continue;
+      }
+      // Phase::inner
+      if (left < costs_.nominal_iteration) break;
+      spent += costs_.nominal_iteration;
+      inner_iteration();
+    }
+    units_spent_ += spent;
+    return spent;
+  }
+
+  // Runs to the end with no budget: for callers off the fixed-rate cycle.
+  IkSolveState run_to_end() {
+    while (state_ == IkSolveState::running) run(std::numeric_limits<std::uint32_t>::max() / 2);
+    return state_;
+  }
+
+  IkSolveState state() const { return state_; }
+  Status status() const { return status_; }
+  IkTargetKind kind() const { return kind_; }
+  const Pose<S>& target() const { return target_; }
+  // Correction evaluations and nominal LM iterations spent on this target.
+  int corrections() const { return corrections_; }
+  int iterations() const { return iterations_; }
+  int restarts() const { return restarts_; }
+  // Units run() has spent on this target.
+  std::uint64_t units_spent() const { return units_spent_; }
+  bool has_best() const { return best_cost_ < std::numeric_limits<S>::infinity(); }
+  // The best point whose compensated residual has been evaluated exactly,
+  // as (alpha, theta) pairs, and its residual.
+  Joints best_joints() const {
+    Joints joints = joints_from_bend(best_bend_);
+    for (int i = 0; i < geometry_->segment_count; ++i) {
+      // A point on the limit circle can sit one rounding step outside it.
+      joints[2 * i + 1] = std::min(joints[2 * i + 1], geometry_->segments[i].theta_max_rad);
+    }
+    return joints;
+  }
+  S best_position_error_mm() const { return best_position_error_; }
+  const Joints& best_bend() const { return best_bend_; }
+  S best_orientation_error_rad() const { return best_orientation_error_; }
+
+ private:
+  enum class Phase : std::uint8_t { evaluate, outer_step, inner };
+
+  // Residual of the target against a tip pose: position (mm) and, for pose
+  // targets, the weighted rotation vector of R_target R^T.
+  void residual_of(const Pose<S>& tip, Residual& residual, S& position_error, S& orientation_error) const {
+    const Vec3<S> dp = target_.position_mm - tip.position_mm;
+    position_error = dp.norm();
+    residual.template head<3>() = dp;
+    if (kind_ == IkTargetKind::pose) {
+      const Vec3<S> dr = log_so3<S>(Mat3<S>(target_.rotation * tip.rotation.transpose()));
+      orientation_error = dr.norm();
+      residual.template tail<3>() = weight_ * dr;
+    } else {
+      orientation_error = S(0);
+      residual.template tail<3>().setZero();
+    }
+  }
+
+  bool within_tolerance(S position_error, S orientation_error) const {
+    return position_error <= options_.position_tolerance_mm && orientation_error <= options_.orientation_tolerance_rad;
+  }
+
+  Status reset(const Pose<S>& target, IkTargetKind kind) {
+    state_ = IkSolveState::failed;
+    status_ = Status::ok;
+    corrections_ = 0;
+    iterations_ = 0;
+    restarts_ = 0;
+    units_spent_ = 0;
+    have_previous_ = false;
+    next_with_gradient_ = false;
+    stalled_outer_ = 0;
+    best_cost_ = std::numeric_limits<S>::infinity();
+    best_position_error_ = best_orientation_error_ = std::numeric_limits<S>::infinity();
+    if (geometry_ == nullptr) return status_ = Status::invalid_geometry;
+    if (!target.all_finite()) return fail(Status::non_finite_input);
+    target_ = target;
+    kind_ = kind;
+    return Status::ok;
+  }
+
+  bool wants_gradient() const {
+    if (!(options_.gradient_refresh_ratio > S(0))) return false;
+    if constexpr (!kSliced) {
+      if (!detail::WholeEvaluation<S, Max, Correction>::kHasGradient) return false;
+    }
+    return !slope_known_ || next_with_gradient_;
+  }
+
+  void begin_outer(const Joints& bend) {
+    point_ = bend;
+    if (const Status s = evaluator_->begin_evaluation(point_, evaluation_, wants_gradient()); s != Status::ok) {
+      fail(s);
+      return;
+    }
+    phase_ = Phase::evaluate;
+  }
+
+  std::uint32_t continue_correction(std::uint32_t max_units) {
+    if constexpr (kSliced) {
+      return evaluator_->continue_evaluation(evaluation_, max_units);
+    } else {
+      (void)max_units;
+      if (const Status s = whole_.finish(evaluation_); s != Status::ok) fail(s);
+      return 1;
+    }
+  }
+
+  // The correction at point_ is known: test convergence on the compensated
+  // model, learn the slope, and set up the next linearised solve.
+  void outer_step() {
+    if (!point_eps_.allFinite()) {
+      fail(Status::correction_failed);
+      return;
+    }
+
+    const Pose<S> tip = exp(point_eps_) * forward_kinematics_bend(point_, *geometry_);
+    Residual residual;
+    S position_error = S(0);
+    S orientation_error = S(0);
+    residual_of(tip, residual, position_error, orientation_error);
+    const S cost = residual.squaredNorm();
+
+    if (point_has_gradient_) {
+      slope_ = point_gradient_;
+      slope_known_ = slope_.allFinite();
+    } else if (options_.secant_updates && have_previous_) {
+      // Secant update of the slope from the last outer point to this one;
+      // steps below the arithmetic's resolution carry only noise.
+      const Joints step = point_ - previous_point_;
+      const S step_sq = step.squaredNorm();
+      if (step_sq > kMinSecantStep * kMinSecantStep) {
+        if (!slope_known_) {
+          slope_.setZero(6, point_.size());
+          slope_known_ = true;
+        }
+        const Twist<S> predicted = previous_eps_ + slope_.lazyProduct(step);
+        slope_.noalias() += ((point_eps_ - predicted) / step_sq).lazyProduct(step.transpose());
+        if (!slope_.allFinite()) slope_known_ = false;
+      }
+    }
+
+    if (cost < best_cost_) {
+      best_cost_ = cost;
+      best_bend_ = point_;
+      best_position_error_ = position_error;
+      best_orientation_error_ = orientation_error;
+      // The next target may start here with the correction known.
+      warm_bend_ = point_;
+      warm_eps_ = point_eps_;
+      have_warm_start_ = true;
+    }
+    if (within_tolerance(position_error, orientation_error)) {
+      state_ = IkSolveState::converged;
+      return;
+    }
+    // A start stalls when the exact residual stops decreasing clearly.
+    if (have_previous_ && !(cost < S(0.9) * previous_cost_)) {
+      ++stalled_outer_;
+    } else {
+      stalled_outer_ = 0;
+    }
+    if (corrections_ >= options_.max_corrections || iterations_ >= options_.max_iterations) {
+      state_ = IkSolveState::not_converged;
+      return;
+    }
+    if (stalled_outer_ >= 2) {
+      // Close to the target a stall is the arithmetic's floor, not a bad start.
+      if (position_error <= options_.restart_above_mm || !restart()) state_ = IkSolveState::not_converged;
+      return;
+    }
+    // A stale slope shows as poor contraction: evaluate the gradient with
+    // the next mean.
+    // Near the tolerance the contraction is limited by the arithmetic, which
+    // a gradient does not improve.
+    next_with_gradient_ = have_previous_ && cost > options_.gradient_refresh_ratio * previous_cost_ &&
+                          position_error > S(20) * options_.position_tolerance_mm;
+    previous_point_ = point_;
+    previous_eps_ = point_eps_;
+    previous_cost_ = cost;
+    have_previous_ = true;
+
+    // The linearised solve starts where the exact model was just evaluated.
+    inner_bend_ = point_;
+    inner_iterations_ = 0;
+    inner_slow_steps_ = 0;
+    damping_ = options_.initial_damping;
+    for (int i = 0; i < geometry_->segment_count; ++i) active_[i] = on_limit(i, inner_bend_);
+    evaluate_inner_pose(inner_bend_, inner_tip_);
+    residual_of(inner_tip_, inner_residual_, inner_position_error_, inner_orientation_error_);
+    inner_cost_ = inner_residual_.squaredNorm();
+    rows_current_ = false;
+    if constexpr (kSliced) {
+      // Inexact solves: far from the target, the linearised model need not
+      // be solved much beyond the accuracy the next evaluation will show.
+      inner_position_goal_ = std::max(S(0.5) * options_.position_tolerance_mm, S(0.02) * position_error);
+      inner_orientation_goal_ = std::max(S(0.5) * options_.orientation_tolerance_rad, S(0.02) * orientation_error);
+    } else {
+      // An evaluation in one call is cheap: solve to the tolerance.
+      inner_position_goal_ = options_.position_tolerance_mm;
+      inner_orientation_goal_ = options_.orientation_tolerance_rad;
+    }
+    phase_ = Phase::inner;
+    if (inner_done()) finish_inner();
+  }
+
+  // A new start after a stall, from a fixed list: the straight robot with a
+  // slight bend, then bends turned a quarter and a half turn.
+  bool restart() {
+    if (restarts_ >= options_.max_restarts) return false;
+    ++restarts_;
+    Joints joints(2 * geometry_->segment_count);
+    static constexpr S kPhase[] = {S(0), S(1.5707963), S(3.1415927), S(-1.5707963)};
+    for (int i = 0; i < geometry_->segment_count; ++i) {
+      joints[2 * i] = kPhase[(restarts_ + i) % 4];
+      joints[2 * i + 1] = std::min(S(0.1) * S(restarts_), geometry_->segments[i].theta_max_rad);
+    }
+    have_previous_ = false;
+    stalled_outer_ = 0;
+    slope_known_ = false;
+    begin_outer(bend_from_joints(joints));
+    return true;
+  }
+
+  Status fail(Status status) {
+    status_ = status;
+    state_ = IkSolveState::failed;
+    return status;
+  }
+
+  bool on_limit(int segment, const Joints& bend) const {
+    const S theta = bend.template segment<2>(2 * segment).norm();
+    return theta >= geometry_->segments[segment].theta_max_rad * (S(1) - S(16) * std::numeric_limits<S>::epsilon());
+  }
+
+  // The linearised compensated model: exp(eps_k + E (b - b_k)) T(b).
+  Twist<S> linearised_eps(const Joints& bend) const {
+    Twist<S> eps = point_eps_;
+    if (slope_known_) eps.noalias() += slope_.lazyProduct(bend - point_);
+    return eps;
+  }
+
+  void evaluate_inner_pose(const Joints& bend, Pose<S>& tip) const {
+    tip = exp(linearised_eps(bend)) * forward_kinematics_bend(bend, *geometry_);
+  }
+
+  bool inner_done() const {
+    return inner_position_error_ <= inner_position_goal_ && inner_orientation_error_ <= inner_orientation_goal_;
+  }
+
+  void finish_inner() { begin_outer(inner_bend_); }
+
+  // One LM iteration on the linearised model.
+  void inner_iteration() {
+    if (kind_ == IkTargetKind::pose) {
+      inner_iteration_rows<6>();
+    } else {
+      inner_iteration_rows<3>();
+    }
+  }
+
+  template <int Rows>
+  void inner_iteration_rows() {
+    ++iterations_;
+    ++inner_iterations_;
+    const int segments = geometry_->segment_count;
+    if (!rows_current_) {
+      Pose<S> tip;
+      Jacobian<S, Max> spatial;
+      tip_jacobian_bend(inner_bend_, *geometry_, tip, spatial);
+      const Twist<S> eps = linearised_eps(inner_bend_);
+      const Pose<S> correction_pose = exp(eps);
+      apply_adjoint(correction_pose, spatial);
+      if (slope_known_) spatial.noalias() += left_jacobian(eps).lazyProduct(slope_);
+      tip = correction_pose * tip;
+      rows_.setZero();
+      rows_.template topLeftCorner<3, kMaxColumns>().leftCols(2 * segments) =
+          spatial.template topRows<3>() - hat3<S>(tip.position_mm) * spatial.template bottomRows<3>();
+      if constexpr (Rows == 6) {
+        rows_.template bottomLeftCorner<3, kMaxColumns>().leftCols(2 * segments) =
+            weight_ * spatial.template bottomRows<3>();
+      }
+      rows_current_ = true;
+      // Segments on the limit leave the active set when descent points inside.
+      for (int i = 0; i < segments; ++i) {
+        if (!active_[i]) continue;
+        const Vec2<S> b = inner_bend_.template segment<2>(2 * i);
+        const Vec2<S> descent = rows_.template topRows<Rows>().template middleCols<2>(2 * i).transpose() *
+                                inner_residual_.template head<Rows>();
+        if (b.dot(descent) < S(0)) active_[i] = false;
+      }
+    }
+
+    Joints trial;
+    bool stepped = false;
+    // Each pass may add segments to the active set; at most one pass per segment.
+    for (int pass = 0; pass <= segments && !stepped; ++pass) {
+      trial = inner_step<Rows>();
+      stepped = true;
+      for (int i = 0; i < segments; ++i) {
+        if (active_[i]) continue;
+        const S theta = trial.template segment<2>(2 * i).norm();
+        if (theta > geometry_->segments[i].theta_max_rad) {
+          active_[i] = true;
+          stepped = false;
+        }
+      }
+    }
+    // Whatever is left outside (all passes used) goes back onto the circle.
+    for (int i = 0; i < segments; ++i) {
+      const S theta = trial.template segment<2>(2 * i).norm();
+      const S limit = geometry_->segments[i].theta_max_rad;
+      if ((active_[i] || theta > limit) && theta > S(0)) trial.template segment<2>(2 * i) *= limit / theta;
+    }
+
+    Pose<S> trial_tip;
+    evaluate_inner_pose(trial, trial_tip);
+    Residual trial_residual;
+    S trial_position_error = S(0);
+    S trial_orientation_error = S(0);
+    residual_of(trial_tip, trial_residual, trial_position_error, trial_orientation_error);
+    const S trial_cost = trial_residual.squaredNorm();
+    if (trial_cost < inner_cost_ && trial.allFinite()) {
+      // Slow progress means the linearised model's own minimum is near (it
+      // is not exact far from b_k): better spent on a new evaluation.
+      if (trial_cost > S(0.25) * inner_cost_) ++inner_slow_steps_;
+      inner_bend_ = trial;
+      inner_residual_ = trial_residual;
+      inner_cost_ = trial_cost;
+      inner_position_error_ = trial_position_error;
+      inner_orientation_error_ = trial_orientation_error;
+      rows_current_ = false;
+      damping_ = std::max(damping_ * S(0.1), std::numeric_limits<S>::epsilon());
+    } else {
+      damping_ *= S(10);
+      // A rejected step may have put segments in the active set that the
+      // accepted point does not have on its limit.
+      for (int i = 0; i < segments; ++i) active_[i] = active_[i] && on_limit(i, inner_bend_);
+    }
+
+    const bool stalled = damping_ > S(1e8);
+    if (stalled && inner_bend_ == point_ && inner_position_error_ > options_.restart_above_mm) {
+      // No step helps at all: a local minimum of the model far from the target.
+      if (!restart()) state_ = IkSolveState::not_converged;
+      return;
+    }
+    const bool give_up_inner =
+        kSliced && (inner_slow_steps_ >= 2 || inner_iterations_ >= options_.max_inner_iterations);
+    if (inner_done() || stalled || give_up_inner ||
+        iterations_ >= options_.max_iterations) {
+      finish_inner();
+    }
+  }
+
+  // The damped step on the reduced coordinates: two per free segment, one
+  // (along the limit circle) per active segment.
+  template <int Rows>
+  Joints inner_step() const {
+    const int segments = geometry_->segment_count;
+    using Reduced = Eigen::Matrix<S, Rows, Eigen::Dynamic, Eigen::RowMajor, Rows, kMaxColumns>;
+    Reduced reduced(Rows, 2 * segments);
+    Vec2<S> tangent[Max];
+    int columns = 0;
+    for (int i = 0; i < segments; ++i) {
+      const auto block = rows_.template topRows<Rows>().template middleCols<2>(2 * i);
+      if (active_[i]) {
+        const Vec2<S> b = inner_bend_.template segment<2>(2 * i);
+        const S theta = b.norm();
+        tangent[i] = theta > S(0) ? Vec2<S>(-b.y() / theta, b.x() / theta) : Vec2<S>(S(0), S(1));
+        reduced.col(columns++) = block * tangent[i];
+      } else {
+        reduced.template middleCols<2>(columns) = block;
+        columns += 2;
+      }
+    }
+    // Coefficient-wise products: Eigen's general product paths can fall back
+    // to heap workspace, which a board build must not link.
+    const auto used = reduced.leftCols(columns);
+    Eigen::Matrix<S, Rows, Rows> normal = used.lazyProduct(used.transpose());
+    const S scale = normal.trace() / S(Rows);
+    normal.diagonal().array() += damping_ * scale + std::numeric_limits<S>::min();
+    const Eigen::Matrix<S, Rows, 1> y = normal.ldlt().solve(inner_residual_.template head<Rows>());
+    Eigen::Matrix<S, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxColumns, 1> step = used.transpose().lazyProduct(y);
+
+    Joints trial = inner_bend_;
+    columns = 0;
+    for (int i = 0; i < segments; ++i) {
+      if (active_[i]) {
+        trial.template segment<2>(2 * i) += step[columns++] * tangent[i];
+      } else {
+        trial.template segment<2>(2 * i) += step.template segment<2>(columns);
+        columns += 2;
+      }
+    }
+    return trial;
+  }
+
+  const RobotGeometry<S, Max>* geometry_ = nullptr;
+  const Evaluator* evaluator_ = nullptr;
+  detail::WholeEvaluation<S, Max, Correction> whole_{};
+  IkSolverOptions<S> options_{};
+  IkWorkCosts costs_{};
+  S weight_ = S(1);
+
+  IkSolveState state_ = IkSolveState::idle;
+  Status status_ = Status::ok;
+  Phase phase_ = Phase::evaluate;
+  Pose<S> target_{};
+  IkTargetKind kind_ = IkTargetKind::pose;
+  int corrections_ = 0;
+  int iterations_ = 0;
+  int restarts_ = 0;
+  std::uint64_t units_spent_ = 0;
+
+  // The outer iteration: the point where the exact correction is (being)
+  // evaluated, the previous one, and the learned slope.
+  typename Evaluator::Evaluation evaluation_{};
+  Joints point_;
+  Twist<S> point_eps_ = Twist<S>::Zero();
+  Jacobian<S, Max> point_gradient_;
+  bool point_has_gradient_ = false;
+  bool next_with_gradient_ = false;
+  Joints previous_point_;
+  Twist<S> previous_eps_ = Twist<S>::Zero();
+  S previous_cost_ = S(0);
+  bool have_previous_ = false;
+  int stalled_outer_ = 0;
+  Jacobian<S, Max> slope_;
+  bool slope_known_ = false;
+  Joints warm_bend_;
+  Twist<S> warm_eps_ = Twist<S>::Zero();
+  bool have_warm_start_ = false;
+
+  Joints best_bend_;
+  S best_cost_ = std::numeric_limits<S>::infinity();
+  S best_position_error_ = std::numeric_limits<S>::infinity();
+  S best_orientation_error_ = std::numeric_limits<S>::infinity();
+
+  // The linearised solve between two evaluations.
+  Joints inner_bend_;
+  Pose<S> inner_tip_{};
+  Residual inner_residual_ = Residual::Zero();
+  S inner_cost_ = S(0);
+  S inner_position_error_ = S(0);
+  S inner_orientation_error_ = S(0);
+  S inner_position_goal_ = S(0);
+  S inner_orientation_goal_ = S(0);
+  S damping_ = S(1e-3);
+  int inner_iterations_ = 0;
+  int inner_slow_steps_ = 0;
+  bool rows_current_ = false;
+  bool active_[Max] = {};
+  Eigen::Matrix<S, 6, kMaxColumns, Eigen::RowMajor> rows_ = Eigen::Matrix<S, 6, kMaxColumns, Eigen::RowMajor>::Zero();
+};
+
+}  // namespace cdcr::model
