@@ -1,0 +1,185 @@
+// The resumable IK solver: a GP evaluation in slices has the bits of a
+// whole one, the work a call does never exceeds its budget, and the result
+// does not depend on how the work is sliced over calls (cycles).
+
+#include <cstdint>
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cdcr/model/compensated_kinematics.hpp"
+#include "cdcr/model/gp_correction.hpp"
+#include "cdcr/model/ik_solver.hpp"
+#include "export/image_writer.hpp"
+
+#include "../support/synthetic_trained_model.hpp"
+
+namespace cdcr::model {
+namespace {
+
+using Correction = GpCorrection<float, double, kMaxSegments>;
+
+struct Fixture {
+  std::vector<std::uint8_t> image;
+  ImageView view{};
+  RobotGeometry<float> geometry;
+  Correction correction;
+};
+
+// A model of several blocks and gradient chunks with a ragged end, its
+// correction scaled to the size a trained model has (millimetres).
+void make(Fixture& f, int training_points) {
+  test_support::SyntheticModelOptions options;
+  options.segments = 4;
+  options.training_points = training_points;
+  training::TrainedModel m = test_support::synthetic_trained_model(options);
+  for (int k = 0; k < 6; ++k) {
+    m.output_mean[k] *= k < 3 ? 0.5 : 0.002;
+    m.output_scale[k] *= k < 3 ? 0.5 : 0.002;
+  }
+  f.image = exporting::write_image(m);
+  ImageCapacity capacity;
+  capacity.max_training_points = 4096;
+  ASSERT_EQ(parse_image(f.image.data(), f.image.size(), f.view, capacity), ImageStatus::ok);
+  ASSERT_EQ(geometry_from_image(f.view, f.geometry), Status::ok);
+  ASSERT_EQ(f.correction.bind(f.view), Status::ok);
+}
+
+JointVector<float> random_joints(std::mt19937& rng, int segments, double theta_max) {
+  std::uniform_real_distribution<double> alpha(-3.1, 3.1), theta(0.0, theta_max);
+  JointVector<float> q(2 * segments);
+  for (int s = 0; s < segments; ++s) {
+    q[2 * s] = float(alpha(rng));
+    q[2 * s + 1] = float(theta(rng));
+  }
+  return q;
+}
+
+TEST(IkSolver, SlicedEvaluationHasTheBitsOfAWholeOne) {
+  Fixture f;
+  make(f, 203);
+  std::mt19937 rng(5);
+  for (int trial = 0; trial < 10; ++trial) {
+    const JointVector<float> bend = bend_from_joints(random_joints(rng, 4, 0.5));
+    for (const bool with_gradient : {false, true}) {
+      Correction::Evaluation whole, sliced;
+      ASSERT_EQ(f.correction.begin_evaluation(bend, whole, with_gradient), Status::ok);
+      ASSERT_EQ(f.correction.begin_evaluation(bend, sliced, with_gradient), Status::ok);
+      EXPECT_EQ(f.correction.continue_evaluation(whole, 1u << 20),
+                203u * (with_gradient ? Correction::kGradientPointUnits : 1u));
+      int slices = 0;
+      const std::uint32_t budget = with_gradient ? 200 : 20;
+      while (!f.correction.evaluation_finished(sliced)) {
+        const std::uint32_t spent = f.correction.continue_evaluation(sliced, budget);
+        ASSERT_LE(spent, budget);
+        ASSERT_GT(spent, 0u);
+        ++slices;
+      }
+      EXPECT_GT(slices, 2);
+      Twist<float> a, b;
+      Jacobian<float> da, db;
+      f.correction.evaluation_result(whole, a, da);
+      f.correction.evaluation_result(sliced, b, db);
+      for (int k = 0; k < 6; ++k) EXPECT_EQ(a[k], b[k]);
+      EXPECT_TRUE(da == db);
+      if (!with_gradient) {
+        const Twist<float> predicted = f.correction.predict(bend);
+        for (int k = 0; k < 6; ++k) EXPECT_EQ(a[k], predicted[k]);
+      }
+    }
+  }
+}
+
+// Solves the same targets once without a budget and once in cycles of a
+// small budget: identical iterates, so identical results, and no call over
+// its budget.
+TEST(IkSolver, ResultDoesNotDependOnTheBudgetAndNoCallExceedsIt) {
+  Fixture f;
+  make(f, 203);
+  std::mt19937 rng(11);
+  static IkSolver<float, kMaxSegments, Correction> whole, sliced;
+  whole.configure(f.geometry, f.correction);
+  sliced.configure(f.geometry, f.correction);
+  const JointVector<float> start = random_joints(rng, 4, 0.1);
+  int converged = 0;
+  for (int trial = 0; trial < 30; ++trial) {
+    const JointVector<float> q = random_joints(rng, 4, 0.3);
+    const JointVector<float> b = bend_from_joints(q);
+    const Pose<float> target = exp(f.correction.predict(b)) * forward_kinematics_bend(b, f.geometry);
+    const IkTargetKind kind = trial % 3 == 0 ? IkTargetKind::position : IkTargetKind::pose;
+    ASSERT_EQ(whole.start(target, kind, start), Status::ok);
+    ASSERT_EQ(sliced.start(target, kind, start), Status::ok);
+    whole.run_to_end();
+    const std::uint32_t budget = 300;
+    int calls = 0;
+    while (sliced.state() == IkSolveState::running) {
+      ASSERT_LE(sliced.run(budget), budget);
+      ASSERT_LT(++calls, 100000);
+    }
+    EXPECT_GT(calls, 1);
+    EXPECT_EQ(whole.state(), sliced.state());
+    EXPECT_EQ(whole.iterations(), sliced.iterations());
+    EXPECT_EQ(whole.corrections(), sliced.corrections());
+    EXPECT_TRUE(whole.best_bend() == sliced.best_bend());
+    EXPECT_EQ(whole.units_spent(), sliced.units_spent());
+    if (whole.state() == IkSolveState::converged) {
+      ++converged;
+      // Independently: the compensated model at the answer, in double.
+      const JointVector<float> answer = sliced.best_joints();
+      const Pose<float> tip = exp(f.correction.predict(bend_from_joints(answer))) *
+                              forward_kinematics_bend(JointVector<float>(bend_from_joints(answer)), f.geometry);
+      EXPECT_LE((tip.position_mm - target.position_mm).norm(), 5e-3f);
+    }
+  }
+  EXPECT_GE(converged, 27);
+}
+
+// A budget smaller than one block or one nominal iteration does nothing,
+// and a solve still ends once the budget allows.
+TEST(IkSolver, TooSmallABudgetDoesNothing) {
+  Fixture f;
+  make(f, 64);
+  static IkSolver<float, kMaxSegments, Correction> solver;
+  solver.configure(f.geometry, f.correction);
+  std::mt19937 rng(3);
+  const JointVector<float> q = random_joints(rng, 4, 0.2);
+  const Pose<float> target = forward_kinematics_bend(JointVector<float>(bend_from_joints(q)), f.geometry);
+  ASSERT_EQ(solver.start(target, IkTargetKind::pose, random_joints(rng, 4, 0.1)), Status::ok);
+  EXPECT_EQ(solver.run(Correction::kBlockPoints * Correction::kGradientPointUnits - 1), 0u);
+  EXPECT_EQ(solver.state(), IkSolveState::running);
+  EXPECT_EQ(solver.run_to_end(), IkSolveState::converged);
+}
+
+// Warm starts along a path reuse the last point's correction and slope: a
+// small step needs few evaluations.
+TEST(IkSolver, WarmStartsAlongAPathNeedFewEvaluations) {
+  Fixture f;
+  make(f, 203);
+  static IkSolver<float, kMaxSegments, Correction> solver;
+  solver.configure(f.geometry, f.correction);
+  JointVector<float> q(8);
+  for (int s = 0; s < 4; ++s) {
+    q[2 * s] = 0.5f * float(s);
+    q[2 * s + 1] = 0.15f;
+  }
+  const auto target_at = [&](double t) {
+    JointVector<float> p = q;
+    for (int s = 0; s < 4; ++s) p[2 * s] += float(0.2 * t);
+    const JointVector<float> b = bend_from_joints(p);
+    return Pose<float>(exp(f.correction.predict(b)) * forward_kinematics_bend(b, f.geometry));
+  };
+  ASSERT_EQ(solver.start(target_at(0), IkTargetKind::pose, q), Status::ok);
+  ASSERT_EQ(solver.run_to_end(), IkSolveState::converged);
+  int evaluations = 0;
+  for (int step = 1; step <= 50; ++step) {
+    ASSERT_EQ(solver.start_warm(target_at(step * 0.002), IkTargetKind::pose, q), Status::ok);
+    solver.run_to_end();
+    EXPECT_LE(solver.best_position_error_mm(), 0.01f) << step;
+    evaluations += solver.corrections();
+  }
+  EXPECT_LE(evaluations, 50 * 3);
+}
+
+}  // namespace
+}  // namespace cdcr::model
