@@ -8,22 +8,14 @@ namespace cdcr::firmware {
 
 namespace {
 
-std::uint16_t saturate_u16(std::int64_t value) {
-  if (value < 0) return 0;
-  return value > 0xFFFF ? 0xFFFF : static_cast<std::uint16_t>(value);
-}
-
 std::int64_t to_us(std::int64_t ns) { return (ns + 500) / 1000; }
 
 // Hamilton quaternion, w first, with w >= 0 so each rotation has one encoding.
-void quaternion_of(const model::Mat3<Scalar>& rotation, double (&q)[4]) {
+protocol::PoseOrientation orientation_frame(const model::Mat3<Scalar>& rotation) {
   Eigen::Quaternion<Scalar> quaternion(rotation);
   quaternion.normalize();
   const double sign = quaternion.w() < 0 ? -1.0 : 1.0;
-  q[0] = sign * quaternion.w();
-  q[1] = sign * quaternion.x();
-  q[2] = sign * quaternion.y();
-  q[3] = sign * quaternion.z();
+  return {sign * quaternion.w(), sign * quaternion.x(), sign * quaternion.y(), sign * quaternion.z()};
 }
 
 // Console lines built without printf: newlib's formatted output allocates,
@@ -60,12 +52,9 @@ Runtime::Runtime(const hal::Hal& hal, const Geometry& fallback_geometry)
 
 RuntimeState Runtime::init() {
   state_ = RuntimeState::boot;
-  static constexpr hal::CanFilter kFilters[] = {
-      {protocol::kCableFeedbackBaseId, 0x7F8},  // 0x100..0x107
-      {protocol::kTargetOrientationId, 0x7FC},  // 0x120..0x123
-  };
+  static constexpr hal::CanFilter kFilters[] = {protocol::kCableFeedbackFrames, protocol::kTargetFrames};
   static_assert(sizeof(kFilters) / sizeof(kFilters[0]) <= kMaxCanFilters, "more filters than a controller must offer");
-  hal_.can.set_filters(kFilters, sizeof(kFilters) / sizeof(kFilters[0]));
+  can_filters_accepted_ = hal_.can.set_filters(kFilters, sizeof(kFilters) / sizeof(kFilters[0]));
 
   const hal::MemoryRegion region = hal_.model_storage.model_region();
   geometry_ = fallback_geometry_;
@@ -78,15 +67,15 @@ RuntimeState Runtime::init() {
     const model::ImageStatus parsed = model::parse_image(region.data, region.size_bytes, image_, capacity);
     if (parsed != model::ImageStatus::ok) {
       boot_fault_ = FaultCode::image_invalid;
-      boot_fault_detail_ = static_cast<std::uint8_t>(parsed);
+      boot_fault_detail_ = FaultDetail(parsed);
     } else if (const model::Status s = model::geometry_from_image(image_, geometry_); s != model::Status::ok) {
       geometry_ = fallback_geometry_;
       boot_fault_ = FaultCode::image_geometry_invalid;
-      boot_fault_detail_ = static_cast<std::uint8_t>(s);
+      boot_fault_detail_ = FaultDetail(s);
     } else if (const model::Status b = correction_.bind(image_); b != model::Status::ok) {
       geometry_ = fallback_geometry_;
       boot_fault_ = FaultCode::image_geometry_invalid;
-      boot_fault_detail_ = static_cast<std::uint8_t>(b);
+      boot_fault_detail_ = FaultDetail(b);
     }
   }
   if (geometry_.validate() != model::Status::ok) {
@@ -102,7 +91,12 @@ RuntimeState Runtime::init() {
   enter(mode_);
   if (boot_fault_ != FaultCode::none) {
     LogLine line;
-    line << "fault: " << to_string(boot_fault_) << " (detail " << unsigned(boot_fault_detail_) << ")";
+    line << "fault: " << to_string(boot_fault_) << " (detail " << unsigned(boot_fault_detail_.wire_value()) << ")";
+    hal_.console.write_line(line.c_str());
+  }
+  if (!can_filters_accepted_) {
+    LogLine line;
+    line << "fault: " << to_string(FaultCode::can_filters_refused) << ", receiving unfiltered";
     hal_.console.write_line(line.c_str());
   }
   return state_;
@@ -111,7 +105,16 @@ RuntimeState Runtime::init() {
 FaultCode Runtime::active_fault() const {
   if (state_ == RuntimeState::fault) return FaultCode::cable_input_stale;
   if (unreported_event_ != FaultCode::none) return unreported_event_;
-  return boot_fault_;
+  if (boot_fault_ != FaultCode::none) return boot_fault_;
+  return can_filters_accepted_ ? FaultCode::none : FaultCode::can_filters_refused;
+}
+
+FaultDetail Runtime::active_fault_detail() const {
+  const FaultCode fault = active_fault();
+  if (fault == FaultCode::none) return FaultDetail();
+  if (fault == unreported_event_) return last_event_detail_;
+  if (fault == boot_fault_) return boot_fault_detail_;
+  return FaultDetail();
 }
 
 model::Status Runtime::estimate_pose(const Cables& cables_mm, PoseEstimate& estimate) const {
@@ -157,58 +160,64 @@ void Runtime::run_cycle(const hal::TimerTick& tick) {
 }
 
 void Runtime::handle_frame(const hal::CanFrame& frame) {
-  if (protocol::is_cable_feedback(frame.id)) {
+  if (protocol::cable_feedback::kMessage.carries(frame.id)) {
     handle_cable_frame(frame);
-    return;
+  } else if (protocol::target_orientation::kMessage.carries(frame.id)) {
+    handle_target_orientation(frame);
+  } else if (protocol::target_position_xy::kMessage.carries(frame.id)) {
+    handle_target_position(frame);
+  } else if (protocol::target_position_z::kMessage.carries(frame.id)) {
+    handle_target_commit(frame);
   }
-  switch (frame.id) {
-    case protocol::kTargetOrientationId: {
-      if (frame.dlc != 8) {
-        reject_frame(FaultCode::target_malformed);
-        return;
-      }
-      for (int k = 0; k < 4; ++k) pending_quaternion_[k] = protocol::get(frame, protocol::signal::quaternion[k]);
-      pending_orientation_ = true;
-      return;
-    }
-    case protocol::kTargetPositionXyId: {
-      if (frame.dlc != 8) {
-        reject_frame(FaultCode::target_malformed);
-        return;
-      }
-      pending_x_mm_ = protocol::get(frame, protocol::signal::position_xy[0]);
-      pending_y_mm_ = protocol::get(frame, protocol::signal::position_xy[1]);
-      pending_xy_ = true;
-      return;
-    }
-    case protocol::kTargetPositionZId:
-      handle_target_commit(frame);
-      return;
-    default:
-      // Outside what the filters pass: another node's traffic.
-      return;
-  }
+  // Anything else is another node's traffic: the unused id the target
+  // filter passes, or everything when the controller refused the filters.
 }
 
 void Runtime::handle_cable_frame(const hal::CanFrame& frame) {
-  const int segment = static_cast<int>(frame.id - protocol::kCableFeedbackBaseId);
-  double lengths_mm[4];
-  if (segment >= geometry_.segment_count ||
-      protocol::decode_cables(frame, lengths_mm) != protocol::CableFrameStatus::ok) {
+  protocol::CableFeedback feedback;
+  if (protocol::decode(frame, feedback) != protocol::DecodeStatus::ok ||
+      feedback.segment >= geometry_.segment_count) {
     reject_frame(FaultCode::cable_frame_malformed);
     return;
   }
-  for (int k = 0; k < 4; ++k) latest_cables_mm_[4 * segment + k] = static_cast<Scalar>(lengths_mm[k]);
+  const int segment = feedback.segment;
+  for (int k = 0; k < 4; ++k) latest_cables_mm_[4 * segment + k] = static_cast<Scalar>(feedback.lengths_mm[k]);
   segment_updated_cycle_[segment] = cycle_;
   segment_seen_[segment] = true;
   fresh_cables_ = true;
 }
 
+// A malformed part of a target drops what was pending of that part, so the
+// commit that follows is refused rather than solved with an older part.
+void Runtime::handle_target_orientation(const hal::CanFrame& frame) {
+  has_pending_orientation_ = protocol::decode(frame, pending_orientation_) == protocol::DecodeStatus::ok;
+  if (!has_pending_orientation_) reject_frame(FaultCode::target_malformed);
+}
+
+void Runtime::handle_target_position(const hal::CanFrame& frame) {
+  has_pending_position_ = protocol::decode(frame, pending_position_) == protocol::DecodeStatus::ok;
+  if (!has_pending_position_) reject_frame(FaultCode::target_malformed);
+}
+
+// A segment's cables are used for a pose while they are younger than the
+// stale limit, so segments reporting in different cycles still make a set.
+bool Runtime::segment_current(int segment) const {
+  return segment_seen_[segment] && cycle_ - segment_updated_cycle_[segment] < std::uint32_t(kStaleInputCycles);
+}
+
+// Stale: one segment silent, or no valid cable set, for more than
+// kStaleInputCycles (a segment that never reported counts from boot).
+bool Runtime::input_stale() const {
+  if (cycle_ - last_valid_cycle_ > std::uint32_t(kStaleInputCycles)) return true;
+  for (int s = 0; s < geometry_.segment_count; ++s) {
+    if (cycle_ - segment_updated_cycle_[s] > std::uint32_t(kStaleInputCycles)) return true;
+  }
+  return false;
+}
+
 void Runtime::update_pose() {
   bool complete = fresh_cables_;
-  for (int s = 0; s < geometry_.segment_count && complete; ++s) {
-    complete = segment_seen_[s] && cycle_ - segment_updated_cycle_[s] < std::uint32_t(kStaleInputCycles);
-  }
+  for (int s = 0; s < geometry_.segment_count && complete; ++s) complete = segment_current(s);
   if (complete) {
     PoseEstimate estimate;
     if (const model::Status s = estimate_pose(latest_cables_mm_, estimate); s == model::Status::ok) {
@@ -221,11 +230,10 @@ void Runtime::update_pose() {
       publish_pose();
     } else {
       statistics_.rejected_cable_sets += 1;
-      last_event_ = unreported_event_ = FaultCode::cable_lengths_invalid;
-      last_event_detail_ = static_cast<std::uint8_t>(s);
+      record_event(FaultCode::cable_lengths_invalid, FaultDetail(s));
     }
   }
-  if (state_ != RuntimeState::fault && cycle_ - last_valid_cycle_ > std::uint32_t(kStaleInputCycles)) {
+  if (state_ != RuntimeState::fault && input_stale()) {
     statistics_.stale_events += 1;
     enter(RuntimeState::fault);
   }
@@ -233,28 +241,30 @@ void Runtime::update_pose() {
 
 void Runtime::handle_target_commit(const hal::CanFrame& frame) {
   statistics_.targets_received += 1;
-  const bool well_formed = frame.dlc == 6 && pending_xy_;
-  const auto mode = static_cast<protocol::TargetMode>(protocol::get_raw(frame, protocol::signal::target_z[1]));
-  const auto sequence = static_cast<std::uint8_t>(protocol::get_raw(frame, protocol::signal::target_z[2]));
+  protocol::TargetPositionZ commit;
+  const bool well_formed = protocol::decode(frame, commit) == protocol::DecodeStatus::ok;
   last_ik_report_ = IkReport{};
-  last_ik_report_.sequence = sequence;
+  // Even a malformed commit is answered with its sequence, if it has one.
+  last_ik_report_.sequence = well_formed ? commit.sequence : protocol::commit_sequence(frame);
 
   Pose target;
-  target.position_mm = model::Vec3<Scalar>(Scalar(pending_x_mm_), Scalar(pending_y_mm_),
-                                           Scalar(protocol::get(frame, protocol::signal::target_z[0])));
-  bool valid = well_formed && (mode == protocol::TargetMode::position || mode == protocol::TargetMode::pose);
-  if (valid && mode == protocol::TargetMode::pose) {
-    const double* q = pending_quaternion_;
-    const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
-    valid = pending_orientation_ && std::abs(norm - 1.0) <= protocol::kQuaternionNormTolerance;
+  bool valid = well_formed && has_pending_position_;
+  if (valid) {
+    target.position_mm = model::Vec3<Scalar>(Scalar(pending_position_.x_mm), Scalar(pending_position_.y_mm),
+                                             Scalar(commit.z_mm));
+  }
+  if (valid && commit.mode == protocol::TargetMode::pose) {
+    const protocol::TargetOrientation& q = pending_orientation_;
+    const double norm = std::sqrt(q.qw * q.qw + q.qx * q.qx + q.qy * q.qy + q.qz * q.qz);
+    valid = has_pending_orientation_ && std::abs(norm - 1.0) <= protocol::kQuaternionNormTolerance;
     if (valid) {
-      target.rotation = Eigen::Quaternion<Scalar>(Scalar(q[0] / norm), Scalar(q[1] / norm), Scalar(q[2] / norm),
-                                                  Scalar(q[3] / norm))
+      target.rotation = Eigen::Quaternion<Scalar>(Scalar(q.qw / norm), Scalar(q.qx / norm), Scalar(q.qy / norm),
+                                                  Scalar(q.qz / norm))
                             .toRotationMatrix();
     }
   }
-  pending_xy_ = false;
-  pending_orientation_ = false;
+  has_pending_position_ = false;
+  has_pending_orientation_ = false;
 
   if (!valid) {
     reject_frame(FaultCode::target_malformed);
@@ -262,7 +272,9 @@ void Runtime::handle_target_commit(const hal::CanFrame& frame) {
   } else if (state_ == RuntimeState::fault || state_ == RuntimeState::boot) {
     last_ik_report_.outcome = protocol::IkOutcome::rejected_state;
   } else {
-    solve_target(target, mode, sequence);
+    // TRACKING changes nothing here: the solver warm-starts from the last
+    // solution for every target, and finishes within this cycle.
+    solve_target(target, commit.mode, commit.sequence);
   }
   publish_ik_report();
 }
@@ -294,20 +306,21 @@ void Runtime::solve_target(const Pose& target, protocol::TargetMode mode, std::u
   last_ik_report_.sequence = sequence;
   last_ik_report_.model_status = result.status;
   last_ik_report_.iterations = result.iterations;
+  last_ik_report_.cycles = 1;
   last_ik_report_.position_error_mm = result.position_error_mm;
+  last_ik_report_.orientation_error_rad = mode == protocol::TargetMode::pose ? result.orientation_error_rad : Scalar(0);
 
   const bool close_enough =
       result.status == model::Status::ik_not_converged && result.position_error_mm <= kIkAcceptedPositionErrorMm &&
       (mode == protocol::TargetMode::position || result.orientation_error_rad <= kIkAcceptedOrientationErrorRad);
   bool encodable = result.converged() || close_enough;
   for (int i = 0; encodable && i < result.cables_mm.size(); ++i) {
-    encodable = result.cables_mm[i] > Scalar(0) && result.cables_mm[i] <= Scalar(protocol::kMaxCableLengthMm);
+    encodable = protocol::cable_length_encodable(double(result.cables_mm[i]));
   }
   if (!encodable) {
     // Setpoints held: the drives keep the last commanded lengths.
     last_ik_report_.outcome = protocol::IkOutcome::unreachable;
-    last_event_ = unreported_event_ = FaultCode::target_unreachable;
-    last_event_detail_ = static_cast<std::uint8_t>(result.status);
+    record_event(FaultCode::target_unreachable, FaultDetail(result.status));
     return;
   }
   last_ik_report_.outcome = protocol::IkOutcome::converged;
@@ -319,77 +332,73 @@ void Runtime::solve_target(const Pose& target, protocol::TargetMode mode, std::u
 
 void Runtime::publish_pose() {
   const Pose& pose = latest_pose_.pose;
-  hal::CanFrame frame = protocol::make_frame(protocol::kPosePositionXyId, 8);
-  protocol::put(frame, protocol::signal::position_xy[0], pose.position_mm.x());
-  protocol::put(frame, protocol::signal::position_xy[1], pose.position_mm.y());
+  hal::CanFrame frame;
+  protocol::encode(protocol::PosePositionXy{pose.position_mm.x(), pose.position_mm.y()}, frame);
   send(frame);
-
-  frame = protocol::make_frame(protocol::kPosePositionZId, 6);
-  protocol::put(frame, protocol::signal::pose_z[0], pose.position_mm.z());
-  protocol::put_raw(frame, protocol::signal::pose_z[1], latest_pose_.compensated ? protocol::kPoseFlagCompensated : 0);
-  protocol::put_raw(frame, protocol::signal::pose_z[2], cycle_ & 0xFF);
+  protocol::encode(protocol::PosePositionZ{pose.position_mm.z(), latest_pose_.compensated,
+                                           static_cast<std::uint8_t>(cycle_ & 0xFF)},
+                   frame);
   send(frame);
-
-  double q[4];
-  quaternion_of(pose.rotation, q);
-  frame = protocol::make_frame(protocol::kPoseOrientationId, 8);
-  for (int k = 0; k < 4; ++k) protocol::put(frame, protocol::signal::quaternion[k], q[k]);
+  protocol::encode(orientation_frame(pose.rotation), frame);
   send(frame);
   statistics_.poses_published += 1;
 }
 
 void Runtime::publish_setpoints() {
   for (int s = 0; s < geometry_.segment_count; ++s) {
-    const double lengths_mm[4] = {setpoints_mm_[4 * s], setpoints_mm_[4 * s + 1], setpoints_mm_[4 * s + 2],
-                                  setpoints_mm_[4 * s + 3]};
+    const protocol::CableSetpoint setpoint{
+        s, {setpoints_mm_[4 * s], setpoints_mm_[4 * s + 1], setpoints_mm_[4 * s + 2], setpoints_mm_[4 * s + 3]}};
     hal::CanFrame frame;
-    if (protocol::encode_cables(protocol::kCableSetpointBaseId + std::uint32_t(s), lengths_mm, frame)) send(frame);
+    if (protocol::encode(setpoint, frame)) send(frame);
   }
 }
 
 void Runtime::publish_ik_report() {
-  hal::CanFrame frame = protocol::make_frame(protocol::kIkReportId, 6);
-  const auto& spec = protocol::signal::ik_report;
-  protocol::put_raw(frame, spec[0], last_ik_report_.sequence);
-  protocol::put_raw(frame, spec[1], static_cast<std::int64_t>(last_ik_report_.outcome));
-  protocol::put_raw(frame, spec[2], last_ik_report_.iterations > 255 ? 255 : last_ik_report_.iterations);
-  protocol::put_raw(frame, spec[3], static_cast<std::int64_t>(last_ik_report_.model_status));
-  const Scalar error_mm = last_ik_report_.position_error_mm;
-  protocol::put(frame, spec[4], std::isfinite(error_mm) ? double(error_mm) : protocol::kMaxCableLengthMm + 1.0);
+  const IkReport& r = last_ik_report_;
+  hal::CanFrame frame;
+  protocol::encode(protocol::IkReport{r.sequence, r.outcome, r.iterations, r.cycles, double(r.position_error_mm),
+                                      double(r.orientation_error_rad)},
+                   frame);
   send(frame);
 }
 
 void Runtime::publish_status() {
-  hal::CanFrame frame = protocol::make_frame(protocol::kStatusId, 8);
-  const auto& status = protocol::signal::status;
+  // Both read before sending: a failed send records an event of its own.
   const FaultCode fault = active_fault();
-  protocol::put_raw(frame, status[0], static_cast<std::int64_t>(state_));
-  protocol::put_raw(frame, status[1], static_cast<std::int64_t>(fault));
-  protocol::put_raw(frame, status[2], saturate_u16(statistics_.overruns));
-  protocol::put_raw(frame, status[3], saturate_u16(to_us(statistics_.execution_max_ns)));
-  protocol::put_raw(frame, status[4], saturate_u16(to_us(statistics_.execution_mean_ns())));
+  const FaultDetail detail = active_fault_detail();
+  protocol::Status status;
+  status.state = state_;
+  status.fault = fault;
+  status.overruns = statistics_.overruns;
+  status.exec_max_us = to_us(statistics_.execution_max_ns);
+  status.exec_mean_us = to_us(statistics_.execution_mean_ns());
+  hal::CanFrame frame;
+  protocol::encode(status, frame);
   send(frame);
 
-  frame = protocol::make_frame(protocol::kStatsId, 8);
-  const auto& stats = protocol::signal::stats;
-  const std::uint8_t detail = fault == boot_fault_ && fault != FaultCode::none ? boot_fault_detail_ : last_event_detail_;
-  protocol::put_raw(frame, stats[0], saturate_u16(to_us(statistics_.jitter_max_ns)));
-  protocol::put_raw(frame, stats[1], saturate_u16(statistics_.rejected_frames + statistics_.rejected_cable_sets));
-  protocol::put_raw(frame, stats[2], statistics_.cycles & 0xFFFF);
-  protocol::put_raw(frame, stats[3], detail);
-  protocol::put_raw(frame, stats[4], statistics_.stale_events > 255 ? 255 : statistics_.stale_events);
+  protocol::Stats stats;
+  stats.jitter_max_us = to_us(statistics_.jitter_max_ns);
+  stats.rejected_frames = std::int64_t(statistics_.rejected_frames) + statistics_.rejected_cable_sets;
+  stats.cycle_count = static_cast<std::uint16_t>(statistics_.cycles & 0xFFFF);
+  stats.fault_detail = detail;
+  stats.stale_events = statistics_.stale_events;
+  protocol::encode(stats, frame);
   send(frame);
   unreported_event_ = FaultCode::none;
 }
 
 void Runtime::send(const hal::CanFrame& frame) {
-  if (hal_.can.send(frame) != hal::CanStatus::ok) last_event_ = unreported_event_ = FaultCode::can_transmit_failed;
+  if (hal_.can.send(frame) != hal::CanStatus::ok) record_event(FaultCode::can_transmit_failed);
+}
+
+void Runtime::record_event(FaultCode code, FaultDetail detail) {
+  last_event_ = unreported_event_ = code;
+  last_event_detail_ = detail;
 }
 
 void Runtime::reject_frame(FaultCode code) {
   statistics_.rejected_frames += 1;
-  last_event_ = unreported_event_ = code;
-  last_event_detail_ = 0;
+  record_event(code);
 }
 
 void Runtime::enter(RuntimeState next) {

@@ -11,22 +11,24 @@ namespace protocol = firmware::protocol;
 SimulatedCableDrives::SimulatedCableDrives(hal::CanBus& bus, const Cables& initial_cables_mm,
                                            double max_rate_mm_per_s)
     : bus_(bus), cables_mm_(initial_cables_mm), setpoints_mm_(initial_cables_mm), max_rate_mm_per_s_(max_rate_mm_per_s) {
-  const hal::CanFilter setpoints{protocol::kCableSetpointBaseId, 0x7F8};
-  bus_.set_filters(&setpoints, 1);
+  bus_.set_filters(&protocol::kCableSetpointFrames, 1);
+}
+
+void SimulatedCableDrives::set_segment_silent(int segment, bool silent) {
+  if (segment >= 0 && segment < firmware::kMaxSegments) segment_silent_[segment] = silent;
 }
 
 void SimulatedCableDrives::step(double dt_s) {
   const int segments = static_cast<int>(cables_mm_.size() / 4);
   hal::CanFrame frame;
   while (bus_.receive(frame) == hal::CanStatus::ok) {
-    if (!protocol::is_cable_setpoint(frame.id)) continue;
-    const int segment = static_cast<int>(frame.id - protocol::kCableSetpointBaseId);
-    double lengths_mm[4];
-    if (segment >= segments || protocol::decode_cables(frame, lengths_mm) != protocol::CableFrameStatus::ok) {
+    if (!protocol::cable_setpoint::kMessage.carries(frame.id)) continue;
+    protocol::CableSetpoint setpoint;
+    if (protocol::decode(frame, setpoint) != protocol::DecodeStatus::ok || setpoint.segment >= segments) {
       rejected_frames_ += 1;
       continue;
     }
-    for (int k = 0; k < 4; ++k) setpoints_mm_[4 * segment + k] = lengths_mm[k];
+    for (int k = 0; k < 4; ++k) setpoints_mm_[4 * setpoint.segment + k] = setpoint.lengths_mm[k];
     setpoint_frames_ += 1;
   }
   const double max_step_mm = max_rate_mm_per_s_ * dt_s;
@@ -35,9 +37,10 @@ void SimulatedCableDrives::step(double dt_s) {
   }
   if (silent_) return;
   for (int s = 0; s < segments; ++s) {
-    const double lengths_mm[4] = {cables_mm_[4 * s], cables_mm_[4 * s + 1], cables_mm_[4 * s + 2],
-                                  cables_mm_[4 * s + 3]};
-    if (protocol::encode_cables(protocol::kCableFeedbackBaseId + std::uint32_t(s), lengths_mm, frame)) bus_.send(frame);
+    if (segment_silent_[s]) continue;
+    const protocol::CableFeedback feedback{
+        s, {cables_mm_[4 * s], cables_mm_[4 * s + 1], cables_mm_[4 * s + 2], cables_mm_[4 * s + 3]}};
+    if (protocol::encode(feedback, frame)) bus_.send(frame);
   }
 }
 

@@ -19,8 +19,10 @@ class SimulatedCableDrives {
   // Takes every pending setpoint frame, moves the cables by dt_s, publishes.
   void step(double dt_s);
 
-  // Stops or resumes the feedback frames (a drive losing its bus).
+  // Stops or resumes the feedback frames (a drive losing its bus): of every
+  // segment, or of one segment's drive only.
   void set_silent(bool silent) { silent_ = silent; }
+  void set_segment_silent(int segment, bool silent);
 
   const Cables& cables_mm() const { return cables_mm_; }
   const Cables& setpoints_mm() const { return setpoints_mm_; }
@@ -33,6 +35,7 @@ class SimulatedCableDrives {
   Cables setpoints_mm_;
   double max_rate_mm_per_s_;
   bool silent_ = false;
+  bool segment_silent_[firmware::kMaxSegments] = {};
   std::uint32_t setpoint_frames_ = 0;
   std::uint32_t rejected_frames_ = 0;
 };

@@ -22,18 +22,17 @@ TEST(RuntimeNoAllocation, TenThousandCyclesAfterInit) {
   Runtime runtime(hal, Geometry::uniform(2, 120.0f, 67.0f));
   ASSERT_EQ(runtime.init(), RuntimeState::run);
   sim::SimulatedCableDrives drives(platform.drives_node, test_support::bent_cables(runtime.geometry()), 50.0);
-  const hal::CanFilter nothing{0x7FF, 0x7FF};
+  const hal::CanFilter nothing{0x7FF, 0x7FF};  // an identifier no node sends: the host's queue stays empty
   platform.host_node.set_filters(&nothing, 1);
 
   test_support::AllocationCounter counter;
   for (int k = 0; k < 10000; ++k) {
     if (k == 100) {
-      hal::CanFrame frame = protocol::make_frame(protocol::kTargetPositionXyId, 8);
-      protocol::put(frame, protocol::signal::position_xy[0], double(runtime.latest_pose().pose.position_mm.x()) + 2);
-      protocol::put(frame, protocol::signal::position_xy[1], double(runtime.latest_pose().pose.position_mm.y()));
+      const model::Vec3<double> position = runtime.latest_pose().pose.position_mm.cast<double>();
+      hal::CanFrame frame;
+      protocol::encode(protocol::TargetPositionXy{position.x() + 2, position.y()}, frame);
       platform.host_node.send(frame);
-      frame = protocol::make_frame(protocol::kTargetPositionZId, 6);
-      protocol::put(frame, protocol::signal::target_z[0], double(runtime.latest_pose().pose.position_mm.z()));
+      protocol::encode(protocol::TargetPositionZ{position.z(), protocol::TargetMode::position, false, 0}, frame);
       platform.host_node.send(frame);
     }
     drives.set_silent(k >= 5000 && k < 5050);

@@ -1,150 +1,231 @@
-// The DBC file and protocol.hpp describe the same frames, signal by signal,
-// and the codec round-trips through the scalings they declare.
+// firmware/protocol/cdcr.dbc and the codec's table (protocol/messages.hpp)
+// describe the same frames: every message and signal of one is in the other,
+// with the same identifier, DLC, sender, start bit, length, byte order, sign,
+// factor, offset, range, unit and value table.
 
-#include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <map>
 #include <regex>
+#include <set>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include <gtest/gtest.h>
 
+#include <cdcr/firmware/fault_detail.hpp>
 #include <cdcr/firmware/protocol.hpp>
 
 namespace cdcr::firmware::protocol {
 namespace {
 
+using ValueMap = std::map<std::uint32_t, std::string>;
+
 struct DbcSignal {
-  int start_bit;
-  int length_bits;
-  bool is_signed;
-  double factor;
-  double offset;
-  double minimum;
-  double maximum;
+  int start_bit = 0;
+  int length_bits = 0;
+  int byte_order = 0;
+  bool is_signed = false;
+  double factor = 0;
+  double offset = 0;
+  double minimum = 0;
+  double maximum = 0;
   std::string unit;
 };
+
 struct DbcMessage {
   std::string name;
-  int dlc;
+  int dlc = 0;
   std::string sender;
   std::map<std::string, DbcSignal> signals;
 };
 
-std::map<std::uint32_t, DbcMessage> read_dbc(const std::string& path) {
+struct Dbc {
+  std::map<std::uint32_t, DbcMessage> messages;
+  std::map<std::pair<std::uint32_t, std::string>, ValueMap> value_tables;      // VAL_
+  std::map<std::pair<std::uint32_t, std::string>, std::string> signal_notes;  // CM_ SG_
+};
+
+ValueMap parse_values(const std::string& text) {
+  ValueMap values;
+  const std::regex entry(R"re((\d+) "([^"]*)")re");
+  for (auto it = std::sregex_iterator(text.begin(), text.end(), entry); it != std::sregex_iterator(); ++it) {
+    values[static_cast<std::uint32_t>(std::stoul((*it)[1]))] = (*it)[2];
+  }
+  return values;
+}
+
+Dbc read_dbc(const std::string& path) {
   std::ifstream in(path);
   EXPECT_TRUE(in) << path;
   const std::regex message(R"re(^BO_ (\d+) (\w+): (\d+) (\w+)\s*$)re");
   const std::regex signal(
-      R"re(^ SG_ (\w+) : (\d+)\|(\d+)@1([+-]) \(([^,]+),([^)]+)\) \[([^|]+)\|([^\]]+)\] "([^"]*)" .+$)re");
-  std::map<std::uint32_t, DbcMessage> messages;
+      R"re(^ SG_ (\w+) : (\d+)\|(\d+)@([01])([+-]) \(([^,]+),([^)]+)\) \[([^|]+)\|([^\]]+)\] "([^"]*)" .+$)re");
+  const std::regex value_table(R"re(^VAL_ (\d+) (\w+) ((?:\d+ "[^"]*" )*);\s*$)re");
+  const std::regex signal_note(R"re(^CM_ SG_ (\d+) (\w+) "([^"]*)";\s*$)re");
+  Dbc dbc;
   DbcMessage* current = nullptr;
   std::string line;
   std::smatch m;
   while (std::getline(in, line)) {
     if (std::regex_match(line, m, message)) {
-      current = &messages[static_cast<std::uint32_t>(std::stoul(m[1]))];
+      const auto id = static_cast<std::uint32_t>(std::stoul(m[1]));
+      EXPECT_EQ(dbc.messages.count(id), 0u) << "identifier listed twice: " << line;
+      current = &dbc.messages[id];
       current->name = m[2];
       current->dlc = std::stoi(m[3]);
       current->sender = m[4];
     } else if (std::regex_match(line, m, signal)) {
       EXPECT_NE(current, nullptr) << line;
       if (current == nullptr) continue;
-      current->signals[m[1]] = DbcSignal{std::stoi(m[2]), std::stoi(m[3]), m[4] == "-", std::stod(m[5]),
-                                         std::stod(m[6]), std::stod(m[7]), std::stod(m[8]), m[9]};
+      EXPECT_EQ(current->signals.count(m[1]), 0u) << "signal listed twice: " << line;
+      current->signals[m[1]] = DbcSignal{std::stoi(m[2]),  std::stoi(m[3]),  std::stoi(m[4]),
+                                         m[5] == "-",      std::stod(m[6]),  std::stod(m[7]),
+                                         std::stod(m[8]),  std::stod(m[9]),  m[10]};
+    } else if (std::regex_match(line, m, value_table)) {
+      dbc.value_tables[{static_cast<std::uint32_t>(std::stoul(m[1])), m[2]}] = parse_values(m[3]);
+    } else if (std::regex_match(line, m, signal_note)) {
+      dbc.signal_notes[{static_cast<std::uint32_t>(std::stoul(m[1])), m[2]}] = m[3];
     } else {
       EXPECT_EQ(line.rfind(" SG_", 0), std::string::npos) << "unparsed signal line: " << line;
       EXPECT_EQ(line.rfind("BO_ ", 0), std::string::npos) << "unparsed message line: " << line;
+      EXPECT_EQ(line.rfind("VAL_ ", 0), std::string::npos) << "unparsed value table: " << line;
+      EXPECT_EQ(line.rfind("CM_ SG_", 0), std::string::npos) << "unparsed signal comment: " << line;
+    }
+  }
+  return dbc;
+}
+
+const Dbc& dbc() {
+  static const Dbc parsed = read_dbc(CDCR_DBC_PATH);
+  return parsed;
+}
+
+// The codec's messages by identifier, per-segment ones expanded to the
+// <name>_<segment> messages the DBC lists.
+struct CodecMessage {
+  std::string name;
+  const MessageSpec* spec;
+};
+
+std::map<std::uint32_t, CodecMessage> codec_messages() {
+  std::map<std::uint32_t, CodecMessage> messages;
+  for (const MessageSpec* spec : kMessages) {
+    for (int i = 0; i < spec->id_count; ++i) {
+      const std::string name = spec->id_count == 1 ? spec->name : spec->name + std::string("_") + std::to_string(i);
+      EXPECT_TRUE(messages.emplace(spec->id + std::uint32_t(i), CodecMessage{name, spec}).second) << name;
     }
   }
   return messages;
 }
 
-TEST(RuntimeProtocol, DbcAgreesWithTheHeader) {
-  const auto dbc = read_dbc(CDCR_DBC_PATH);
-  ASSERT_EQ(dbc.size(), std::size(kMessages));
-  for (const MessageSpec& spec : kMessages) {
-    SCOPED_TRACE(spec.name);
-    const auto found = dbc.find(spec.id);
-    ASSERT_NE(found, dbc.end());
+ValueMap codec_values(const SignalSpec& signal) {
+  ValueMap values;
+  for (int i = 0; i < signal.values.count; ++i) values[signal.values.entries[i].value] = signal.values.entries[i].name;
+  return values;
+}
+
+TEST(DbcAgreesWithTheCodec, SameMessages) {
+  const auto codec = codec_messages();
+  for (const auto& [id, message] : codec) EXPECT_EQ(dbc().messages.count(id), 1u) << "not in the DBC: " << message.name;
+  for (const auto& [id, message] : dbc().messages) EXPECT_EQ(codec.count(id), 1u) << "not in the codec: " << message.name;
+}
+
+TEST(DbcAgreesWithTheCodec, SameMessageHeaders) {
+  for (const auto& [id, expected] : codec_messages()) {
+    const auto found = dbc().messages.find(id);
+    if (found == dbc().messages.end()) continue;  // SameMessages says so
+    SCOPED_TRACE(expected.name);
+    EXPECT_EQ(found->second.name, expected.name);
+    EXPECT_EQ(found->second.dlc, expected.spec->dlc);
+    EXPECT_EQ(found->second.sender, expected.spec->sender);
+  }
+}
+
+TEST(DbcAgreesWithTheCodec, SameSignals) {
+  for (const auto& [id, expected] : codec_messages()) {
+    const auto found = dbc().messages.find(id);
+    if (found == dbc().messages.end()) continue;
+    SCOPED_TRACE(expected.name);
     const DbcMessage& message = found->second;
-    EXPECT_EQ(message.name, spec.name);
-    EXPECT_EQ(message.dlc, spec.dlc);
-    EXPECT_EQ(message.sender, spec.sender);
-    ASSERT_EQ(message.signals.size(), spec.signal_count);
-    for (int i = 0; i < spec.signal_count; ++i) {
-      const SignalSpec& s = spec.signals[i];
-      SCOPED_TRACE(s.name);
-      const auto sig = message.signals.find(s.name);
-      ASSERT_NE(sig, message.signals.end());
-      EXPECT_EQ(sig->second.start_bit, s.start_bit);
-      EXPECT_EQ(sig->second.length_bits, s.length_bits);
-      EXPECT_EQ(sig->second.is_signed, s.is_signed);
-      EXPECT_NEAR(sig->second.factor, s.factor, 1e-15);
-      EXPECT_EQ(sig->second.offset, s.offset);
-      EXPECT_NEAR(sig->second.minimum, s.minimum, 1e-9);
-      EXPECT_NEAR(sig->second.maximum, s.maximum, 1e-9);
-      EXPECT_EQ(sig->second.unit, s.unit);
-      EXPECT_LE(s.start_bit + s.length_bits, 8 * spec.dlc);
+    std::set<std::string> codec_names;
+    for (const SignalSpec* s : expected.spec->signals) {
+      codec_names.insert(s->name);
+      SCOPED_TRACE(s->name);
+      const auto sig = message.signals.find(s->name);
+      if (sig == message.signals.end()) {
+        ADD_FAILURE() << "signal not in the DBC";
+        continue;
+      }
+      EXPECT_EQ(sig->second.start_bit, s->start_bit);
+      EXPECT_EQ(sig->second.length_bits, s->length_bits);
+      EXPECT_EQ(sig->second.byte_order, kDbcIntelByteOrder);
+      EXPECT_EQ(sig->second.is_signed, s->is_signed);
+      // Exactly: the DBC's decimal text must read as the codec's double.
+      EXPECT_EQ(sig->second.factor, s->factor);
+      EXPECT_EQ(sig->second.offset, s->offset);
+      EXPECT_EQ(sig->second.minimum, s->minimum);
+      EXPECT_EQ(sig->second.maximum, s->maximum);
+      EXPECT_EQ(sig->second.unit, s->unit);
+    }
+    for (const auto& [name, signal] : message.signals) {
+      EXPECT_EQ(codec_names.count(name), 1u) << "signal not in the codec: " << name;
     }
   }
 }
 
-TEST(RuntimeProtocol, IdentifiersAreUniqueStandardIds) {
-  std::map<std::uint32_t, int> seen;
-  for (const MessageSpec& spec : kMessages) {
-    EXPECT_LE(spec.id, 0x7FFu) << spec.name;
-    EXPECT_EQ(seen[spec.id]++, 0) << spec.name;
+TEST(DbcAgreesWithTheCodec, SameValueTables) {
+  const auto codec = codec_messages();
+  std::set<std::pair<std::uint32_t, std::string>> codec_tables;
+  for (const auto& [id, expected] : codec) {
+    for (const SignalSpec* s : expected.spec->signals) {
+      if (s->values.count == 0) continue;
+      codec_tables.insert({id, s->name});
+      const auto found = dbc().value_tables.find({id, s->name});
+      if (found == dbc().value_tables.end()) {
+        ADD_FAILURE() << expected.name << "." << s->name << ": no VAL_ in the DBC";
+        continue;
+      }
+      EXPECT_EQ(found->second, codec_values(*s)) << expected.name << "." << s->name;
+    }
+  }
+  for (const auto& [key, values] : dbc().value_tables) {
+    EXPECT_EQ(codec_tables.count(key), 1u) << "VAL_ " << key.first << " " << key.second << " has no codec table";
   }
 }
 
-TEST(RuntimeProtocol, CableFramesRoundTripWithinHalfAQuantum) {
-  const double lengths_mm[4] = {0.01, 119.996, 225.3349, 655.34};
-  hal::CanFrame frame;
-  ASSERT_TRUE(encode_cables(kCableFeedbackBaseId + 3, lengths_mm, frame));
-  EXPECT_EQ(frame.id, kCableFeedbackBaseId + 3);
-  EXPECT_EQ(frame.dlc, 8);
-  double decoded_mm[4];
-  ASSERT_EQ(decode_cables(frame, decoded_mm), CableFrameStatus::ok);
-  for (int k = 0; k < 4; ++k) EXPECT_NEAR(decoded_mm[k], lengths_mm[k], 0.005 + 1e-12);
-  EXPECT_EQ(frame.data[0], 1);  // little-endian: 0.01 mm is raw 1
-  EXPECT_EQ(frame.data[1], 0);
-}
-
-TEST(RuntimeProtocol, CableEncoderRefusesWhatItCannotRepresent) {
-  hal::CanFrame frame;
-  const double nan_mm[4] = {100, std::nan(""), 100, 100};
-  const double negative_mm[4] = {100, -1, 100, 100};
-  const double too_long_mm[4] = {100, 700, 100, 100};
-  EXPECT_FALSE(encode_cables(kCableSetpointBaseId, nan_mm, frame));
-  EXPECT_FALSE(encode_cables(kCableSetpointBaseId, negative_mm, frame));
-  EXPECT_FALSE(encode_cables(kCableSetpointBaseId, too_long_mm, frame));
-}
-
-TEST(RuntimeProtocol, CableDecoderRejectsMalformedFrames) {
-  double lengths_mm[4];
-  hal::CanFrame frame = make_frame(kCableFeedbackBaseId, 6);
-  EXPECT_EQ(decode_cables(frame, lengths_mm), CableFrameStatus::wrong_dlc);
-  frame = make_frame(kCableFeedbackBaseId, 8);
-  for (int k = 0; k < 4; ++k) put_raw(frame, signal::cable[k], 10000);
-  put_raw(frame, signal::cable[2], kCableNotAvailable);
-  EXPECT_EQ(decode_cables(frame, lengths_mm), CableFrameStatus::not_available);
-  put_raw(frame, signal::cable[2], 0);
-  EXPECT_EQ(decode_cables(frame, lengths_mm), CableFrameStatus::not_positive);
-}
-
-TEST(RuntimeProtocol, SignedSignalsSignExtendAndSaturate) {
-  hal::CanFrame frame = make_frame(kPosePositionXyId, 8);
-  put(frame, signal::position_xy[0], -1234.567);
-  put(frame, signal::position_xy[1], 1e12);
-  EXPECT_NEAR(get(frame, signal::position_xy[0]), -1234.57, 1e-9);
-  EXPECT_EQ(get_raw(frame, signal::position_xy[1]), 2147483647);
-  frame = make_frame(kPoseOrientationId, 8);
-  put(frame, signal::quaternion[0], 1.0);
-  put(frame, signal::quaternion[1], -1.0);
-  EXPECT_EQ(get_raw(frame, signal::quaternion[0]), 32767);
-  EXPECT_EQ(get_raw(frame, signal::quaternion[1]), -32767);
+// The FAULT_DETAIL comment says, for every fault code that carries a
+// detail, which enum it is (fault_detail.hpp holds the same table).
+TEST(DbcAgreesWithTheCodec, FaultDetailCommentNamesTheEnumOfEveryDetailedFault) {
+  const auto note = dbc().signal_notes.find({stats::kMessage.id, stats::kFaultDetail.name});
+  ASSERT_NE(note, dbc().signal_notes.end()) << "no CM_ SG_ for FAULT_DETAIL";
+  // One sentence per group of fault codes.
+  std::map<std::string, std::string> sentence_of_fault;
+  std::istringstream sentences(note->second);
+  std::string sentence;
+  while (std::getline(sentences, sentence, '.')) {
+    for (const ValueName& fault : values::kFaultCode) {
+      const std::string named = std::to_string(fault.value) + " " + fault.name;
+      if (sentence.find(named) != std::string::npos) sentence_of_fault[fault.name] = sentence;
+    }
+  }
+  for (const ValueName& fault : values::kFaultCode) {
+    SCOPED_TRACE(fault.name);
+    switch (detail_kind(static_cast<FaultCode>(fault.value))) {
+      case FaultDetailKind::image_status:
+        ASSERT_EQ(sentence_of_fault.count(fault.name), 1u);
+        EXPECT_NE(sentence_of_fault[fault.name].find("model::ImageStatus"), std::string::npos);
+        break;
+      case FaultDetailKind::model_status:
+        ASSERT_EQ(sentence_of_fault.count(fault.name), 1u);
+        EXPECT_NE(sentence_of_fault[fault.name].find("model::Status"), std::string::npos);
+        break;
+      case FaultDetailKind::none:
+        EXPECT_EQ(sentence_of_fault.count(fault.name), 0u) << "named as carrying a detail";
+        break;
+    }
+  }
 }
 
 }  // namespace

@@ -3,70 +3,17 @@
 // inverse kinematics requests.
 
 #include <cmath>
-#include <memory>
 #include <vector>
 
 #include <gtest/gtest.h>
 
-#include "runtime_fixture.hpp"
+#include "runtime_test_fixture.hpp"
 
 namespace cdcr::firmware {
 namespace {
 
 namespace protocol = firmware::protocol;
-using test_support::SimulatedPlatform;
-
-class RuntimeTest : public ::testing::Test {
- protected:
-  void boot(const std::vector<std::uint8_t>& image) {
-    platform = std::make_unique<SimulatedPlatform>(image);
-    runtime = std::make_unique<Runtime>(platform->hal, Geometry::uniform(2, 120.0f, 67.0f));
-    runtime->init();
-    drives = std::make_unique<sim::SimulatedCableDrives>(platform->drives_node,
-                                                         test_support::bent_cables(runtime->geometry()), 50.0);
-    const hal::CanFilter host_filters[] = {{protocol::kIkReportId, 0x7FF}, {protocol::kStatusId, 0x7FE}};
-    platform->host_node.set_filters(host_filters, 2);
-  }
-
-  void cycles(int count) {
-    for (int i = 0; i < count; ++i) {
-      const hal::TimerTick tick = platform->timer.wait_next();
-      drives->step(1e-3);
-      runtime->run_cycle(tick);
-    }
-  }
-
-  void send(const hal::CanFrame& frame) { ASSERT_EQ(platform->host_node.send(frame), hal::CanStatus::ok); }
-
-  void send_position_target(double x, double y, double z, std::uint8_t sequence) {
-    hal::CanFrame frame = protocol::make_frame(protocol::kTargetPositionXyId, 8);
-    protocol::put(frame, protocol::signal::position_xy[0], x);
-    protocol::put(frame, protocol::signal::position_xy[1], y);
-    send(frame);
-    frame = protocol::make_frame(protocol::kTargetPositionZId, 6);
-    protocol::put(frame, protocol::signal::target_z[0], z);
-    protocol::put_raw(frame, protocol::signal::target_z[1], 0);
-    protocol::put_raw(frame, protocol::signal::target_z[2], sequence);
-    send(frame);
-  }
-
-  // The last IK_REPORT frame on the host's node, if any.
-  bool last_ik_report(hal::CanFrame& report) {
-    bool found = false;
-    hal::CanFrame frame;
-    while (platform->host_node.receive(frame) == hal::CanStatus::ok) {
-      if (frame.id == protocol::kIkReportId) {
-        report = frame;
-        found = true;
-      }
-    }
-    return found;
-  }
-
-  std::unique_ptr<SimulatedPlatform> platform;
-  std::unique_ptr<Runtime> runtime;
-  std::unique_ptr<sim::SimulatedCableDrives> drives;
-};
+using test_support::RuntimeTest;
 
 TEST_F(RuntimeTest, ValidImageBootsIntoRunAndPublishesCompensatedPoses) {
   boot(test_support::small_image());
@@ -81,13 +28,13 @@ TEST_F(RuntimeTest, ValidImageBootsIntoRunAndPublishesCompensatedPoses) {
   EXPECT_EQ(runtime->statistics().cycles, 20u);
   EXPECT_EQ(runtime->statistics().overruns, 0u);
 
-  hal::CanFrame frame;
   bool saw_status = false;
-  while (platform->host_node.receive(frame) == hal::CanStatus::ok) {
-    if (frame.id != protocol::kStatusId) continue;
+  for (const hal::CanFrame& frame : host_frames()) {
+    protocol::Status status;
+    if (protocol::decode(frame, status) != protocol::DecodeStatus::ok) continue;
     saw_status = true;
-    EXPECT_EQ(protocol::get_raw(frame, protocol::signal::status[0]), int(RuntimeState::run));
-    EXPECT_EQ(protocol::get_raw(frame, protocol::signal::status[1]), int(FaultCode::none));
+    EXPECT_EQ(status.state, RuntimeState::run);
+    EXPECT_EQ(status.fault, FaultCode::none);
   }
   EXPECT_TRUE(saw_status);
 }
@@ -98,12 +45,27 @@ TEST_F(RuntimeTest, CorruptedImageDegradesToNominalKinematics) {
   boot(image);
   EXPECT_EQ(runtime->state(), RuntimeState::degraded);
   EXPECT_EQ(runtime->boot_fault(), FaultCode::image_invalid);
-  EXPECT_EQ(runtime->boot_fault_detail(), std::uint8_t(model::ImageStatus::checksum_mismatch));
+  EXPECT_EQ(runtime->boot_fault_detail(), FaultDetail(model::ImageStatus::checksum_mismatch));
   EXPECT_EQ(runtime->active_fault(), FaultCode::image_invalid);
   cycles(20);
   EXPECT_EQ(runtime->state(), RuntimeState::degraded);
   ASSERT_TRUE(runtime->has_pose());
   EXPECT_FALSE(runtime->latest_pose().compensated);
+
+  // On the bus: STATS carries the parser's verdict, typed by STATUS's FAULT.
+  const std::vector<hal::CanFrame> frames = host_frames();
+  protocol::Status status;
+  ASSERT_TRUE(last_of(frames, status));
+  EXPECT_EQ(status.state, RuntimeState::degraded);
+  EXPECT_EQ(status.fault, FaultCode::image_invalid);
+  protocol::Stats stats;
+  bool saw_stats = false;
+  for (const hal::CanFrame& frame : frames) {
+    saw_stats = protocol::decode(frame, status.fault, stats) == protocol::DecodeStatus::ok || saw_stats;
+  }
+  ASSERT_TRUE(saw_stats);
+  EXPECT_EQ(stats.fault_detail.kind(), FaultDetailKind::image_status);
+  EXPECT_EQ(stats.fault_detail.image_status(), model::ImageStatus::checksum_mismatch);
 }
 
 TEST_F(RuntimeTest, TruncatedImageDegrades) {
@@ -112,7 +74,7 @@ TEST_F(RuntimeTest, TruncatedImageDegrades) {
   boot(image);
   EXPECT_EQ(runtime->state(), RuntimeState::degraded);
   EXPECT_EQ(runtime->boot_fault(), FaultCode::image_invalid);
-  EXPECT_EQ(runtime->boot_fault_detail(), std::uint8_t(model::ImageStatus::truncated));
+  EXPECT_EQ(runtime->boot_fault_detail(), FaultDetail(model::ImageStatus::truncated));
   cycles(5);
   EXPECT_TRUE(runtime->has_pose());
 }
@@ -130,15 +92,16 @@ TEST_F(RuntimeTest, MalformedCableFramesAreCountedAndRejected) {
   const PoseEstimate before = runtime->latest_pose();
   drives->set_silent(true);
 
-  hal::CanFrame short_frame = protocol::make_frame(protocol::kCableFeedbackBaseId, 6);
+  hal::CanFrame short_frame;
+  ASSERT_TRUE(protocol::encode(protocol::CableFeedback{0, {120, 120, 120, 120}}, short_frame));
+  short_frame.dlc = 6;
   send(short_frame);
-  hal::CanFrame unavailable = protocol::make_frame(protocol::kCableFeedbackBaseId, 8);
-  for (int k = 0; k < 4; ++k) protocol::put_raw(unavailable, protocol::signal::cable[k], 12000);
-  protocol::put_raw(unavailable, protocol::signal::cable[1], protocol::kCableNotAvailable);
+  hal::CanFrame unavailable;
+  ASSERT_TRUE(protocol::encode(protocol::CableFeedback{0, {120, 120, 120, 120}}, unavailable));
+  protocol::write_raw(unavailable, protocol::cable_lengths::kL2, protocol::kCableNotAvailableRaw);
   send(unavailable);
-  hal::CanFrame unknown_segment = unavailable;
-  unknown_segment.id = protocol::kCableFeedbackBaseId + 5;  // the image has 2 segments
-  protocol::put_raw(unknown_segment, protocol::signal::cable[1], 12000);
+  hal::CanFrame unknown_segment;  // the image has 2 segments
+  ASSERT_TRUE(protocol::encode(protocol::CableFeedback{5, {120, 120, 120, 120}}, unknown_segment));
   send(unknown_segment);
   cycles(1);
 
@@ -155,16 +118,15 @@ TEST_F(RuntimeTest, ImpossibleCableLengthsAreRejected) {
   drives->set_silent(true);
   const std::uint32_t published = runtime->statistics().poses_published;
   // A difference of 390 mm across a 67 mm anchor radius is a bend of 2.9 rad.
-  const double impossible_mm[4] = {10.0, 120.0, 400.0, 120.0};
-  const double fine_mm[4] = {120.0, 120.0, 120.0, 120.0};
   hal::CanFrame frame;
-  ASSERT_TRUE(protocol::encode_cables(protocol::kCableFeedbackBaseId, impossible_mm, frame));
+  ASSERT_TRUE(protocol::encode(protocol::CableFeedback{0, {10.0, 120.0, 400.0, 120.0}}, frame));
   send(frame);
-  ASSERT_TRUE(protocol::encode_cables(protocol::kCableFeedbackBaseId + 1, fine_mm, frame));
+  ASSERT_TRUE(protocol::encode(protocol::CableFeedback{1, {120.0, 120.0, 120.0, 120.0}}, frame));
   send(frame);
   cycles(1);
   EXPECT_EQ(runtime->statistics().rejected_cable_sets, 1u);
   EXPECT_EQ(runtime->last_event(), FaultCode::cable_lengths_invalid);
+  EXPECT_EQ(runtime->active_fault_detail(), FaultDetail(model::Status::cable_difference_out_of_range));
   EXPECT_EQ(runtime->statistics().poses_published, published);
 }
 
@@ -191,8 +153,7 @@ TEST_F(RuntimeTest, StaleInputFaultsAndRecovers) {
   EXPECT_EQ(runtime->statistics().stale_events, 1u);
   const std::uint32_t published = runtime->statistics().poses_published;
 
-  hal::CanFrame report;
-  last_ik_report(report);
+  host_frames();
   send_position_target(10, 10, 200, 9);
   cycles(1);
   EXPECT_EQ(runtime->last_ik_report().outcome, protocol::IkOutcome::rejected_state);
@@ -213,13 +174,17 @@ TEST_F(RuntimeTest, ReachableTargetPublishesSetpointsAndTheDrivesFollow) {
   cycles(3);
   const model::Vec3<Scalar> target = runtime->latest_pose().pose.position_mm + model::Vec3<Scalar>(3, -2, 0);
   // Whatever sits in the host queue from boot is not the answer.
-  hal::CanFrame report;
-  last_ik_report(report);
+  host_frames();
   send_position_target(target.x(), target.y(), target.z(), 42);
   cycles(1);
+  protocol::IkReport report;
   ASSERT_TRUE(last_ik_report(report));
-  EXPECT_EQ(protocol::get_raw(report, protocol::signal::ik_report[0]), 42);
-  EXPECT_EQ(protocol::get_raw(report, protocol::signal::ik_report[1]), int(protocol::IkOutcome::converged));
+  EXPECT_EQ(report.sequence, 42);
+  EXPECT_EQ(report.outcome, protocol::IkOutcome::converged);
+  EXPECT_EQ(report.cycles, 1);
+  EXPECT_GE(report.iterations, 1);
+  EXPECT_LE(report.position_residual_mm, double(kIkAcceptedPositionErrorMm));
+  EXPECT_EQ(report.orientation_residual_rad, 0.0);  // a position target
   ASSERT_TRUE(runtime->has_setpoints());
   cycles(500);
   EXPECT_LT((runtime->latest_pose().pose.position_mm - target).norm(), 0.05f);
@@ -236,31 +201,83 @@ TEST_F(RuntimeTest, UnreachableTargetIsReportedAndSetpointsHeld) {
   cycles(5);
   const std::uint32_t setpoint_frames = drives->setpoint_frames();
 
-  hal::CanFrame report;
-  last_ik_report(report);
+  host_frames();
   send_position_target(900.0, 0.0, 50.0, 2);
   cycles(1);
-  ASSERT_TRUE(last_ik_report(report));
-  EXPECT_EQ(protocol::get_raw(report, protocol::signal::ik_report[0]), 2);
-  EXPECT_EQ(protocol::get_raw(report, protocol::signal::ik_report[1]), int(protocol::IkOutcome::unreachable));
+  EXPECT_EQ(runtime->setpoints_mm(), held);
   EXPECT_EQ(runtime->last_ik_report().model_status, model::Status::ik_not_converged);
   EXPECT_EQ(runtime->last_event(), FaultCode::target_unreachable);
-  EXPECT_EQ(runtime->setpoints_mm(), held);
-  cycles(1);
+  cycles(kStatusEveryCycles);
   EXPECT_EQ(drives->setpoint_frames(), setpoint_frames);
   EXPECT_EQ(runtime->state(), RuntimeState::run);
+
+  const std::vector<hal::CanFrame> frames = host_frames();
+  protocol::IkReport report;
+  ASSERT_TRUE(last_of(frames, report));
+  EXPECT_EQ(report.sequence, 2);
+  EXPECT_EQ(report.outcome, protocol::IkOutcome::unreachable);
+  EXPECT_GT(report.position_residual_mm, 1.0);
+  // The next STATUS names the event, and STATS the solver's status with it.
+  bool reported = false;
+  protocol::Status status;
+  for (const hal::CanFrame& frame : frames) {
+    protocol::Stats stats;
+    if (protocol::decode(frame, status) == protocol::DecodeStatus::ok) continue;
+    if (protocol::decode(frame, status.fault, stats) != protocol::DecodeStatus::ok) continue;
+    EXPECT_EQ(status.fault, FaultCode::target_unreachable);
+    EXPECT_EQ(stats.fault_detail, FaultDetail(model::Status::ik_not_converged));
+    reported = true;
+    break;
+  }
+  EXPECT_TRUE(reported);
 }
 
 TEST_F(RuntimeTest, TargetWithoutItsPositionFrameIsMalformed) {
   boot(test_support::small_image());
   cycles(3);
-  hal::CanFrame frame = protocol::make_frame(protocol::kTargetPositionZId, 6);
-  protocol::put_raw(frame, protocol::signal::target_z[2], 7);
-  send(frame);
+  send_frame(protocol::TargetPositionZ{150.0, protocol::TargetMode::position, false, 7});
   cycles(1);
   EXPECT_EQ(runtime->last_ik_report().outcome, protocol::IkOutcome::rejected_malformed);
+  EXPECT_EQ(runtime->last_ik_report().sequence, 7);
   EXPECT_EQ(runtime->last_event(), FaultCode::target_malformed);
   EXPECT_FALSE(runtime->has_setpoints());
+}
+
+TEST_F(RuntimeTest, TargetWithReservedBitsSetIsMalformed) {
+  boot(test_support::small_image());
+  cycles(3);
+  const model::Vec3<Scalar> reachable = runtime->latest_pose().pose.position_mm + model::Vec3<Scalar>(1, 1, 0);
+  send_frame(protocol::TargetPositionXy{reachable.x(), reachable.y()});
+  hal::CanFrame commit;
+  protocol::encode(protocol::TargetPositionZ{reachable.z(), protocol::TargetMode::position, false, 11}, commit);
+  // Bits 34..39 of TARGET_POSITION_Z are reserved: a sender that sets one
+  // means something this runtime does not know.
+  constexpr protocol::SignalSpec kReservedBit39{"RESERVED", 39, 1, false, 1, 0, 0, 1, ""};
+  protocol::write_raw(commit, kReservedBit39, 1);
+  send(commit);
+  cycles(1);
+  protocol::IkReport report;
+  ASSERT_TRUE(last_ik_report(report));
+  EXPECT_EQ(report.sequence, 11);
+  EXPECT_EQ(report.outcome, protocol::IkOutcome::rejected_malformed);
+  EXPECT_EQ(runtime->last_event(), FaultCode::target_malformed);
+  EXPECT_FALSE(runtime->has_setpoints());
+}
+
+TEST_F(RuntimeTest, TrackingTargetsAreSolvedLikeSingleOnes) {
+  boot(test_support::small_image());
+  cycles(3);
+  const model::Vec3<Scalar> start = runtime->latest_pose().pose.position_mm;
+  for (int k = 1; k <= 5; ++k) {
+    const model::Vec3<Scalar> target = start + model::Vec3<Scalar>(0.2f * k, -0.1f * k, 0);
+    send_frame(protocol::TargetPositionXy{target.x(), target.y()});
+    send_frame(protocol::TargetPositionZ{target.z(), protocol::TargetMode::position, true, std::uint8_t(k)});
+    cycles(1);
+    protocol::IkReport report;
+    ASSERT_TRUE(last_ik_report(report));
+    EXPECT_EQ(report.sequence, k);
+    EXPECT_EQ(report.outcome, protocol::IkOutcome::converged);
+  }
 }
 
 TEST(SimulatedPlatform, LockstepTimerReportsMissedReleases) {
@@ -280,7 +297,9 @@ TEST(SimulatedPlatform, VirtualBusFiltersAndCountsOverruns) {
   sim::VirtualCanBus bus;
   const hal::CanFilter only_0x100{0x100, 0x7FF};
   ASSERT_TRUE(bus.node(1).set_filters(&only_0x100, 1));
-  hal::CanFrame frame = protocol::make_frame(0x101, 8);
+  hal::CanFrame frame;
+  frame.id = 0x101;
+  frame.dlc = 8;
   EXPECT_EQ(bus.node(0).send(frame), hal::CanStatus::ok);
   frame.id = 0x100;
   for (int i = 0; i < kRxQueueDepth + 3; ++i) bus.node(0).send(frame);

@@ -106,12 +106,23 @@ int main(int argc, char** argv) {
       if (cdcr::model::cables_from_joints(joints, geometry, cables_mm) != Status::ok) {
         throw std::runtime_error("cannot compute cable lengths");
       }
-      // As the runtime sees them: 0.01 mm units on the bus, then float.
+      // As the runtime sees them: through a feedback frame (0.01 mm quanta),
+      // then float. The header keeps the decoded lengths, which the boards
+      // encode again into the same frames.
       cables_text << "    {";
-      for (int k = 0; k < cables_mm.size(); ++k) {
-        const auto raw = static_cast<std::uint16_t>(std::lround(cables_mm[k] / cdcr::firmware::protocol::kLengthScaleMm));
-        cables_mm[k] = static_cast<double>(static_cast<float>(raw * cdcr::firmware::protocol::kLengthScaleMm));
-        cables_text << (k ? ", " : "") << raw;
+      for (int s = 0; s < segments; ++s) {
+        const cdcr::firmware::protocol::CableFeedback sent{
+            s, {cables_mm[4 * s], cables_mm[4 * s + 1], cables_mm[4 * s + 2], cables_mm[4 * s + 3]}};
+        cdcr::firmware::protocol::CableFeedback received;
+        cdcr::hal::CanFrame frame;
+        if (!cdcr::firmware::protocol::encode(sent, frame) ||
+            cdcr::firmware::protocol::decode(frame, received) != cdcr::firmware::protocol::DecodeStatus::ok) {
+          throw std::runtime_error("a cable length beyond the feedback frame's range");
+        }
+        for (int k = 0; k < 4; ++k) {
+          cables_text << (s || k ? ", " : "") << exact(received.lengths_mm[k]);
+          cables_mm[4 * s + k] = static_cast<double>(static_cast<float>(received.lengths_mm[k]));
+        }
       }
       cables_text << "},\n";
 
@@ -156,8 +167,8 @@ int main(int argc, char** argv) {
            << "inline constexpr std::uint32_t kTrainingPoints = " << view.training_points << ";\n\n"
            << "// The image's geometry: backbone length (mm), anchor radius (mm), theta max (rad).\n"
            << "inline constexpr float kGeometry[kSegments][3] = {\n" << geometry_text.str() << "};\n\n"
-           << "// Cable lengths in the bus's 0.01 mm units, segment by segment.\n"
-           << "inline constexpr std::uint16_t kCablesRaw[kCases][4 * kSegments] = {\n" << cables_text.str() << "};\n\n"
+           << "// Cable lengths (mm) as decoded from the feedback frames, segment by segment.\n"
+           << "inline constexpr double kCablesMm[kCases][4 * kSegments] = {\n" << cables_text.str() << "};\n\n"
            << "// (alpha, theta) per segment for the cables above.\n"
            << "inline constexpr float kJoints[kCases][2 * kSegments] = {\n" << joints_text.str() << "};\n\n"
            << "inline constexpr double kCompensatedPositionMm[kCases][3] = {\n" << compensated_position.str() << "};\n\n"

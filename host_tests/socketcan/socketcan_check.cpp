@@ -72,7 +72,7 @@ model::CableVector<double> bent_cables(const Model& m, double theta_rad, double 
   }
   model::CableVector<double> cables;
   model::cables_from_joints(joints, m.geometry, cables);
-  for (int i = 0; i < cables.size(); ++i) cables[i] = std::round(cables[i] / protocol::kLengthScaleMm) * protocol::kLengthScaleMm;
+  for (int i = 0; i < cables.size(); ++i) cables[i] = protocol::cable_length_as_transmitted(cables[i]);
   return cables;
 }
 
@@ -114,20 +114,16 @@ int write_image(const std::string& path) {
 int print_frames(const Model& m) {
   const model::CableVector<double> cables = feedback_cables(m);
   for (int s = 0; s < m.geometry.segment_count; ++s) {
-    const double lengths_mm[4] = {cables[4 * s], cables[4 * s + 1], cables[4 * s + 2], cables[4 * s + 3]};
+    const protocol::CableFeedback feedback{s, {cables[4 * s], cables[4 * s + 1], cables[4 * s + 2], cables[4 * s + 3]}};
     CanFrame frame;
-    protocol::encode_cables(protocol::kCableFeedbackBaseId + std::uint32_t(s), lengths_mm, frame);
+    protocol::encode(feedback, frame);
     std::printf("FEEDBACK_%d=%s\n", s, hex(frame).c_str());
   }
   std::printf("SEGMENTS=%d\n", m.geometry.segment_count);
   const model::Vec3<double> target = target_position_mm(m);
-  CanFrame xy = protocol::make_frame(protocol::kTargetPositionXyId, 8);
-  protocol::put(xy, protocol::signal::position_xy[0], target.x());
-  protocol::put(xy, protocol::signal::position_xy[1], target.y());
-  CanFrame z = protocol::make_frame(protocol::kTargetPositionZId, 6);
-  protocol::put(z, protocol::signal::target_z[0], target.z());
-  protocol::put_raw(z, protocol::signal::target_z[1], int(protocol::TargetMode::position));
-  protocol::put_raw(z, protocol::signal::target_z[2], kTargetSequence);
+  CanFrame xy, z;
+  protocol::encode(protocol::TargetPositionXy{target.x(), target.y()}, xy);
+  protocol::encode(protocol::TargetPositionZ{target.z(), protocol::TargetMode::position, false, kTargetSequence}, z);
   std::printf("TARGET_XY=%s\nTARGET_Z=%s\n", hex(xy).c_str(), hex(z).c_str());
   return 0;
 }
@@ -178,31 +174,29 @@ class Checker {
     int poses = 0, uncompensated = 0;
     // A pose is the three frames in a row, as the runtime sends them; a
     // triplet with a frame missing from the log is skipped, not misread.
-    CanFrame xy{}, z{};
+    protocol::PosePositionXy xy;
+    protocol::PosePositionZ z;
+    protocol::PoseOrientation orientation;
+    constexpr protocol::DecodeStatus ok = protocol::DecodeStatus::ok;
     int pose_frames_in_row = 0;
     for (const LoggedFrame& logged : phase.frames) {
       const CanFrame& f = logged.frame;
-      if (f.id == protocol::kPosePositionXyId) {
-        xy = f;
+      if (protocol::decode(f, xy) == ok) {
         pose_frames_in_row = 1;
-      } else if (f.id == protocol::kPosePositionZId) {
-        z = f;
+      } else if (protocol::decode(f, z) == ok) {
         pose_frames_in_row = pose_frames_in_row == 1 ? 2 : 0;
       }
-      if (f.id != protocol::kPoseOrientationId) continue;
+      if (protocol::decode(f, orientation) != ok) continue;
       const bool complete = pose_frames_in_row == 2;
       pose_frames_in_row = 0;
       if (!complete) continue;
-      model::Vec3<double> position(protocol::get(xy, protocol::signal::position_xy[0]),
-                                   protocol::get(xy, protocol::signal::position_xy[1]),
-                                   protocol::get(z, protocol::signal::pose_z[0]));
-      Eigen::Quaterniond q(protocol::get(f, protocol::signal::quaternion[0]), protocol::get(f, protocol::signal::quaternion[1]),
-                           protocol::get(f, protocol::signal::quaternion[2]), protocol::get(f, protocol::signal::quaternion[3]));
+      model::Vec3<double> position(xy.x_mm, xy.y_mm, z.z_mm);
+      Eigen::Quaterniond q(orientation.qw, orientation.qx, orientation.qy, orientation.qz);
       q.normalize();
       const Eigen::Quaterniond reference(expected.compensated.rotation);
       worst_mm = std::max(worst_mm, (position - expected.compensated.position_mm).norm());
       worst_rad = std::max(worst_rad, q.angularDistance(reference));
-      if (!(protocol::get_raw(z, protocol::signal::pose_z[1]) & protocol::kPoseFlagCompensated)) ++uncompensated;
+      if (!z.compensated) ++uncompensated;
       ++poses;
     }
     std::printf("%s: %d poses, worst position %.4f mm, worst orientation %.2e rad\n", name, poses, worst_mm, worst_rad);
@@ -225,10 +219,22 @@ std::vector<const LoggedFrame*> with_id(const Phase& phase, std::uint32_t id) {
   return out;
 }
 
-int last_stat(const std::vector<Phase>& phases, int upto_phase, const protocol::SignalSpec& spec) {
+// A STATUS frame as decoded; one that does not decode (random traffic on its
+// id) reads as BOOT without a fault, which no check looks for.
+protocol::Status status_of(const LoggedFrame* f) {
+  protocol::Status status;
+  protocol::decode(f->frame, status);
+  return status;
+}
+
+// A counter of the last STATS frame up to the phase; its fault detail is not read.
+int last_stat(const std::vector<Phase>& phases, int upto_phase, std::int64_t protocol::Stats::*counter) {
   for (int p = upto_phase; p >= 0; --p) {
-    const auto stats = with_id(phases[p], protocol::kStatsId);
-    if (!stats.empty()) return int(protocol::get_raw(stats.back()->frame, spec));
+    const auto frames = with_id(phases[p], protocol::stats::kMessage.id);
+    for (auto f = frames.rbegin(); f != frames.rend(); ++f) {
+      protocol::Stats stats;
+      if (protocol::decode((*f)->frame, FaultCode::none, stats) == protocol::DecodeStatus::ok) return int(stats.*counter);
+    }
   }
   return -1;
 }
@@ -255,9 +261,8 @@ int check(const Model& m, const std::string& log_path) {
   Checker c(m);
   c.expect(phases.size() == 8, "all 7 markers in the log (got " + std::to_string(phases.size() - 1) + ")");
   if (phases.size() != 8) return 1;
-  const auto& status = protocol::signal::status;
-  const auto& stats = protocol::signal::stats;
-  const auto state_of = [&](const LoggedFrame* f) { return RuntimeState(protocol::get_raw(f->frame, status[0])); };
+  constexpr std::uint32_t kStatusId = protocol::status::kMessage.id;
+  const auto state_of = [](const LoggedFrame* f) { return status_of(f).state; };
   // Under User-Mode Linux every system call is expensive and the feeders
   // share one virtual CPU with the runtime (and the host may be busy), so a
   // 1 kHz cycle misses releases and the input may go stale for a while even
@@ -265,7 +270,7 @@ int check(const Model& m, const std::string& log_path) {
   // reached, and the pose content is what is checked strictly.
   const auto reaches_run = [&](const Phase& phase, const char* name) {
     int run = 0, total = 0;
-    for (const LoggedFrame* f : with_id(phase, protocol::kStatusId)) {
+    for (const LoggedFrame* f : with_id(phase, kStatusId)) {
       run += state_of(f) == RuntimeState::run ? 1 : 0;
       ++total;
     }
@@ -274,9 +279,9 @@ int check(const Model& m, const std::string& log_path) {
   };
 
   // 0: no cable input yet: the runtime's heartbeat says its input is stale.
-  const auto boot_status = with_id(phases[0], protocol::kStatusId);
+  const auto boot_status = with_id(phases[0], kStatusId);
   c.expect(!boot_status.empty() && state_of(boot_status.back()) == RuntimeState::fault &&
-               FaultCode(protocol::get_raw(boot_status.back()->frame, status[1])) == FaultCode::cable_input_stale,
+               status_of(boot_status.back()).fault == FaultCode::cable_input_stale,
            "before any cable frame: STATUS is FAULT, cable input stale");
 
   // 1: cable feedback flowing: RUN, poses equal the model's.
@@ -291,14 +296,14 @@ int check(const Model& m, const std::string& log_path) {
   // STATS certainly sent after the runtime read them (it answered the target
   // sent after them, and nothing is rejected once the feeders stop).
   {
-    const int before = last_stat(phases, 1, stats[1]);
-    const int after = last_stat(phases, 4, stats[1]);
+    const int before = last_stat(phases, 1, &protocol::Stats::rejected_frames);
+    const int after = last_stat(phases, 4, &protocol::Stats::rejected_frames);
     std::printf("malformed: rejected frames %d -> %d\n", before, after);
     c.expect(before >= 0 && after >= before + 4, "malformed: STATS rejected frames grew by the 4 sent");
     bool reported = false;
     for (int p = 2; p <= 3; ++p) {
-      for (const LoggedFrame* f : with_id(phases[p], protocol::kStatusId)) {
-        const auto fault = FaultCode(protocol::get_raw(f->frame, status[1]));
+      for (const LoggedFrame* f : with_id(phases[p], kStatusId)) {
+        const FaultCode fault = status_of(f).fault;
         reported = reported || fault == FaultCode::cable_frame_malformed || fault == FaultCode::target_malformed;
       }
     }
@@ -307,20 +312,21 @@ int check(const Model& m, const std::string& log_path) {
   }
   // 3: target -> IK_REPORT and setpoints whose kinematics reach the target.
   {
-    const auto reports = with_id(phases[3], protocol::kIkReportId);
+    const auto reports = with_id(phases[3], protocol::ik_report::kMessage.id);
     bool converged = false;
     for (const LoggedFrame* f : reports) {
-      converged = converged || (protocol::get_raw(f->frame, protocol::signal::ik_report[0]) == kTargetSequence &&
-                                protocol::get_raw(f->frame, protocol::signal::ik_report[1]) == int(protocol::IkOutcome::converged));
+      protocol::IkReport report;
+      converged = converged || (protocol::decode(f->frame, report) == protocol::DecodeStatus::ok &&
+                                report.sequence == kTargetSequence && report.outcome == protocol::IkOutcome::converged);
     }
     c.expect(converged, "target: IK_REPORT with the sequence, converged");
     model::CableVector<double> setpoints(4 * m.geometry.segment_count);
     int found = 0;
     for (int s = 0; s < m.geometry.segment_count; ++s) {
-      const auto frames = with_id(phases[3], protocol::kCableSetpointBaseId + std::uint32_t(s));
-      double lengths_mm[4];
-      if (frames.empty() || protocol::decode_cables(frames.back()->frame, lengths_mm) != protocol::CableFrameStatus::ok) continue;
-      for (int k = 0; k < 4; ++k) setpoints[4 * s + k] = lengths_mm[k];
+      const auto frames = with_id(phases[3], protocol::cable_setpoint::kMessage.id + std::uint32_t(s));
+      protocol::CableSetpoint setpoint;
+      if (frames.empty() || protocol::decode(frames.back()->frame, setpoint) != protocol::DecodeStatus::ok) continue;
+      for (int k = 0; k < 4; ++k) setpoints[4 * s + k] = setpoint.lengths_mm[k];
       ++found;
     }
     c.expect(found == m.geometry.segment_count, "target: a CABLE_SETPOINT frame per segment");
@@ -334,7 +340,7 @@ int check(const Model& m, const std::string& log_path) {
   }
   // 4: feeders stopped: FAULT, and no pose after it.
   {
-    const auto s = with_id(phases[4], protocol::kStatusId);
+    const auto s = with_id(phases[4], kStatusId);
     const LoggedFrame* first_fault = nullptr;
     for (const LoggedFrame* f : s) {
       if (state_of(f) == RuntimeState::fault) {
@@ -342,15 +348,15 @@ int check(const Model& m, const std::string& log_path) {
         break;
       }
     }
-    c.expect(first_fault != nullptr && FaultCode(protocol::get_raw(first_fault->frame, status[1])) == FaultCode::cable_input_stale,
+    c.expect(first_fault != nullptr && status_of(first_fault).fault == FaultCode::cable_input_stale,
              "stale: STATUS goes to FAULT, cable input stale");
     int poses_after = 0;
     for (const LoggedFrame& f : phases[4].frames) {
-      if (first_fault != nullptr && f.time_s > first_fault->time_s && f.frame.id == protocol::kPoseOrientationId) ++poses_after;
+      if (first_fault != nullptr && f.time_s > first_fault->time_s && f.frame.id == protocol::pose_orientation::kMessage.id) ++poses_after;
     }
     c.expect(first_fault != nullptr && poses_after == 0, "stale: no pose published in FAULT");
-    const int stale_before = last_stat(phases, 3, stats[4]);
-    const int stale_after = last_stat(phases, 4, stats[4]);
+    const int stale_before = last_stat(phases, 3, &protocol::Stats::stale_events);
+    const int stale_after = last_stat(phases, 4, &protocol::Stats::stale_events);
     std::printf("stale: stale events %d -> %d\n", stale_before, stale_after);
     c.expect(stale_before >= 0 && stale_after > stale_before, "stale: STATS stale events grew");
   }
@@ -361,20 +367,20 @@ int check(const Model& m, const std::string& log_path) {
   }
   // 6: random traffic from cangen: the runtime keeps its heartbeat and counts what it refused.
   {
-    const auto s = with_id(phases[6], protocol::kStatusId);
+    const auto s = with_id(phases[6], kStatusId);
     std::printf("random traffic: %zu frames on the bus, %zu STATUS\n", phases[6].frames.size(), s.size());
     c.expect(s.size() >= 10, "random traffic: STATUS keeps coming");
-    c.expect(last_stat(phases, 6, stats[1]) > last_stat(phases, 5, stats[1]), "random traffic: rejected frames grew");
+    c.expect(last_stat(phases, 6, &protocol::Stats::rejected_frames) > last_stat(phases, 5, &protocol::Stats::rejected_frames), "random traffic: rejected frames grew");
   }
   // 7: after the noise: RUN and the feedback poses again.
   {
-    const auto s = with_id(phases[7], protocol::kStatusId);
+    const auto s = with_id(phases[7], kStatusId);
     c.expect(reaches_run(phases[7], "after traffic"), "after traffic: STATUS is RUN");
     c.expect(c.check_poses(phases[7], "after traffic") >= 10, "after traffic: poses published");
     if (!s.empty()) {
       std::printf("last STATUS: overruns %lld, execution max %lld us, mean %lld us; jitter max %d us\n",
-                  (long long)protocol::get_raw(s.back()->frame, status[2]), (long long)protocol::get_raw(s.back()->frame, status[3]),
-                  (long long)protocol::get_raw(s.back()->frame, status[4]), last_stat(phases, 7, stats[0]));
+                  (long long)status_of(s.back()).overruns, (long long)status_of(s.back()).exec_max_us,
+                  (long long)status_of(s.back()).exec_mean_us, last_stat(phases, 7, &protocol::Stats::jitter_max_us));
     }
   }
   std::printf("%d check(s) failed\n", c.failures());

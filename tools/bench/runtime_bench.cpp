@@ -72,33 +72,29 @@ using CableFrames = std::vector<cdcr::hal::CanFrame>;
 CableFrames cable_frames(const model::CableVector<double>& cables_mm, int segment_count) {
   CableFrames frames(static_cast<std::size_t>(segment_count));
   for (int s = 0; s < segment_count; ++s) {
-    const double lengths_mm[4] = {cables_mm[4 * s], cables_mm[4 * s + 1], cables_mm[4 * s + 2], cables_mm[4 * s + 3]};
-    if (!protocol::encode_cables(protocol::kCableFeedbackBaseId + std::uint32_t(s), lengths_mm, frames[std::size_t(s)])) {
+    const protocol::CableFeedback feedback{
+        s, {cables_mm[4 * s], cables_mm[4 * s + 1], cables_mm[4 * s + 2], cables_mm[4 * s + 3]}};
+    if (!protocol::encode(feedback, frames[std::size_t(s)])) {
       throw std::runtime_error("cable length out of the frame's range");
     }
   }
   return frames;
 }
 
+// tracking: the target is one of a stream along a path (TRACKING = 1).
 std::vector<cdcr::hal::CanFrame> target_frames(const model::Pose<double>& target, protocol::TargetMode mode,
-                                               std::uint8_t sequence) {
+                                               bool tracking, std::uint8_t sequence) {
   std::vector<cdcr::hal::CanFrame> frames;
+  cdcr::hal::CanFrame frame;
   if (mode == protocol::TargetMode::pose) {
     Eigen::Quaterniond q(target.rotation);
     q.normalize();
-    cdcr::hal::CanFrame frame = protocol::make_frame(protocol::kTargetOrientationId, 8);
-    const double w_first[4] = {q.w(), q.x(), q.y(), q.z()};
-    for (int k = 0; k < 4; ++k) protocol::put(frame, protocol::signal::quaternion[k], w_first[k]);
+    protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, frame);
     frames.push_back(frame);
   }
-  cdcr::hal::CanFrame frame = protocol::make_frame(protocol::kTargetPositionXyId, 8);
-  protocol::put(frame, protocol::signal::position_xy[0], target.position_mm.x());
-  protocol::put(frame, protocol::signal::position_xy[1], target.position_mm.y());
+  protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
   frames.push_back(frame);
-  frame = protocol::make_frame(protocol::kTargetPositionZId, 6);
-  protocol::put(frame, protocol::signal::target_z[0], target.position_mm.z());
-  protocol::put_raw(frame, protocol::signal::target_z[1], static_cast<int>(mode));
-  protocol::put_raw(frame, protocol::signal::target_z[2], sequence);
+  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), mode, tracking, sequence}, frame);
   frames.push_back(frame);
   return frames;
 }
@@ -132,8 +128,8 @@ Workload make_workload(const fw::Runtime& runtime, const Options& options) {
     w.bends.push_back(model::bend_from_joints(sample.joints).cast<float>());
     const model::Pose<double> reached = robot.true_pose(sample.cables_mm);
     const auto sequence = static_cast<std::uint8_t>(k);
-    w.jump.push_back(target_frames(reached, protocol::TargetMode::position, sequence));
-    w.pose_jump.push_back(target_frames(reached, protocol::TargetMode::pose, sequence));
+    w.jump.push_back(target_frames(reached, protocol::TargetMode::position, false, sequence));
+    w.pose_jump.push_back(target_frames(reached, protocol::TargetMode::pose, false, sequence));
   }
 
   // A random walk in joint space, kept inside the sampled workspace.
@@ -150,7 +146,7 @@ Workload make_workload(const fw::Runtime& runtime, const Options& options) {
       throw std::runtime_error("trajectory left the nominal model's range");
     }
     w.stream.push_back(
-        target_frames(robot.true_pose(cables_mm), protocol::TargetMode::position, static_cast<std::uint8_t>(k)));
+        target_frames(robot.true_pose(cables_mm), protocol::TargetMode::position, true, static_cast<std::uint8_t>(k)));
   }
   return w;
 }

@@ -57,7 +57,7 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
   if (runtime.init() != fw::RuntimeState::run) {
     std::string message = std::string("image ") + image_path + ": " + fw::to_string(runtime.boot_fault());
     if (runtime.boot_fault() == fw::FaultCode::image_invalid) {
-      message += std::string(" (") + model::to_string(static_cast<model::ImageStatus>(runtime.boot_fault_detail())) + ")";
+      message += std::string(" (") + model::to_string(runtime.boot_fault_detail().image_status()) + ")";
     }
     throw InputError(message);
   }
@@ -93,14 +93,10 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
 }
 
 void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, std::uint8_t sequence) {
-  cdcr::hal::CanFrame frame = protocol::make_frame(protocol::kTargetPositionXyId, 8);
-  protocol::put(frame, protocol::signal::position_xy[0], target_mm.x());
-  protocol::put(frame, protocol::signal::position_xy[1], target_mm.y());
+  cdcr::hal::CanFrame frame;
+  protocol::encode(protocol::TargetPositionXy{target_mm.x(), target_mm.y()}, frame);
   host.send(frame);
-  frame = protocol::make_frame(protocol::kTargetPositionZId, 6);
-  protocol::put(frame, protocol::signal::target_z[0], target_mm.z());
-  protocol::put_raw(frame, protocol::signal::target_z[1], static_cast<int>(protocol::TargetMode::position));
-  protocol::put_raw(frame, protocol::signal::target_z[2], sequence);
+  protocol::encode(protocol::TargetPositionZ{target_mm.z(), protocol::TargetMode::position, false, sequence}, frame);
   host.send(frame);
 }
 
@@ -134,8 +130,7 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
   model::cables_from_joints(random_joints(), geometry, start_cables);
   sim::SimulatedCableDrives drives(platform.bus.node(1), start_cables, 50.0);
   cdcr::hal::CanBus& host = platform.bus.node(2);
-  const cdcr::hal::CanFilter host_filter{protocol::kIkReportId, 0x7FF};
-  host.set_filters(&host_filter, 1);
+  host.set_filters(&protocol::kIkReportFrames, 1);
 
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
   const double dt_s = double(period_ns) * 1e-9;
@@ -206,10 +201,11 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
       setpoint_target_error_max_mm = std::max(setpoint_target_error_max_mm, error_mm);
       ++setpoints_checked;
     }
-    cdcr::hal::CanFrame report;
-    while (host.receive(report) == cdcr::hal::CanStatus::ok) {
-      if (report.id == protocol::kIkReportId &&
-          protocol::get_raw(report, protocol::signal::ik_report[1]) == int(protocol::IkOutcome::converged)) {
+    cdcr::hal::CanFrame frame;
+    while (host.receive(frame) == cdcr::hal::CanStatus::ok) {
+      protocol::IkReport report;
+      if (protocol::decode(frame, report) == protocol::DecodeStatus::ok &&
+          report.outcome == protocol::IkOutcome::converged) {
         ++targets_converged;
       }
     }

@@ -97,7 +97,7 @@ void report(const char* name, std::uint32_t* counts, int count) {
 model::CableVector<float> golden_cables(int c) {
   model::CableVector<float> cables(4 * golden::kSegments);
   for (int k = 0; k < cables.size(); ++k) {
-    cables[k] = static_cast<float>(golden::kCablesRaw[c][k] * cdcr::firmware::protocol::kLengthScaleMm);
+    cables[k] = static_cast<float>(golden::kCablesMm[c][k]);
   }
   return cables;
 }
@@ -111,18 +111,12 @@ void deliver_pose_target(const model::Pose<float>& target, std::uint8_t sequence
   namespace protocol = cdcr::firmware::protocol;
   Eigen::Quaternion<float> q(target.rotation);
   q.normalize();
-  cdcr::hal::CanFrame frame = protocol::make_frame(protocol::kTargetOrientationId, 8);
-  const float components[4] = {q.w(), q.x(), q.y(), q.z()};
-  for (int k = 0; k < 4; ++k) protocol::put(frame, protocol::signal::quaternion[k], components[k]);
+  cdcr::hal::CanFrame frame;
+  protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, frame);
   board.can.deliver(frame);
-  frame = protocol::make_frame(protocol::kTargetPositionXyId, 8);
-  protocol::put(frame, protocol::signal::position_xy[0], target.position_mm.x());
-  protocol::put(frame, protocol::signal::position_xy[1], target.position_mm.y());
+  protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
   board.can.deliver(frame);
-  frame = protocol::make_frame(protocol::kTargetPositionZId, 6);
-  protocol::put(frame, protocol::signal::target_z[0], target.position_mm.z());
-  protocol::put_raw(frame, protocol::signal::target_z[1], static_cast<std::int64_t>(protocol::TargetMode::pose));
-  protocol::put_raw(frame, protocol::signal::target_z[2], sequence);
+  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), protocol::TargetMode::pose, false, sequence}, frame);
   board.can.deliver(frame);
 }
 

@@ -42,13 +42,12 @@ inline PoseDeviation deviation(const model::Pose<float>& pose, const model::Pose
 // One cable feedback frame per segment, as the drives send them.
 template <typename Can>
 void deliver_cables(Can& can, int golden_case) {
+  const double* lengths_mm = qemu_golden::kCablesMm[golden_case];
   for (int s = 0; s < qemu_golden::kSegments; ++s) {
-    hal::CanFrame frame = firmware::protocol::make_frame(firmware::protocol::kCableFeedbackBaseId + std::uint32_t(s), 8);
-    for (int k = 0; k < 4; ++k) {
-      firmware::protocol::put_raw(frame, firmware::protocol::signal::cable[k],
-                                  qemu_golden::kCablesRaw[golden_case][4 * s + k]);
-    }
-    can.deliver(frame);
+    const firmware::protocol::CableFeedback feedback{
+        s, {lengths_mm[4 * s], lengths_mm[4 * s + 1], lengths_mm[4 * s + 2], lengths_mm[4 * s + 3]}};
+    hal::CanFrame frame;
+    if (firmware::protocol::encode(feedback, frame)) can.deliver(frame);
   }
 }
 

@@ -73,37 +73,40 @@ struct BusView {
   int status_frames = 0;
   int reported_state = -1;
   int reported_fault = -1;
-  int reported_detail = -1;
+  cdcr::firmware::FaultDetail reported_detail;
 };
 
+// Every frame the runtime sent, decoded; STATS follows the STATUS whose
+// FAULT types its detail.
 void drain(BusView& bus) {
   cdcr::hal::CanFrame frame;
+  protocol::PosePositionXy xy;
+  protocol::PosePositionZ z;
+  protocol::PoseOrientation orientation;
+  protocol::Status status;
+  protocol::Stats stats;
+  constexpr protocol::DecodeStatus ok = protocol::DecodeStatus::ok;
   while (board.can.take_transmitted(frame)) {
-    switch (frame.id) {
-      case protocol::kPosePositionXyId:
-        bus.position_mm[0] = protocol::get(frame, protocol::signal::position_xy[0]);
-        bus.position_mm[1] = protocol::get(frame, protocol::signal::position_xy[1]);
-        bus.pose_frames += 1;
-        break;
-      case protocol::kPosePositionZId:
-        bus.position_mm[2] = protocol::get(frame, protocol::signal::pose_z[0]);
-        bus.compensated_flag = protocol::get_raw(frame, protocol::signal::pose_z[1]) & protocol::kPoseFlagCompensated;
-        bus.pose_frames += 1;
-        break;
-      case protocol::kPoseOrientationId:
-        for (int k = 0; k < 4; ++k) bus.quaternion[k] = protocol::get(frame, protocol::signal::quaternion[k]);
-        bus.pose_frames += 1;
-        break;
-      case protocol::kStatusId:
-        bus.reported_state = static_cast<int>(protocol::get_raw(frame, protocol::signal::status[0]));
-        bus.reported_fault = static_cast<int>(protocol::get_raw(frame, protocol::signal::status[1]));
-        bus.status_frames += 1;
-        break;
-      case protocol::kStatsId:
-        bus.reported_detail = static_cast<int>(protocol::get_raw(frame, protocol::signal::stats[3]));
-        break;
-      default:
-        break;
+    if (protocol::decode(frame, xy) == ok) {
+      bus.position_mm[0] = xy.x_mm;
+      bus.position_mm[1] = xy.y_mm;
+      bus.pose_frames += 1;
+    } else if (protocol::decode(frame, z) == ok) {
+      bus.position_mm[2] = z.z_mm;
+      bus.compensated_flag = z.compensated;
+      bus.pose_frames += 1;
+    } else if (protocol::decode(frame, orientation) == ok) {
+      bus.quaternion[0] = orientation.qw;
+      bus.quaternion[1] = orientation.qx;
+      bus.quaternion[2] = orientation.qy;
+      bus.quaternion[3] = orientation.qz;
+      bus.pose_frames += 1;
+    } else if (protocol::decode(frame, status) == ok) {
+      bus.reported_state = static_cast<int>(status.state);
+      bus.reported_fault = static_cast<int>(status.fault);
+      bus.status_frames += 1;
+    } else if (protocol::decode(frame, static_cast<FaultCode>(bus.reported_fault), stats) == ok) {
+      bus.reported_detail = stats.fault_detail;
     }
   }
 }
@@ -152,12 +155,12 @@ int main() {
   console::console_write(" (");
   console::console_write(cdcr::firmware::to_string(runtime.boot_fault()));
   console::console_write("), detail ");
-  console::console_write_int(runtime.boot_fault_detail());
+  console::console_write_int(runtime.boot_fault_detail().wire_value());
   console::console_write("\n");
   check(state == kExpectedState, "unexpected state after boot");
   check(runtime.boot_fault() == kExpectedFault, "unexpected boot fault");
   if (kExpectDegraded) {
-    check(runtime.boot_fault_detail() == static_cast<int>(cdcr::model::ImageStatus::checksum_mismatch),
+    check(runtime.boot_fault_detail() == cdcr::firmware::FaultDetail(cdcr::model::ImageStatus::checksum_mismatch),
           "the flipped byte was not caught by the checksum");
   }
 
@@ -218,11 +221,12 @@ int main() {
   console::console_write(", fault ");
   console::console_write_int(bus.reported_fault);
   console::console_write(", detail ");
-  console::console_write_int(bus.reported_detail);
+  console::console_write_int(bus.reported_detail.wire_value());
   console::console_write("\n");
   check(bus.status_frames > 0, "no STATUS frame");
   check(bus.reported_state == static_cast<int>(kExpectedState), "STATUS reports the wrong state");
   check(bus.reported_fault == static_cast<int>(kExpectedFault), "STATUS reports the wrong fault");
+  check(bus.reported_detail == runtime.boot_fault_detail(), "STATS reports the wrong fault detail");
   check(runtime.statistics().rejected_frames == 0, "frames were rejected");
 
   console::console_write("stack: ");

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include "cdcr/cortexm/mailbox_can.hpp"
+#include "cdcr/firmware/protocol/messages.hpp"
 
 namespace cdcr::cortexm {
 namespace {
@@ -18,7 +19,8 @@ hal::CanFrame frame(std::uint32_t id, std::uint8_t first_byte = 0) {
 
 TEST(MailboxCan, DeliversInOrderThroughTheFilters) {
   MailboxCan<8, 2> can;
-  const hal::CanFilter filters[] = {{0x100, 0x7F8}, {0x120, 0x7FC}};
+  // The runtime's filters: cable feedback 0x100..0x107, targets 0x120..0x123.
+  const hal::CanFilter filters[] = {firmware::protocol::kCableFeedbackFrames, firmware::protocol::kTargetFrames};
   ASSERT_TRUE(can.set_filters(filters, 2));
   for (std::uint32_t id : {0x100u, 0x0FFu, 0x107u, 0x108u, 0x123u, 0x124u}) can.deliver(frame(id));
   hal::CanFrame received;

@@ -1,6 +1,7 @@
 #pragma once
 // The runtime's states and the one list of fault codes it reports (in the
-// STATUS frame, FAULT signal; the STATS frame's FAULT_DETAIL refines some).
+// STATUS frame, FAULT signal; the STATS frame's FAULT_DETAIL refines some,
+// see fault_detail.hpp).
 
 #include <cstdint>
 
@@ -24,6 +25,8 @@ enum class FaultCode : std::uint8_t {
   target_malformed = 7,        // last target frame refused: wrong DLC, NaN, non-unit quaternion, out of sequence
   target_unreachable = 8,      // last IK request did not converge; setpoints held; detail = model::Status
   can_transmit_failed = 9,     // a frame could not be queued for transmission
+  can_filters_refused = 10,    // the controller refused the acceptance filters: the runtime runs and ignores
+                               // foreign frames, but every frame on the bus now costs it a receive
 };
 
 constexpr const char* to_string(RuntimeState state) {
@@ -48,6 +51,7 @@ constexpr const char* to_string(FaultCode code) {
     case FaultCode::target_malformed: return "target frame malformed";
     case FaultCode::target_unreachable: return "target unreachable";
     case FaultCode::can_transmit_failed: return "CAN transmit failed";
+    case FaultCode::can_filters_refused: return "CAN acceptance filters refused";
   }
   return "unknown fault";
 }

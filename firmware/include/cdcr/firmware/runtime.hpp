@@ -6,7 +6,8 @@
 //   BOOT -> RUN       the model image parses and binds: compensated kinematics.
 //   BOOT -> DEGRADED  no usable image: nominal kinematics on the fallback
 //                     geometry, the image's fault code reported in every STATUS.
-//   RUN/DEGRADED -> FAULT  no valid cable set for kStaleInputCycles cycles.
+//   RUN/DEGRADED -> FAULT  a segment's cable feedback silent, or no valid cable
+//                          set, for more than kStaleInputCycles cycles.
 //   FAULT -> RUN/DEGRADED  as soon as a valid cable set arrives again.
 // In FAULT the runtime stops publishing poses and setpoints and refuses new
 // targets; the drives keep the last setpoint they received (holding position
@@ -15,11 +16,13 @@
 // Per cycle: drain up to kMaxRxFramesPerCycle frames (cable feedback, target
 // frames), estimate the pose from the latest cable lengths, solve a committed
 // target, publish, and measure execution time and start jitter on the HAL clock.
+// Every frame goes through the codec in protocol.hpp.
 
 #include <cstdint>
 
 #include "cdcr/firmware/capacity.hpp"
 #include "cdcr/firmware/fault.hpp"
+#include "cdcr/firmware/fault_detail.hpp"
 #include "cdcr/firmware/protocol.hpp"
 #include "cdcr/hal/hal.hpp"
 #include "cdcr/model/compensated_kinematics.hpp"
@@ -66,12 +69,16 @@ struct PoseEstimate {
   bool compensated = false;
 };
 
+// The outcome of the last committed target, as IK_REPORT carries it.
 struct IkReport {
   std::uint8_t sequence = 0;
   protocol::IkOutcome outcome = protocol::IkOutcome::converged;
+  // Not on the bus: for an unreachable target, STATS FAULT_DETAIL carries it.
   model::Status model_status = model::Status::ok;
   int iterations = 0;
+  int cycles = 0;  // cycles spent on the target: 1, as the solver finishes in the cycle the target arrives in
   Scalar position_error_mm = 0;
+  Scalar orientation_error_rad = 0;  // 0 for a position target
 };
 
 class Runtime {
@@ -84,6 +91,9 @@ class Runtime {
   Runtime& operator=(const Runtime&) = delete;
 
   // BOOT: validates the image with the shared parser and sets the CAN filters.
+  // A controller that refuses the filters is a standing fault
+  // (can_filters_refused), not a stop: the runtime ignores the foreign frames
+  // it then receives, and kMaxRxFramesPerCycle bounds that work.
   RuntimeState init();
 
   // One cycle of work for the given release.
@@ -95,10 +105,14 @@ class Runtime {
 
   RuntimeState state() const { return state_; }
   // What STATUS reports: stale input in FAULT, else the last rejection since
-  // the previous STATUS, else the boot fault (image) or none.
+  // the previous STATUS, else the boot fault (image), else refused filters,
+  // else none.
   FaultCode active_fault() const;
+  // What STATS reports with it (fault_detail.hpp).
+  FaultDetail active_fault_detail() const;
   FaultCode boot_fault() const { return boot_fault_; }
-  std::uint8_t boot_fault_detail() const { return boot_fault_detail_; }
+  FaultDetail boot_fault_detail() const { return boot_fault_detail_; }
+  bool can_filters_accepted() const { return can_filters_accepted_; }
   FaultCode last_event() const { return last_event_; }
   const CycleStatistics& statistics() const { return statistics_; }
   const Geometry& geometry() const { return geometry_; }
@@ -111,14 +125,19 @@ class Runtime {
  private:
   void handle_frame(const hal::CanFrame& frame);
   void handle_cable_frame(const hal::CanFrame& frame);
+  void handle_target_orientation(const hal::CanFrame& frame);
+  void handle_target_position(const hal::CanFrame& frame);
   void handle_target_commit(const hal::CanFrame& frame);
   void solve_target(const Pose& target, protocol::TargetMode mode, std::uint8_t sequence);
+  bool segment_current(int segment) const;
+  bool input_stale() const;
   void update_pose();
   void publish_pose();
   void publish_setpoints();
   void publish_ik_report();
   void publish_status();
   void send(const hal::CanFrame& frame);
+  void record_event(FaultCode code, FaultDetail detail = FaultDetail());
   void reject_frame(FaultCode code);
   void enter(RuntimeState next);
 
@@ -130,10 +149,11 @@ class Runtime {
   RuntimeState state_ = RuntimeState::boot;
   RuntimeState mode_ = RuntimeState::boot;  // RUN or DEGRADED: where FAULT returns to
   FaultCode boot_fault_ = FaultCode::none;
-  std::uint8_t boot_fault_detail_ = 0;
+  FaultDetail boot_fault_detail_;
+  bool can_filters_accepted_ = false;
   FaultCode last_event_ = FaultCode::none;
   FaultCode unreported_event_ = FaultCode::none;
-  std::uint8_t last_event_detail_ = 0;
+  FaultDetail last_event_detail_;
 
   std::uint32_t cycle_ = 0;
   Cables latest_cables_mm_;
@@ -145,11 +165,11 @@ class Runtime {
   PoseEstimate latest_pose_;
   bool has_pose_ = false;
 
-  bool pending_xy_ = false;
-  bool pending_orientation_ = false;
-  double pending_x_mm_ = 0;
-  double pending_y_mm_ = 0;
-  double pending_quaternion_[4] = {1, 0, 0, 0};
+  // The parts of a target received before its commit frame.
+  bool has_pending_position_ = false;
+  bool has_pending_orientation_ = false;
+  protocol::TargetPositionXy pending_position_;
+  protocol::TargetOrientation pending_orientation_;
   IkReport last_ik_report_;
   bool has_setpoints_ = false;
   Cables setpoints_mm_;

@@ -1,0 +1,317 @@
+#pragma once
+// The protocol's messages as typed frames: one struct per message, its fields
+// named after the DBC signals, encoded and decoded through the signal table
+// of messages.hpp, so each signal's bits are written down once.
+//
+//   hal::CanFrame frame;
+//   protocol::encode(protocol::TargetPositionZ{z_mm, protocol::TargetMode::pose, false, 7}, frame);
+//   protocol::TargetPositionZ target;
+//   if (protocol::decode(frame, target) == protocol::DecodeStatus::ok) { ... }
+//
+// Encoders saturate what a signal cannot hold (counters, residuals), except
+// cable lengths, which they refuse (a clipped cable length is a wrong one):
+// those encoders return false and leave the frame alone. Decoders check the
+// identifier, the DLC, the reserved bits and every signal's range first, and
+// write the struct only when the frame is well formed.
+
+#include <cstdint>
+
+#include "cdcr/firmware/fault.hpp"
+#include "cdcr/firmware/fault_detail.hpp"
+#include "cdcr/firmware/protocol/message_codec.hpp"
+#include "cdcr/firmware/protocol/messages.hpp"
+#include "cdcr/firmware/protocol/signal_codec.hpp"
+#include "cdcr/hal/can_bus.hpp"
+
+namespace cdcr::firmware::protocol {
+
+// CABLE_FEEDBACK_s and CABLE_SETPOINT_s: the four cable lengths of a segment.
+struct CableFeedback {
+  int segment = 0;
+  double lengths_mm[4] = {};  // L1..L4
+};
+struct CableSetpoint {
+  int segment = 0;
+  double lengths_mm[4] = {};  // L1..L4
+};
+
+struct TargetOrientation {
+  double qw = 1, qx = 0, qy = 0, qz = 0;
+};
+struct TargetPositionXy {
+  double x_mm = 0, y_mm = 0;
+};
+struct TargetPositionZ {
+  double z_mm = 0;
+  TargetMode mode = TargetMode::position;
+  bool tracking = false;
+  std::uint8_t sequence = 0;
+};
+
+struct PosePositionXy {
+  double x_mm = 0, y_mm = 0;
+};
+struct PosePositionZ {
+  double z_mm = 0;
+  bool compensated = false;  // FLAGS bit 0
+  std::uint8_t sequence = 0;
+};
+struct PoseOrientation {
+  double qw = 1, qx = 0, qy = 0, qz = 0;
+};
+
+struct IkReport {
+  std::uint8_t sequence = 0;
+  IkOutcome outcome = IkOutcome::converged;
+  int iterations = 0;                   // saturates at 255
+  int cycles = 0;                       // saturates at 255
+  double position_residual_mm = 0;      // saturates at 65.535 mm; NaN and infinity encode as that
+  double orientation_residual_rad = 0;  // saturates at 0.65535 rad, likewise
+};
+
+struct Status {
+  RuntimeState state = RuntimeState::boot;
+  FaultCode fault = FaultCode::none;
+  std::int64_t overruns = 0;  // the u16 counters saturate
+  std::int64_t exec_max_us = 0;
+  std::int64_t exec_mean_us = 0;
+};
+
+struct Stats {
+  std::int64_t jitter_max_us = 0;  // saturates, as the other counters
+  std::int64_t rejected_frames = 0;
+  std::uint16_t cycle_count = 0;  // wraps
+  FaultDetail fault_detail;        // of the FAULT in the STATUS frame sent with it
+  std::int64_t stale_events = 0;
+};
+
+// Whether a cable length survives the frame: positive after rounding to the
+// 0.01 mm quantum and short of the "not available" mark (655.34 mm at most).
+inline bool cable_length_encodable(double length_mm) {
+  std::int64_t raw = 0;
+  return to_raw_checked(cable_lengths::kL1, length_mm, raw) && raw != 0 && raw != kCableNotAvailableRaw;
+}
+
+// The length a receiver decodes for `length_mm` (which must be encodable).
+inline double cable_length_as_transmitted(double length_mm) { return as_transmitted(cable_lengths::kL1, length_mm); }
+
+namespace cable_frames {
+
+inline bool encode(const MessageSpec& message, int segment, const double (&lengths_mm)[4], hal::CanFrame& frame) {
+  if (segment < 0 || segment >= message.id_count) return false;
+  hal::CanFrame out = empty_frame(message, segment);
+  int k = 0;
+  for (const SignalSpec* signal : message.signals) {
+    if (!cable_length_encodable(lengths_mm[k])) return false;
+    put_saturating(out, *signal, lengths_mm[k++]);
+  }
+  frame = out;
+  return true;
+}
+
+inline DecodeStatus decode(const MessageSpec& message, const hal::CanFrame& frame, int& segment,
+                           double (&lengths_mm)[4]) {
+  if (const DecodeStatus s = check_frame(message, frame); s != DecodeStatus::ok) return s;
+  double decoded_mm[4];
+  int k = 0;
+  for (const SignalSpec* signal : message.signals) {
+    const std::int64_t raw = read_raw(frame, *signal);
+    if (raw == kCableNotAvailableRaw) return DecodeStatus::not_available;
+    if (raw == 0) return DecodeStatus::out_of_range;  // a cable has a length
+    decoded_mm[k++] = to_physical(*signal, raw);
+  }
+  segment = static_cast<int>(frame.id - message.id);
+  for (int i = 0; i < 4; ++i) lengths_mm[i] = decoded_mm[i];
+  return DecodeStatus::ok;
+}
+
+}  // namespace cable_frames
+
+inline bool encode(const CableFeedback& f, hal::CanFrame& frame) {
+  return cable_frames::encode(cable_feedback::kMessage, f.segment, f.lengths_mm, frame);
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, CableFeedback& f) {
+  return cable_frames::decode(cable_feedback::kMessage, frame, f.segment, f.lengths_mm);
+}
+inline bool encode(const CableSetpoint& f, hal::CanFrame& frame) {
+  return cable_frames::encode(cable_setpoint::kMessage, f.segment, f.lengths_mm, frame);
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, CableSetpoint& f) {
+  return cable_frames::decode(cable_setpoint::kMessage, frame, f.segment, f.lengths_mm);
+}
+
+namespace quaternion_frames {
+
+inline void encode(const MessageSpec& message, double qw, double qx, double qy, double qz, hal::CanFrame& frame) {
+  frame = empty_frame(message);
+  put_saturating(frame, quaternion::kQw, qw);
+  put_saturating(frame, quaternion::kQx, qx);
+  put_saturating(frame, quaternion::kQy, qy);
+  put_saturating(frame, quaternion::kQz, qz);
+}
+
+template <typename Frame>
+DecodeStatus decode(const MessageSpec& message, const hal::CanFrame& frame, Frame& out) {
+  if (const DecodeStatus s = check_frame(message, frame); s != DecodeStatus::ok) return s;
+  out.qw = get_physical(frame, quaternion::kQw);
+  out.qx = get_physical(frame, quaternion::kQx);
+  out.qy = get_physical(frame, quaternion::kQy);
+  out.qz = get_physical(frame, quaternion::kQz);
+  return DecodeStatus::ok;
+}
+
+}  // namespace quaternion_frames
+
+namespace position_xy_frames {
+
+inline void encode(const MessageSpec& message, double x_mm, double y_mm, hal::CanFrame& frame) {
+  frame = empty_frame(message);
+  put_saturating(frame, position_xy::kX, x_mm);
+  put_saturating(frame, position_xy::kY, y_mm);
+}
+
+template <typename Frame>
+DecodeStatus decode(const MessageSpec& message, const hal::CanFrame& frame, Frame& out) {
+  if (const DecodeStatus s = check_frame(message, frame); s != DecodeStatus::ok) return s;
+  out.x_mm = get_physical(frame, position_xy::kX);
+  out.y_mm = get_physical(frame, position_xy::kY);
+  return DecodeStatus::ok;
+}
+
+}  // namespace position_xy_frames
+
+inline void encode(const TargetOrientation& f, hal::CanFrame& frame) {
+  quaternion_frames::encode(target_orientation::kMessage, f.qw, f.qx, f.qy, f.qz, frame);
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, TargetOrientation& f) {
+  return quaternion_frames::decode(target_orientation::kMessage, frame, f);
+}
+inline void encode(const PoseOrientation& f, hal::CanFrame& frame) {
+  quaternion_frames::encode(pose_orientation::kMessage, f.qw, f.qx, f.qy, f.qz, frame);
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, PoseOrientation& f) {
+  return quaternion_frames::decode(pose_orientation::kMessage, frame, f);
+}
+
+inline void encode(const TargetPositionXy& f, hal::CanFrame& frame) {
+  position_xy_frames::encode(target_position_xy::kMessage, f.x_mm, f.y_mm, frame);
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, TargetPositionXy& f) {
+  return position_xy_frames::decode(target_position_xy::kMessage, frame, f);
+}
+inline void encode(const PosePositionXy& f, hal::CanFrame& frame) {
+  position_xy_frames::encode(pose_position_xy::kMessage, f.x_mm, f.y_mm, frame);
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, PosePositionXy& f) {
+  return position_xy_frames::decode(pose_position_xy::kMessage, frame, f);
+}
+
+inline void encode(const TargetPositionZ& f, hal::CanFrame& frame) {
+  using namespace target_position_z;
+  frame = empty_frame(kMessage);
+  put_saturating(frame, kZ, f.z_mm);
+  put_integer(frame, kMode, static_cast<std::int64_t>(f.mode));
+  put_integer(frame, kTracking, f.tracking ? 1 : 0);
+  put_integer(frame, kSequence, f.sequence);
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, TargetPositionZ& f) {
+  using namespace target_position_z;
+  if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
+  f.z_mm = get_physical(frame, kZ);
+  f.mode = static_cast<TargetMode>(read_raw(frame, kMode));
+  f.tracking = read_raw(frame, kTracking) != 0;
+  f.sequence = static_cast<std::uint8_t>(read_raw(frame, kSequence));
+  return DecodeStatus::ok;
+}
+
+// The SEQUENCE of a TARGET_POSITION_Z frame that did not decode, so that
+// the rejection can name its target; 0 when the frame is too short to hold one.
+inline std::uint8_t commit_sequence(const hal::CanFrame& frame) {
+  const SignalSpec& sequence = target_position_z::kSequence;
+  if (8 * frame.dlc < sequence.start_bit + sequence.length_bits) return 0;
+  return static_cast<std::uint8_t>(read_raw(frame, sequence));
+}
+
+inline void encode(const PosePositionZ& f, hal::CanFrame& frame) {
+  using namespace pose_position_z;
+  frame = empty_frame(kMessage);
+  put_saturating(frame, kZ, f.z_mm);
+  put_integer(frame, kFlags, f.compensated ? kFlagCompensated : 0);
+  put_integer(frame, kSequence, f.sequence);
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, PosePositionZ& f) {
+  using namespace pose_position_z;
+  if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
+  const std::int64_t flags = read_raw(frame, kFlags);
+  if ((flags & ~kFlagCompensated) != 0) return DecodeStatus::reserved_bits_set;
+  f.z_mm = get_physical(frame, kZ);
+  f.compensated = (flags & kFlagCompensated) != 0;
+  f.sequence = static_cast<std::uint8_t>(read_raw(frame, kSequence));
+  return DecodeStatus::ok;
+}
+
+inline void encode(const IkReport& f, hal::CanFrame& frame) {
+  using namespace ik_report;
+  frame = empty_frame(kMessage);
+  put_integer(frame, kSequence, f.sequence);
+  put_integer(frame, kOutcome, static_cast<std::int64_t>(f.outcome));
+  put_integer(frame, kIterations, f.iterations);
+  put_integer(frame, kCycles, f.cycles);
+  put_saturating(frame, kPositionResidual, f.position_residual_mm);
+  put_saturating(frame, kOrientationResidual, f.orientation_residual_rad);
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, IkReport& f) {
+  using namespace ik_report;
+  if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
+  f.sequence = static_cast<std::uint8_t>(read_raw(frame, kSequence));
+  f.outcome = static_cast<IkOutcome>(read_raw(frame, kOutcome));
+  f.iterations = static_cast<int>(read_raw(frame, kIterations));
+  f.cycles = static_cast<int>(read_raw(frame, kCycles));
+  f.position_residual_mm = get_physical(frame, kPositionResidual);
+  f.orientation_residual_rad = get_physical(frame, kOrientationResidual);
+  return DecodeStatus::ok;
+}
+
+inline void encode(const Status& f, hal::CanFrame& frame) {
+  using namespace status;
+  frame = empty_frame(kMessage);
+  put_integer(frame, kState, static_cast<std::int64_t>(f.state));
+  put_integer(frame, kFault, static_cast<std::int64_t>(f.fault));
+  put_integer(frame, kOverruns, f.overruns);
+  put_integer(frame, kExecMax, f.exec_max_us);
+  put_integer(frame, kExecMean, f.exec_mean_us);
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, Status& f) {
+  using namespace status;
+  if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
+  f.state = static_cast<RuntimeState>(read_raw(frame, kState));
+  f.fault = static_cast<FaultCode>(read_raw(frame, kFault));
+  f.overruns = read_raw(frame, kOverruns);
+  f.exec_max_us = read_raw(frame, kExecMax);
+  f.exec_mean_us = read_raw(frame, kExecMean);
+  return DecodeStatus::ok;
+}
+
+inline void encode(const Stats& f, hal::CanFrame& frame) {
+  using namespace stats;
+  frame = empty_frame(kMessage);
+  put_integer(frame, kJitterMax, f.jitter_max_us);
+  put_integer(frame, kRejectedFrames, f.rejected_frames);
+  put_integer(frame, kCycleCount, f.cycle_count);
+  put_integer(frame, kFaultDetail, f.fault_detail.wire_value());
+  put_integer(frame, kStaleEvents, f.stale_events);
+}
+// FAULT_DETAIL means something only with the FAULT it details: `reported_fault`
+// is the FAULT of the STATUS frame sent with this one.
+inline DecodeStatus decode(const hal::CanFrame& frame, FaultCode reported_fault, Stats& f) {
+  using namespace stats;
+  if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
+  f.jitter_max_us = read_raw(frame, kJitterMax);
+  f.rejected_frames = read_raw(frame, kRejectedFrames);
+  f.cycle_count = static_cast<std::uint16_t>(read_raw(frame, kCycleCount));
+  f.fault_detail = FaultDetail::from_wire(reported_fault, static_cast<std::uint8_t>(read_raw(frame, kFaultDetail)));
+  f.stale_events = read_raw(frame, kStaleEvents);
+  return DecodeStatus::ok;
+}
+
+}  // namespace cdcr::firmware::protocol
