@@ -88,6 +88,15 @@ RuntimeState Runtime::init() {
   }
   mode_ = boot_fault_ == FaultCode::none ? RuntimeState::run : RuntimeState::degraded;
   latest_cables_mm_.setZero(4 * geometry_.segment_count);
+  model::IkSolverOptions<Scalar> solver_options;
+  solver_options.max_corrections = kMaxIkCorrections;
+  solver_options.max_iterations = kMaxIkIterations;
+  compensated_solver_.configure(geometry_, correction_, solver_options, kIkWorkCosts);
+  nominal_solver_.configure(geometry_, no_correction_, solver_options, kIkWorkCosts);
+  // The forward path spends one unit per training point; IK gets the rest.
+  const std::uint32_t forward_units = mode_ == RuntimeState::run ? correction_.training_points() : 0;
+  ik_units_per_cycle_ = forward_units + kMinIkUnitsPerCycle < kCycleWorkUnits ? kCycleWorkUnits - forward_units
+                                                                               : kMinIkUnitsPerCycle;
   enter(mode_);
   if (boot_fault_ != FaultCode::none) {
     LogLine line;
@@ -147,6 +156,8 @@ void Runtime::run_cycle(const hal::TimerTick& tick) {
 
   if (state_ != RuntimeState::boot) update_pose();
   if (cycle_ % kStatusEveryCycles == 0) publish_status();
+  // IK last: the pose, STATUS and the staleness check never wait for it.
+  if (solving_) continue_solve();
 
   const std::int64_t end_ns = hal_.clock.now_ns();
   const std::int64_t execution_ns = end_ns - start_ns;
@@ -236,6 +247,7 @@ void Runtime::update_pose() {
   if (state_ != RuntimeState::fault && input_stale()) {
     statistics_.stale_events += 1;
     enter(RuntimeState::fault);
+    if (solving_) end_solve(protocol::IkOutcome::aborted_fault);
   }
 }
 
@@ -272,14 +284,24 @@ void Runtime::handle_target_commit(const hal::CanFrame& frame) {
   } else if (state_ == RuntimeState::fault || state_ == RuntimeState::boot) {
     last_ik_report_.outcome = protocol::IkOutcome::rejected_state;
   } else {
-    // TRACKING changes nothing here: the solver warm-starts from the last
-    // solution for every target, and finishes within this cycle.
-    solve_target(target, commit.mode, commit.sequence);
+    start_solve(target, commit);
+    return;  // reported when it ends
   }
   publish_ik_report();
 }
 
-void Runtime::solve_target(const Pose& target, protocol::TargetMode mode, std::uint8_t sequence) {
+// The solver of the current mode: compensated in RUN, nominal in DEGRADED.
+template <typename Work>
+static void with_solver(RuntimeState mode, CompensatedSolver& compensated, NominalSolver& nominal, Work&& work) {
+  if (mode == RuntimeState::run) {
+    work(compensated);
+  } else {
+    work(nominal);
+  }
+}
+
+void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& commit) {
+  if (solving_) end_solve(protocol::IkOutcome::superseded);
   Joints initial(2 * geometry_.segment_count);
   if (has_setpoints_) {
     initial = setpoint_joints_;
@@ -292,42 +314,121 @@ void Runtime::solve_target(const Pose& target, protocol::TargetMode mode, std::u
       initial[2 * s + 1] = Scalar(0.1);
     }
   }
-  model::IkOptions<Scalar> options;
-  options.max_iterations = kMaxIkIterations;
-  model::IkResult<Scalar, kMaxSegments> result;
-  const bool compensated = mode_ == RuntimeState::run;
-  if (mode == protocol::TargetMode::pose) {
-    result = compensated ? model::solve_ik(target, geometry_, initial, options, correction_)
-                         : model::solve_ik(target, geometry_, initial, options);
-  } else {
-    result = compensated ? model::solve_ik_position(target.position_mm, geometry_, initial, options, correction_)
-                         : model::solve_ik_position(target.position_mm, geometry_, initial, options);
-  }
-  last_ik_report_.sequence = sequence;
-  last_ik_report_.model_status = result.status;
-  last_ik_report_.iterations = result.iterations;
-  last_ik_report_.cycles = 1;
-  last_ik_report_.position_error_mm = result.position_error_mm;
-  last_ik_report_.orientation_error_rad = mode == protocol::TargetMode::pose ? result.orientation_error_rad : Scalar(0);
-
-  const bool close_enough =
-      result.status == model::Status::ik_not_converged && result.position_error_mm <= kIkAcceptedPositionErrorMm &&
-      (mode == protocol::TargetMode::position || result.orientation_error_rad <= kIkAcceptedOrientationErrorRad);
-  bool encodable = result.converged() || close_enough;
-  for (int i = 0; encodable && i < result.cables_mm.size(); ++i) {
-    encodable = protocol::cable_length_encodable(double(result.cables_mm[i]));
-  }
-  if (!encodable) {
-    // Setpoints held: the drives keep the last commanded lengths.
+  const model::IkTargetKind kind =
+      commit.mode == protocol::TargetMode::pose ? model::IkTargetKind::pose : model::IkTargetKind::position;
+  model::Status started = model::Status::ok;
+  with_solver(mode_, compensated_solver_, nominal_solver_, [&](auto& solver) {
+    // A streamed target starts where the last request's best point is, with
+    // the correction there and its slope known; any other from the setpoints.
+    started = commit.tracking ? solver.start_warm(target, kind, initial) : solver.start(target, kind, initial);
+  });
+  solving_sequence_ = commit.sequence;
+  solving_mode_ = commit.mode;
+  solving_tracking_ = commit.tracking;
+  solving_cycles_ = 0;
+  published_best_bend_.resize(0);
+  if (started != model::Status::ok) {
+    last_ik_report_ = IkReport{};
+    last_ik_report_.sequence = commit.sequence;
+    last_ik_report_.model_status = started;
     last_ik_report_.outcome = protocol::IkOutcome::unreachable;
-    record_event(FaultCode::target_unreachable, FaultDetail(result.status));
+    record_event(FaultCode::target_unreachable, FaultDetail(started));
+    publish_ik_report();
     return;
   }
-  last_ik_report_.outcome = protocol::IkOutcome::converged;
-  setpoints_mm_ = result.cables_mm;
-  setpoint_joints_ = result.joints;
+  solving_ = true;
+}
+
+void Runtime::continue_solve() {
+  if (state_ != RuntimeState::run && state_ != RuntimeState::degraded) return;
+  ++solving_cycles_;
+  model::IkSolveState end = model::IkSolveState::running;
+  with_solver(mode_, compensated_solver_, nominal_solver_, [&](auto& solver) {
+    solver.run(ik_units_per_cycle_);
+    end = solver.state();
+    if (end != model::IkSolveState::running || !solving_tracking_ || !solver.has_best()) return;
+    // Streamed targets: the best point so far, when it is close and new.
+    const bool close = solver.best_position_error_mm() <= kTrackingPublishPositionErrorMm &&
+                       (solving_mode_ == protocol::TargetMode::position ||
+                        solver.best_orientation_error_rad() <= kTrackingPublishOrientationErrorRad);
+    const bool is_new = published_best_bend_.size() != solver.best_bend().size() ||
+                        published_best_bend_ != solver.best_bend();
+    if (close && is_new && set_setpoints(solver.best_joints())) {
+      published_best_bend_ = solver.best_bend();
+      publish_setpoints();
+    }
+  });
+  if (end != model::IkSolveState::running) {
+    finish_solve(end);
+  } else if (solving_cycles_ >= kMaxIkCycles) {
+    finish_solve(model::IkSolveState::not_converged);
+  } else if (solving_cycles_ % kIkProgressEveryCycles == 0) {
+    fill_ik_report(protocol::IkOutcome::in_progress);
+    publish_ik_report();
+  }
+}
+
+void Runtime::fill_ik_report(protocol::IkOutcome outcome) {
+  last_ik_report_ = IkReport{};
+  last_ik_report_.sequence = solving_sequence_;
+  last_ik_report_.outcome = outcome;
+  last_ik_report_.cycles = solving_cycles_;
+  with_solver(mode_, compensated_solver_, nominal_solver_, [&](auto& solver) {
+    last_ik_report_.model_status = solver.state() == model::IkSolveState::failed ? solver.status()
+                                   : solver.state() == model::IkSolveState::converged
+                                       ? model::Status::ok
+                                       : model::Status::ik_not_converged;
+    last_ik_report_.iterations = solver.iterations();
+    last_ik_report_.position_error_mm = solver.best_position_error_mm();
+    last_ik_report_.orientation_error_rad =
+        solving_mode_ == protocol::TargetMode::pose ? solver.best_orientation_error_rad() : Scalar(0);
+  });
+}
+
+void Runtime::finish_solve(model::IkSolveState end) {
+  bool reached = false;
+  Joints joints;
+  with_solver(mode_, compensated_solver_, nominal_solver_, [&](auto& solver) {
+    if (end == model::IkSolveState::failed || !solver.has_best()) return;
+    // A residual within the accepted one counts, even if the solver's own
+    // (float rounding-level) tolerance was not met.
+    reached = end == model::IkSolveState::converged ||
+              (solver.best_position_error_mm() <= kIkAcceptedPositionErrorMm &&
+               (solving_mode_ == protocol::TargetMode::position ||
+                solver.best_orientation_error_rad() <= kIkAcceptedOrientationErrorRad));
+    joints = solver.best_joints();
+  });
+  fill_ik_report(protocol::IkOutcome::converged);
+  if (end != model::IkSolveState::converged && end != model::IkSolveState::failed) {
+    last_ik_report_.model_status = model::Status::ik_not_converged;
+  }
+  if (reached && set_setpoints(joints)) {
+    publish_setpoints();
+  } else {
+    // Setpoints held: the drives keep the last commanded lengths.
+    last_ik_report_.outcome = protocol::IkOutcome::unreachable;
+    record_event(FaultCode::target_unreachable, FaultDetail(last_ik_report_.model_status));
+  }
+  solving_ = false;
+  publish_ik_report();
+}
+
+void Runtime::end_solve(protocol::IkOutcome outcome) {
+  fill_ik_report(outcome);
+  solving_ = false;
+  publish_ik_report();
+}
+
+bool Runtime::set_setpoints(const Joints& joints) {
+  Cables cables;
+  if (model::cables_from_joints(joints, geometry_, cables) != model::Status::ok) return false;
+  for (int i = 0; i < cables.size(); ++i) {
+    if (!protocol::cable_length_encodable(double(cables[i]))) return false;
+  }
+  setpoints_mm_ = cables;
+  setpoint_joints_ = joints;
   has_setpoints_ = true;
-  publish_setpoints();
+  return true;
 }
 
 void Runtime::publish_pose() {
@@ -351,6 +452,7 @@ void Runtime::publish_setpoints() {
     hal::CanFrame frame;
     if (protocol::encode(setpoint, frame)) send(frame);
   }
+  setpoints_published_ += 1;
 }
 
 void Runtime::publish_ik_report() {

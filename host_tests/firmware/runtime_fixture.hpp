@@ -17,8 +17,10 @@ namespace cdcr::test_support {
 
 // Corrections a few tenths of a millimetre and milliradians: the size of the
 // errors a trained model corrects, so IK behaves as on the robot.
-inline training::TrainedModel small_correction_model() {
-  training::TrainedModel m = synthetic_trained_model();
+inline training::TrainedModel small_correction_model(int training_points = 5) {
+  SyntheticModelOptions options;
+  options.training_points = training_points;
+  training::TrainedModel m = synthetic_trained_model(options);
   for (int k = 0; k < 6; ++k) {
     m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
     m.output_scale[k] *= k < 3 ? 0.1 : 0.001;
@@ -27,6 +29,9 @@ inline training::TrainedModel small_correction_model() {
 }
 
 inline std::vector<std::uint8_t> small_image() { return exporting::write_image(small_correction_model()); }
+
+// A model large enough that a compensated IK request spans several cycles.
+inline std::vector<std::uint8_t> multi_cycle_image() { return exporting::write_image(small_correction_model(600)); }
 
 struct SimulatedPlatform {
   sim::VirtualCanBus bus;

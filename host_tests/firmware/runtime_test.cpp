@@ -195,7 +195,7 @@ TEST_F(RuntimeTest, UnreachableTargetIsReportedAndSetpointsHeld) {
   cycles(3);
   const model::Vec3<Scalar> reachable = runtime->latest_pose().pose.position_mm + model::Vec3<Scalar>(1, 1, 0);
   send_position_target(reachable.x(), reachable.y(), reachable.z(), 1);
-  cycles(1);
+  cycles_until_ik_done();
   ASSERT_TRUE(runtime->has_setpoints());
   const Cables held = runtime->setpoints_mm();
   cycles(5);
@@ -203,17 +203,17 @@ TEST_F(RuntimeTest, UnreachableTargetIsReportedAndSetpointsHeld) {
 
   host_frames();
   send_position_target(900.0, 0.0, 50.0, 2);
-  cycles(1);
+  cycles_until_ik_done();
   EXPECT_EQ(runtime->setpoints_mm(), held);
   EXPECT_EQ(runtime->last_ik_report().model_status, model::Status::ik_not_converged);
   EXPECT_EQ(runtime->last_event(), FaultCode::target_unreachable);
+  protocol::IkReport report;
+  ASSERT_TRUE(last_of(host_frames(), report));
   cycles(kStatusEveryCycles);
   EXPECT_EQ(drives->setpoint_frames(), setpoint_frames);
   EXPECT_EQ(runtime->state(), RuntimeState::run);
 
   const std::vector<hal::CanFrame> frames = host_frames();
-  protocol::IkReport report;
-  ASSERT_TRUE(last_of(frames, report));
   EXPECT_EQ(report.sequence, 2);
   EXPECT_EQ(report.outcome, protocol::IkOutcome::unreachable);
   EXPECT_GT(report.position_residual_mm, 1.0);

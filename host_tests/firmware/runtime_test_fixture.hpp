@@ -42,6 +42,17 @@ class RuntimeTest : public ::testing::Test {
     }
   }
 
+  // Runs cycles until the IK request in progress ends (its final IK_REPORT
+  // is then on the bus); returns the cycles run.
+  int cycles_until_ik_done(int limit = firmware::kMaxIkCycles + 1) {
+    int count = 0;
+    do {
+      cycles(1);
+      ++count;
+    } while (runtime->ik_running() && count < limit);
+    return count;
+  }
+
   void send(const hal::CanFrame& frame) { ASSERT_EQ(platform->host_node.send(frame), hal::CanStatus::ok); }
 
   template <typename Frame>

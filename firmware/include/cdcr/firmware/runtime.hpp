@@ -47,6 +47,8 @@ using Cables = model::CableVector<Scalar, kMaxSegments>;
 using Joints = model::JointVector<Scalar, kMaxSegments>;
 using Correction = model::GpCorrection<Scalar, Accumulator, kMaxSegments>;
 using Pose = model::Pose<Scalar>;
+using CompensatedSolver = model::IkSolver<Scalar, kMaxSegments, Correction>;
+using NominalSolver = model::IkSolver<Scalar, kMaxSegments, model::NoCorrection>;
 
 struct CycleStatistics {
   std::uint32_t cycles = 0;
@@ -76,7 +78,7 @@ struct IkReport {
   // Not on the bus: for an unreachable target, STATS FAULT_DETAIL carries it.
   model::Status model_status = model::Status::ok;
   int iterations = 0;
-  int cycles = 0;  // cycles spent on the target: 1, as the solver finishes in the cycle the target arrives in
+  int cycles = 0;  // cycles spent on the target, the one it arrived in included
   Scalar position_error_mm = 0;
   Scalar orientation_error_rad = 0;  // 0 for a position target
 };
@@ -117,6 +119,11 @@ class Runtime {
   const CycleStatistics& statistics() const { return statistics_; }
   const Geometry& geometry() const { return geometry_; }
   const IkReport& last_ik_report() const { return last_ik_report_; }
+  // A target being solved, and the IK work units a cycle may spend on it.
+  bool ik_running() const { return solving_; }
+  std::uint32_t ik_units_per_cycle() const { return ik_units_per_cycle_; }
+  // Setpoint frames sent, final and best-so-far.
+  std::uint32_t setpoints_published() const { return setpoints_published_; }
   bool has_setpoints() const { return has_setpoints_; }
   const Cables& setpoints_mm() const { return setpoints_mm_; }
   bool has_pose() const { return has_pose_; }
@@ -128,7 +135,12 @@ class Runtime {
   void handle_target_orientation(const hal::CanFrame& frame);
   void handle_target_position(const hal::CanFrame& frame);
   void handle_target_commit(const hal::CanFrame& frame);
-  void solve_target(const Pose& target, protocol::TargetMode mode, std::uint8_t sequence);
+  void start_solve(const Pose& target, const protocol::TargetPositionZ& commit);
+  void continue_solve();
+  void finish_solve(model::IkSolveState end);
+  void end_solve(protocol::IkOutcome outcome);
+  bool set_setpoints(const Joints& joints);
+  void fill_ik_report(protocol::IkOutcome outcome);
   bool segment_current(int segment) const;
   bool input_stale() const;
   void update_pose();
@@ -171,6 +183,18 @@ class Runtime {
   protocol::TargetPositionXy pending_position_;
   protocol::TargetOrientation pending_orientation_;
   IkReport last_ik_report_;
+  // The IK request in progress: one solver per mode, both in static memory.
+  CompensatedSolver compensated_solver_;
+  model::NoCorrection no_correction_;
+  NominalSolver nominal_solver_;
+  bool solving_ = false;
+  bool solving_tracking_ = false;
+  protocol::TargetMode solving_mode_ = protocol::TargetMode::position;
+  std::uint8_t solving_sequence_ = 0;
+  int solving_cycles_ = 0;
+  Joints published_best_bend_;
+  std::uint32_t ik_units_per_cycle_ = kMinIkUnitsPerCycle;
+  std::uint32_t setpoints_published_ = 0;
   bool has_setpoints_ = false;
   Cables setpoints_mm_;
   Joints setpoint_joints_;
