@@ -301,6 +301,8 @@ static void with_solver(RuntimeState mode, CompensatedSolver& compensated, Nomin
 }
 
 void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& commit) {
+  // A streamed target continues the running streamed request's work.
+  const bool retarget = solving_ && solving_tracking_ && commit.tracking;
   if (solving_) end_solve(protocol::IkOutcome::superseded);
   Joints initial(2 * geometry_.segment_count);
   if (has_setpoints_) {
@@ -320,7 +322,9 @@ void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& c
   with_solver(mode_, compensated_solver_, nominal_solver_, [&](auto& solver) {
     // A streamed target starts where the last request's best point is, with
     // the correction there and its slope known; any other from the setpoints.
-    started = commit.tracking ? solver.start_warm(target, kind, initial) : solver.start(target, kind, initial);
+    started = retarget          ? solver.retarget(target, kind, initial)
+              : commit.tracking ? solver.start_warm(target, kind, initial)
+                                : solver.start(target, kind, initial);
   });
   solving_sequence_ = commit.sequence;
   solving_mode_ = commit.mode;

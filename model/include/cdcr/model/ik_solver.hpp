@@ -265,6 +265,32 @@ class IkSolver {
     return status_;
   }
 
+  // Moves the target of a running solve (a stream of targets along a path):
+  // the work in progress is kept, since a correction evaluation does not
+  // depend on the target; the best point is re-scored against the new
+  // target, and the bounds count afresh. Not running: as start_warm().
+  Status retarget(const Pose<S>& target, IkTargetKind kind, const Joints& fallback_joints) {
+    if (state_ != IkSolveState::running) return start_warm(target, kind, fallback_joints);
+    if (!target.all_finite()) return fail(Status::non_finite_input);
+    target_ = target;
+    kind_ = kind;
+    corrections_ = 0;
+    iterations_ = 0;
+    restarts_ = 0;
+    units_spent_ = 0;
+    have_previous_ = false;
+    stalled_outer_ = 0;
+    const Pose<S> tip = exp(warm_eps_) * forward_kinematics_bend(warm_bend_, *geometry_);
+    Residual residual;
+    residual_of(tip, residual, best_position_error_, best_orientation_error_);
+    best_cost_ = residual.squaredNorm();
+    best_bend_ = warm_bend_;
+    // A linearised solve aimed at the old target ends here; its point is
+    // evaluated next.
+    if (phase_ == Phase::inner) begin_outer(inner_bend_);
+    return status_;
+  }
+
   // Does whole steps while their cost fits in `budget` units; returns the
   // units spent (0 when nothing fits or nothing is left to do). A correction
   // evaluation is sliced to fit; a nominal iteration runs only when its whole

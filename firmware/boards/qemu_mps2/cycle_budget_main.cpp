@@ -1,0 +1,323 @@
+// The cycle budget on the board: thousands of consecutive Runtime::run_cycle
+// calls, each counted in instructions (QEMU -icount, as cycle_bench_main),
+// over a workload that mixes everything a cycle can meet:
+//   forward-only cycles; position and pose targets anywhere in the paper's
+//   workspace, and pose targets over the full design range; unreachable
+//   targets; a streamed circle (a TRACKING target every cycle, 100 mm/s);
+//   targets superseded every few cycles; a drive falling silent (FAULT) and
+//   coming back.
+// The drives are ideal: each cycle they report the last setpoints they got.
+// Targets are made on the board from random joints with the runtime's own
+// model (not counted). Prints `worst cycle: N instructions over C cycles`
+// and the latency figures in cycles, and fails when a cycle exceeds the
+// board's budget (80,000 instructions on the Cortex-M7, 120,000 on the
+// Cortex-M4F).
+
+#include <algorithm>
+#include <cmath>
+
+#include <cdcr/cortexm/semihosting.hpp>
+#include <cdcr/firmware/runtime.hpp>
+
+#include "board.hpp"
+#include "golden_check.hpp"
+
+namespace {
+
+namespace console = cdcr::cortexm;
+namespace model = cdcr::model;
+namespace firmware = cdcr::firmware;
+namespace protocol = cdcr::firmware::protocol;
+
+#if defined(__ARM_FP) && !(__ARM_FP & 0x8)
+constexpr std::uint32_t kBudgetInstructions = 120'000;  // Cortex-M4F
+#else
+constexpr std::uint32_t kBudgetInstructions = 80'000;  // Cortex-M7
+#endif
+constexpr int kIcountShift = 10;
+constexpr std::int64_t kCountingPeriodNs = 600'000'000;
+
+cdcr::boards::mps2::Board board;
+firmware::Runtime runtime(board.hal(), cdcr::boards::mps2::golden_geometry());
+firmware::Correction correction;
+
+std::uint64_t overhead_ticks = 0;
+
+std::uint32_t ticks_to_instructions(std::uint64_t ticks) {
+  const std::uint64_t ns = ticks * (1'000'000'000u / cdcr::boards::mps2::kCoreClockHz);
+  return static_cast<std::uint32_t>((ns + (1u << (kIcountShift - 1))) >> kIcountShift);
+}
+
+__attribute__((noinline)) void run_cycle_opaque(const cdcr::hal::TimerTick& tick) { runtime.run_cycle(tick); }
+
+std::uint32_t counted_cycle() {
+  const cdcr::hal::TimerTick tick{board.timer.now_ns(), 0};
+  asm volatile("" ::: "memory");
+  const std::uint64_t start = board.timer.now_ticks();
+  asm volatile("" ::: "memory");
+  run_cycle_opaque(tick);
+  asm volatile("" ::: "memory");
+  const std::uint64_t end = board.timer.now_ticks();
+  asm volatile("" ::: "memory");
+  const std::uint64_t ticks = end - start;
+  return ticks_to_instructions(ticks > overhead_ticks ? ticks - overhead_ticks : 0);
+}
+
+// xorshift32: the same workload on every run and both boards.
+std::uint32_t rng_state = 0x2545F491u;
+float uniform(float lo, float hi) {
+  rng_state ^= rng_state << 13;
+  rng_state ^= rng_state >> 17;
+  rng_state ^= rng_state << 5;
+  return lo + (hi - lo) * float(rng_state >> 8) * (1.0f / 16777216.0f);
+}
+
+// The ideal drives: the last setpoint of each segment, reported every cycle.
+float drive_lengths_mm[firmware::kMaxSegments][4];
+int segments = 0;
+int silent_segment = -1;
+
+void exchange_with_drives() {
+  cdcr::hal::CanFrame frame;
+  while (board.can.take_transmitted(frame)) {
+    protocol::CableSetpoint setpoint;
+    if (protocol::decode(frame, setpoint) != protocol::DecodeStatus::ok) continue;
+    for (int k = 0; k < 4; ++k) drive_lengths_mm[setpoint.segment][k] = float(setpoint.lengths_mm[k]);
+  }
+  for (int s = 0; s < segments; ++s) {
+    if (s == silent_segment) continue;
+    protocol::CableFeedback feedback{s, {drive_lengths_mm[s][0], drive_lengths_mm[s][1], drive_lengths_mm[s][2],
+                                         drive_lengths_mm[s][3]}};
+    if (protocol::encode(feedback, frame)) board.can.deliver(frame);
+  }
+}
+
+void deliver_target(const model::Pose<float>& target, protocol::TargetMode mode, bool tracking,
+                    std::uint8_t sequence) {
+  cdcr::hal::CanFrame frame;
+  if (mode == protocol::TargetMode::pose) {
+    Eigen::Quaternion<float> q(target.rotation);
+    q.normalize();
+    protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, frame);
+    board.can.deliver(frame);
+  }
+  protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
+  board.can.deliver(frame);
+  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), mode, tracking, sequence}, frame);
+  board.can.deliver(frame);
+}
+
+// Where the compensated model puts the tip for random joints.
+model::Pose<float> reachable_target(float theta_max_rad) {
+  model::JointVector<float> joints(2 * segments);
+  for (int s = 0; s < segments; ++s) {
+    joints[2 * s] = uniform(-3.14159f, 3.14159f);
+    joints[2 * s + 1] = uniform(0.0f, std::min(theta_max_rad, runtime.geometry().segments[s].theta_max_rad));
+  }
+  const model::JointVector<float> bend = model::bend_from_joints(joints);
+  return model::exp(correction.predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
+}
+
+// Latencies in cycles, per kind of request.
+constexpr int kMaxSamples = 400;
+struct Latencies {
+  const char* name;
+  std::uint16_t cycles[kMaxSamples];
+  int count = 0;
+  int converged = 0;
+  void add(int spent, bool ok) {
+    if (count < kMaxSamples) cycles[count++] = static_cast<std::uint16_t>(spent);
+    converged += ok ? 1 : 0;
+  }
+  void report() {
+    if (count == 0) return;
+    std::sort(cycles, cycles + count);
+    console::console_write("latency ");
+    console::console_write(name);
+    console::console_write(": n ");
+    console::console_write_int(count);
+    console::console_write(" converged ");
+    console::console_write_int(converged);
+    console::console_write(" p50 ");
+    console::console_write_int(cycles[count / 2]);
+    console::console_write(" p99 ");
+    console::console_write_int(cycles[std::min(count - 1, (count * 99) / 100)]);
+    console::console_write(" max ");
+    console::console_write_int(cycles[count - 1]);
+    console::console_write(" cycles\n");
+  }
+};
+
+Latencies paper_pose{"paper_pose"};
+Latencies paper_position{"paper_position"};
+Latencies full_range_pose{"full_range_pose"};
+Latencies streamed{"streamed_setpoint_age"};
+
+std::uint32_t worst = 0;
+std::uint32_t cycles_run = 0;
+std::uint32_t over_budget = 0;
+std::uint32_t poses_missing = 0;
+
+// One counted cycle with the drives' exchange around it.
+void cycle() {
+  exchange_with_drives();
+  const std::uint32_t published = runtime.statistics().poses_published;
+  const std::uint32_t instructions = counted_cycle();
+  worst = std::max(worst, instructions);
+  if (instructions > kBudgetInstructions) ++over_budget;
+  if (runtime.state() == firmware::RuntimeState::run && runtime.statistics().poses_published != published + 1) {
+    ++poses_missing;
+  }
+  ++cycles_run;
+}
+
+std::uint8_t next_sequence = 0;
+
+// A target, then cycles until its request ends; returns the cycles spent.
+int solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies* latencies) {
+  const std::uint8_t sequence = next_sequence++;
+  deliver_target(target, mode, false, sequence);
+  int spent = 0;
+  do {
+    cycle();
+    ++spent;
+  } while (runtime.ik_running() && spent < firmware::kMaxIkCycles + 2);
+  const bool ok = runtime.last_ik_report().sequence == sequence &&
+                  runtime.last_ik_report().outcome == protocol::IkOutcome::converged;
+  if (latencies != nullptr) latencies->add(spent, ok);
+  return spent;
+}
+
+}  // namespace
+
+int main() {
+  cdcr::cortexm::attach_systick(board.timer);
+  board.timer.start(kCountingPeriodNs);
+  if (runtime.init() != firmware::RuntimeState::run) {
+    console::console_write("FAIL: the runtime did not boot into RUN\n");
+    return 1;
+  }
+  const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
+  model::ImageView image{};
+  if (model::parse_image(region.data, region.size_bytes, image, model::ImageCapacity{}) != model::ImageStatus::ok ||
+      correction.bind(image) != model::Status::ok) {
+    console::console_write("FAIL: cannot bind the image\n");
+    return 1;
+  }
+  segments = runtime.geometry().segment_count;
+  {
+    const cdcr::hal::TimerTick tick{0, 0};
+    (void)tick;
+    asm volatile("" ::: "memory");
+    const std::uint64_t start = board.timer.now_ticks();
+    asm volatile("" ::: "memory");
+    const std::uint64_t end = board.timer.now_ticks();
+    overhead_ticks = end - start;
+  }
+  console::console_write("model: ");
+  console::console_write_int(static_cast<std::int32_t>(image.training_points));
+  console::console_write(" training points; IK work per cycle ");
+  console::console_write_int(static_cast<std::int32_t>(runtime.ik_units_per_cycle()));
+  console::console_write(" units\n");
+
+  // The drives start where golden case 0 has them.
+  for (int s = 0; s < segments; ++s) {
+    for (int k = 0; k < 4; ++k) drive_lengths_mm[s][k] = float(cdcr::qemu_golden::kCablesMm[0][4 * s + k]);
+  }
+  // Forward-only cycles.
+  for (int i = 0; i < 100; ++i) cycle();
+
+  // Targets anywhere in the paper's workspace, pose and position, with an
+  // unreachable one every eighth.
+  for (int t = 0; t < 60; ++t) {
+    if (t % 8 == 7) {
+      model::Pose<float> far;
+      far.position_mm = model::Vec3<float>(900.0f, 0.0f, 50.0f);
+      solve(far, protocol::TargetMode::position, nullptr);
+    } else if (t % 3 == 0) {
+      solve(reachable_target(0.2f), protocol::TargetMode::position, &paper_position);
+    } else {
+      solve(reachable_target(0.2f), protocol::TargetMode::pose, &paper_pose);
+    }
+  }
+
+  // A streamed circle, 40 mm radius at 100 mm/s: a TRACKING position target
+  // every cycle. First the robot goes to the circle's start.
+  const model::Vec3<float> center = runtime.latest_pose().pose.position_mm - model::Vec3<float>(40.0f, 0.0f, 0.0f);
+  const auto on_circle = [&](int step) {
+    const float angle = 2.5e-3f * float(step);  // 100 mm/s at 1 kHz on a 40 mm radius
+    model::Pose<float> p;
+    p.position_mm = center + model::Vec3<float>(40.0f * std::cos(angle), 40.0f * std::sin(angle), 0.0f);
+    return p;
+  };
+  solve(on_circle(0), protocol::TargetMode::position, nullptr);
+  int arrival_of_setpoint_target = 0;
+  for (int step = 1; step <= 800; ++step) {
+    deliver_target(on_circle(step), protocol::TargetMode::position, true, next_sequence++);
+    const std::uint32_t before = runtime.setpoints_published();
+    cycle();
+    // The age of what the drives were last sent: the target being solved
+    // arrived in this cycle whenever setpoints went out in it.
+    if (runtime.setpoints_published() != before) arrival_of_setpoint_target = step;
+    if (step > 20) streamed.add(step - arrival_of_setpoint_target + 1, true);
+  }
+  while (runtime.ik_running()) cycle();
+
+  // Superseding targets: a new one every 3 cycles.
+  for (int t = 0; t < 40; ++t) {
+    deliver_target(reachable_target(0.2f), t % 2 ? protocol::TargetMode::pose : protocol::TargetMode::position, false,
+                   next_sequence++);
+    for (int i = 0; i < 3; ++i) cycle();
+  }
+  // A drive falls silent while a request runs, and comes back.
+  deliver_target(reachable_target(0.2f), protocol::TargetMode::pose, false, next_sequence++);
+  cycle();
+  silent_segment = segments - 1;
+  for (int i = 0; i < 30; ++i) cycle();
+  const bool faulted = runtime.state() == firmware::RuntimeState::fault;
+  silent_segment = -1;
+  for (int i = 0; i < 10; ++i) cycle();
+  const bool recovered = runtime.state() == firmware::RuntimeState::run;
+  while (runtime.ik_running()) cycle();
+
+  // Pose targets over the full design range, each from a straight start.
+  for (int t = 0; t < 40; ++t) {
+    model::Pose<float> straight_target;
+    straight_target = model::forward_kinematics_bend(model::JointVector<float>::Zero(2 * segments), runtime.geometry());
+    solve(straight_target, protocol::TargetMode::position, nullptr);
+    solve(reachable_target(1.5707963f), protocol::TargetMode::pose, &full_range_pose);
+  }
+
+  paper_pose.report();
+  paper_position.report();
+  full_range_pose.report();
+  streamed.report();
+  console::console_write("worst cycle: ");
+  console::console_write_int(static_cast<std::int32_t>(worst));
+  console::console_write(" instructions over ");
+  console::console_write_int(static_cast<std::int32_t>(cycles_run));
+  console::console_write(" cycles (budget ");
+  console::console_write_int(static_cast<std::int32_t>(kBudgetInstructions));
+  console::console_write(")\n");
+  bool ok = true;
+  if (over_budget > 0) {
+    console::console_write("FAIL: cycles over budget: ");
+    console::console_write_int(static_cast<std::int32_t>(over_budget));
+    console::console_write("\n");
+    ok = false;
+  }
+  if (poses_missing > 0) {
+    console::console_write("FAIL: cycles in RUN without a pose\n");
+    ok = false;
+  }
+  if (!faulted || !recovered) {
+    console::console_write("FAIL: the silent drive did not fault the runtime, or its return did not recover it\n");
+    ok = false;
+  }
+  if (cycles_run < 2000) {
+    console::console_write("FAIL: fewer than 2,000 cycles\n");
+    ok = false;
+  }
+  console::console_write(ok ? "PASS\n" : "FAIL\n");
+  return ok ? 0 : 1;
+}
