@@ -169,6 +169,15 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
         target_error_sum_mm += error_mm;
         target_error_max_mm = std::max(target_error_max_mm, error_mm);
         ++targets_checked;
+        // The request spans cycles: its setpoints are checked when the next
+        // target is due.
+        if (runtime.has_setpoints() && runtime.last_ik_report().outcome == protocol::IkOutcome::converged) {
+          const model::CableVector<double> setpoints_mm = runtime.setpoints_mm().cast<double>();
+          const double setpoint_error_mm = (robot.true_pose(setpoints_mm).position_mm - target_mm).norm();
+          setpoint_target_error_sum_mm += setpoint_error_mm;
+          setpoint_target_error_max_mm = std::max(setpoint_target_error_max_mm, setpoint_error_mm);
+          ++setpoints_checked;
+        }
       }
       // Targets the real robot can reach: where it goes for random cables.
       model::CableVector<double> target_cables;
@@ -193,14 +202,6 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
     // Lockstep time charges the cycle nothing, so the runtime's own overrun
     // count stays zero; this is the count the host's speed would give.
     if (elapsed_ns > period_ns) ++host_overruns;
-    if (k % cycles_per_target == 0 && runtime.has_setpoints() &&
-        runtime.last_ik_report().outcome == protocol::IkOutcome::converged) {
-      model::CableVector<double> setpoints_mm = runtime.setpoints_mm().cast<double>();
-      const double error_mm = (robot.true_pose(setpoints_mm).position_mm - target_mm).norm();
-      setpoint_target_error_sum_mm += error_mm;
-      setpoint_target_error_max_mm = std::max(setpoint_target_error_max_mm, error_mm);
-      ++setpoints_checked;
-    }
     cdcr::hal::CanFrame frame;
     while (host.receive(frame) == cdcr::hal::CanStatus::ok) {
       protocol::IkReport report;

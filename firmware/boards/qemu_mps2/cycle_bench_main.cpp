@@ -11,7 +11,8 @@
 //   compensated_ik  one compensated IK call (pose target, the runtime's
 //                   options) from one golden case's joints to the next's pose
 //   ik_cycle        Runtime::run_cycle with cable frames and a pose target
-//                   waiting: the forward path plus the runtime's IK call
+//                   waiting: the forward path plus the first slice of IK
+//                   (the request then continues over the next cycles)
 // Every count has the cost of reading the counter (an empty measurement)
 // subtracted.
 
@@ -171,9 +172,16 @@ int main() {
     deliver_pose_target(golden_pose((c + 1) % kCases), static_cast<std::uint8_t>(c));
     const cdcr::hal::TimerTick target_tick{board.timer.now_ns(), 0};
     ik_cycle[c] = count_instructions([&] { runtime.run_cycle(target_tick); });
+    drain_transmitted();
+    // The request continues over the next cycles, within the cycle budget.
+    for (int spent = 1; runtime.ik_running() && spent <= cdcr::firmware::kMaxIkCycles; ++spent) {
+      cdcr::boards::mps2::deliver_cables(board.can, c);
+      const cdcr::hal::TimerTick next{board.timer.now_ns(), 0};
+      runtime.run_cycle(next);
+      drain_transmitted();
+    }
     ok = ok && runtime.last_ik_report().sequence == c &&
          runtime.last_ik_report().outcome == cdcr::firmware::protocol::IkOutcome::converged;
-    drain_transmitted();
     // Keep the STATUS heartbeat (every tenth cycle) out of the counted ones.
     while ((runtime.statistics().cycles + 1) % cdcr::firmware::kStatusEveryCycles == 0 ||
            (runtime.statistics().cycles + 2) % cdcr::firmware::kStatusEveryCycles == 0) {
@@ -209,8 +217,12 @@ int main() {
       ik_result = model::solve_ik(target, geometry, start, options, correction);
       keep(ik_result);
     });
-    if (!ik_result.converged()) ++not_converged;
-    ik_per_iteration[c] = ik_result.iterations > 0 ? ik[c] / static_cast<std::uint32_t>(ik_result.iterations) : ik[c];
+    if (!ik_result.converged() && !(ik_result.position_error_mm <= cdcr::firmware::kIkAcceptedPositionErrorMm &&
+                                    ik_result.orientation_error_rad <= cdcr::firmware::kIkAcceptedOrientationErrorRad)) {
+      ++not_converged;
+    }
+    // Per GP evaluation (the solver's outer iteration), the unit of its cost.
+    ik_per_iteration[c] = ik_result.corrections > 0 ? ik[c] / static_cast<std::uint32_t>(ik_result.corrections) : ik[c];
     console::console_write("case ");
     console::console_write_int(c);
     console::console_write(": forward_cycle ");
@@ -219,7 +231,9 @@ int main() {
     console::console_write_int(static_cast<std::int32_t>(ik[c]));
     console::console_write(" in ");
     console::console_write_int(ik_result.iterations);
-    console::console_write(" iterations, position error ");
+    console::console_write(" nominal iterations and ");
+    console::console_write_int(ik_result.corrections);
+    console::console_write(" GP evaluations, position error ");
     console::console_write_fixed(ik_result.position_error_mm, 5);
     console::console_write(" mm\n");
   }
@@ -228,7 +242,7 @@ int main() {
   report("gp_predict", gp, kCases);
   report("nominal_forward", nominal, kCases);
   report("compensated_ik", ik, kCases);
-  report("compensated_ik_per_iteration", ik_per_iteration, kCases);
+  report("compensated_ik_per_gp_evaluation", ik_per_iteration, kCases);
   report("ik_cycle", ik_cycle, kCases);
   // The deepest the runtime goes: a cycle with a compensated IK call.
   console::console_write("stack: ");
