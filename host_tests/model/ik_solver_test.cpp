@@ -69,7 +69,7 @@ TEST(IkSolver, SlicedEvaluationHasTheBitsOfAWholeOne) {
       EXPECT_EQ(f.correction.continue_evaluation(whole, 1u << 20),
                 203u * (with_gradient ? Correction::kGradientPointUnits : 1u));
       int slices = 0;
-      const std::uint32_t budget = with_gradient ? 200 : 20;
+      const std::uint32_t budget = with_gradient ? 300 : 20;
       while (!f.correction.evaluation_finished(sliced)) {
         const std::uint32_t spent = f.correction.continue_evaluation(sliced, budget);
         ASSERT_LE(spent, budget);

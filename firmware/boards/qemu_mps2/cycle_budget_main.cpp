@@ -282,10 +282,10 @@ int main() {
 
   // Pose targets over the full design range, each from a straight start.
   for (int t = 0; t < 40; ++t) {
-    model::Pose<float> straight_target;
-    straight_target = model::forward_kinematics_bend(model::JointVector<float>::Zero(2 * segments), runtime.geometry());
+    const model::JointVector<float> straight = model::JointVector<float>::Zero(2 * segments);
+    const model::Pose<float> straight_target = model::forward_kinematics_bend(straight, runtime.geometry());
     solve(straight_target, protocol::TargetMode::position, nullptr);
-    solve(reachable_target(1.5707963f), protocol::TargetMode::pose, &full_range_pose);
+    solve(reachable_target(0.97f * 1.5707963f), protocol::TargetMode::pose, &full_range_pose);
   }
 
   paper_pose.report();

@@ -42,10 +42,10 @@ inline constexpr int kMaxCanFilters = 4;
 #ifdef CDCR_CYCLE_WORK_UNITS
 inline constexpr std::uint32_t kCycleWorkUnits = CDCR_CYCLE_WORK_UNITS;
 #else
-inline constexpr std::uint32_t kCycleWorkUnits = 1400;
+inline constexpr std::uint32_t kCycleWorkUnits = 1000;
 #endif
-inline constexpr std::uint32_t kMinIkUnitsPerCycle = 400;
-inline constexpr model::IkWorkCosts kIkWorkCosts{160, 60};
+inline constexpr std::uint32_t kMinIkUnitsPerCycle = 300;
+inline constexpr model::IkWorkCosts kIkWorkCosts{300, 100};
 
 // Bounds of one IK request: correction evaluations and nominal LM
 // iterations (see model::IkSolverOptions), and the cycles it may span

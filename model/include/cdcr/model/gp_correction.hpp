@@ -115,7 +115,7 @@ class GpCorrection {
   // training point of the mean is one unit, of the mean with the gradient
   // kGradientPointUnits (the ratio of their instruction counts, measured on
   // the Cortex-M boards).
-  static constexpr std::uint32_t kGradientPointUnits = 3;
+  static constexpr std::uint32_t kGradientPointUnits = 4;
   // The gradient pass goes over chunks of this many training points.
   static constexpr std::uint32_t kChunkPoints = 8 * kBlockPoints;
 
