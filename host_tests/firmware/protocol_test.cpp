@@ -129,7 +129,9 @@ ValueMap codec_values(const SignalSpec& signal) {
 TEST(DbcAgreesWithTheCodec, SameMessages) {
   const auto codec = codec_messages();
   for (const auto& [id, message] : codec) EXPECT_EQ(dbc().messages.count(id), 1u) << "not in the DBC: " << message.name;
-  for (const auto& [id, message] : dbc().messages) EXPECT_EQ(codec.count(id), 1u) << "not in the codec: " << message.name;
+  for (const auto& [id, message] : dbc().messages) {
+    EXPECT_EQ(codec.count(id), 1u) << "not in the codec: " << message.name;
+  }
 }
 
 TEST(DbcAgreesWithTheCodec, SameMessageHeaders) {

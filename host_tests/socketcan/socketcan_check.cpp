@@ -233,7 +233,9 @@ int last_stat(const std::vector<Phase>& phases, int upto_phase, std::int64_t pro
     const auto frames = with_id(phases[p], protocol::stats::kMessage.id);
     for (auto f = frames.rbegin(); f != frames.rend(); ++f) {
       protocol::Stats stats;
-      if (protocol::decode((*f)->frame, FaultCode::none, stats) == protocol::DecodeStatus::ok) return int(stats.*counter);
+      if (protocol::decode((*f)->frame, FaultCode::none, stats) == protocol::DecodeStatus::ok) {
+        return int(stats.*counter);
+      }
     }
   }
   return -1;
@@ -352,7 +354,10 @@ int check(const Model& m, const std::string& log_path) {
              "stale: STATUS goes to FAULT, cable input stale");
     int poses_after = 0;
     for (const LoggedFrame& f : phases[4].frames) {
-      if (first_fault != nullptr && f.time_s > first_fault->time_s && f.frame.id == protocol::pose_orientation::kMessage.id) ++poses_after;
+      if (first_fault != nullptr && f.time_s > first_fault->time_s &&
+          protocol::pose_orientation::kMessage.carries(f.frame.id)) {
+        ++poses_after;
+      }
     }
     c.expect(first_fault != nullptr && poses_after == 0, "stale: no pose published in FAULT");
     const int stale_before = last_stat(phases, 3, &protocol::Stats::stale_events);

@@ -117,7 +117,8 @@ void deliver_pose_target(const model::Pose<float>& target, std::uint8_t sequence
   board.can.deliver(frame);
   protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
   board.can.deliver(frame);
-  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), protocol::TargetMode::pose, false, sequence}, frame);
+  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), protocol::TargetMode::pose, false, sequence},
+                   frame);
   board.can.deliver(frame);
 }
 

@@ -99,23 +99,25 @@ namespace cable_frames {
 
 inline bool encode(const MessageSpec& message, int segment, const double (&lengths_mm)[4], hal::CanFrame& frame) {
   if (segment < 0 || segment >= message.id_count) return false;
-  hal::CanFrame out = empty_frame(message, segment);
+  std::uint64_t word = 0;
   int k = 0;
   for (const SignalSpec* signal : message.signals) {
     if (!cable_length_encodable(lengths_mm[k])) return false;
-    put_saturating(out, *signal, lengths_mm[k++]);
+    word |= placed_saturating(*signal, lengths_mm[k++]);
   }
-  frame = out;
+  frame = empty_frame(message, segment);
+  set_data_word(frame, word);
   return true;
 }
 
 inline DecodeStatus decode(const MessageSpec& message, const hal::CanFrame& frame, int& segment,
                            double (&lengths_mm)[4]) {
   if (const DecodeStatus s = check_frame(message, frame); s != DecodeStatus::ok) return s;
+  const std::uint64_t word = data_word(frame);
   double decoded_mm[4];
   int k = 0;
   for (const SignalSpec* signal : message.signals) {
-    const std::int64_t raw = read_raw(frame, *signal);
+    const std::int64_t raw = raw_in_word(word, *signal);
     if (raw == kCableNotAvailableRaw) return DecodeStatus::not_available;
     if (raw == 0) return DecodeStatus::out_of_range;  // a cable has a length
     decoded_mm[k++] = to_physical(*signal, raw);
@@ -144,19 +146,18 @@ namespace quaternion_frames {
 
 inline void encode(const MessageSpec& message, double qw, double qx, double qy, double qz, hal::CanFrame& frame) {
   frame = empty_frame(message);
-  put_saturating(frame, quaternion::kQw, qw);
-  put_saturating(frame, quaternion::kQx, qx);
-  put_saturating(frame, quaternion::kQy, qy);
-  put_saturating(frame, quaternion::kQz, qz);
+  set_data_word(frame, placed_saturating(quaternion::kQw, qw) | placed_saturating(quaternion::kQx, qx) |
+                           placed_saturating(quaternion::kQy, qy) | placed_saturating(quaternion::kQz, qz));
 }
 
 template <typename Frame>
 DecodeStatus decode(const MessageSpec& message, const hal::CanFrame& frame, Frame& out) {
   if (const DecodeStatus s = check_frame(message, frame); s != DecodeStatus::ok) return s;
-  out.qw = get_physical(frame, quaternion::kQw);
-  out.qx = get_physical(frame, quaternion::kQx);
-  out.qy = get_physical(frame, quaternion::kQy);
-  out.qz = get_physical(frame, quaternion::kQz);
+  const std::uint64_t word = data_word(frame);
+  out.qw = physical_in_word(word, quaternion::kQw);
+  out.qx = physical_in_word(word, quaternion::kQx);
+  out.qy = physical_in_word(word, quaternion::kQy);
+  out.qz = physical_in_word(word, quaternion::kQz);
   return DecodeStatus::ok;
 }
 
@@ -166,15 +167,15 @@ namespace position_xy_frames {
 
 inline void encode(const MessageSpec& message, double x_mm, double y_mm, hal::CanFrame& frame) {
   frame = empty_frame(message);
-  put_saturating(frame, position_xy::kX, x_mm);
-  put_saturating(frame, position_xy::kY, y_mm);
+  set_data_word(frame, placed_saturating(position_xy::kX, x_mm) | placed_saturating(position_xy::kY, y_mm));
 }
 
 template <typename Frame>
 DecodeStatus decode(const MessageSpec& message, const hal::CanFrame& frame, Frame& out) {
   if (const DecodeStatus s = check_frame(message, frame); s != DecodeStatus::ok) return s;
-  out.x_mm = get_physical(frame, position_xy::kX);
-  out.y_mm = get_physical(frame, position_xy::kY);
+  const std::uint64_t word = data_word(frame);
+  out.x_mm = physical_in_word(word, position_xy::kX);
+  out.y_mm = physical_in_word(word, position_xy::kY);
   return DecodeStatus::ok;
 }
 
@@ -209,18 +210,17 @@ inline DecodeStatus decode(const hal::CanFrame& frame, PosePositionXy& f) {
 inline void encode(const TargetPositionZ& f, hal::CanFrame& frame) {
   using namespace target_position_z;
   frame = empty_frame(kMessage);
-  put_saturating(frame, kZ, f.z_mm);
-  put_integer(frame, kMode, static_cast<std::int64_t>(f.mode));
-  put_integer(frame, kTracking, f.tracking ? 1 : 0);
-  put_integer(frame, kSequence, f.sequence);
+  set_data_word(frame, placed_saturating(kZ, f.z_mm) | placed_integer(kMode, static_cast<std::int64_t>(f.mode)) |
+                           placed_integer(kTracking, f.tracking ? 1 : 0) | placed_integer(kSequence, f.sequence));
 }
 inline DecodeStatus decode(const hal::CanFrame& frame, TargetPositionZ& f) {
   using namespace target_position_z;
   if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
-  f.z_mm = get_physical(frame, kZ);
-  f.mode = static_cast<TargetMode>(read_raw(frame, kMode));
-  f.tracking = read_raw(frame, kTracking) != 0;
-  f.sequence = static_cast<std::uint8_t>(read_raw(frame, kSequence));
+  const std::uint64_t word = data_word(frame);
+  f.z_mm = physical_in_word(word, kZ);
+  f.mode = static_cast<TargetMode>(raw_in_word(word, kMode));
+  f.tracking = raw_in_word(word, kTracking) != 0;
+  f.sequence = static_cast<std::uint8_t>(raw_in_word(word, kSequence));
   return DecodeStatus::ok;
 }
 
@@ -235,82 +235,83 @@ inline std::uint8_t commit_sequence(const hal::CanFrame& frame) {
 inline void encode(const PosePositionZ& f, hal::CanFrame& frame) {
   using namespace pose_position_z;
   frame = empty_frame(kMessage);
-  put_saturating(frame, kZ, f.z_mm);
-  put_integer(frame, kFlags, f.compensated ? kFlagCompensated : 0);
-  put_integer(frame, kSequence, f.sequence);
+  set_data_word(frame, placed_saturating(kZ, f.z_mm) | placed_integer(kFlags, f.compensated ? kFlagCompensated : 0) |
+                           placed_integer(kSequence, f.sequence));
 }
 inline DecodeStatus decode(const hal::CanFrame& frame, PosePositionZ& f) {
   using namespace pose_position_z;
   if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
-  const std::int64_t flags = read_raw(frame, kFlags);
+  const std::uint64_t word = data_word(frame);
+  const std::int64_t flags = raw_in_word(word, kFlags);
   if ((flags & ~kFlagCompensated) != 0) return DecodeStatus::reserved_bits_set;
-  f.z_mm = get_physical(frame, kZ);
+  f.z_mm = physical_in_word(word, kZ);
   f.compensated = (flags & kFlagCompensated) != 0;
-  f.sequence = static_cast<std::uint8_t>(read_raw(frame, kSequence));
+  f.sequence = static_cast<std::uint8_t>(raw_in_word(word, kSequence));
   return DecodeStatus::ok;
 }
 
 inline void encode(const IkReport& f, hal::CanFrame& frame) {
   using namespace ik_report;
   frame = empty_frame(kMessage);
-  put_integer(frame, kSequence, f.sequence);
-  put_integer(frame, kOutcome, static_cast<std::int64_t>(f.outcome));
-  put_integer(frame, kIterations, f.iterations);
-  put_integer(frame, kCycles, f.cycles);
-  put_saturating(frame, kPositionResidual, f.position_residual_mm);
-  put_saturating(frame, kOrientationResidual, f.orientation_residual_rad);
+  set_data_word(frame, placed_integer(kSequence, f.sequence) |
+                           placed_integer(kOutcome, static_cast<std::int64_t>(f.outcome)) |
+                           placed_integer(kIterations, f.iterations) | placed_integer(kCycles, f.cycles) |
+                           placed_saturating(kPositionResidual, f.position_residual_mm) |
+                           placed_saturating(kOrientationResidual, f.orientation_residual_rad));
 }
 inline DecodeStatus decode(const hal::CanFrame& frame, IkReport& f) {
   using namespace ik_report;
   if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
-  f.sequence = static_cast<std::uint8_t>(read_raw(frame, kSequence));
-  f.outcome = static_cast<IkOutcome>(read_raw(frame, kOutcome));
-  f.iterations = static_cast<int>(read_raw(frame, kIterations));
-  f.cycles = static_cast<int>(read_raw(frame, kCycles));
-  f.position_residual_mm = get_physical(frame, kPositionResidual);
-  f.orientation_residual_rad = get_physical(frame, kOrientationResidual);
+  const std::uint64_t word = data_word(frame);
+  f.sequence = static_cast<std::uint8_t>(raw_in_word(word, kSequence));
+  f.outcome = static_cast<IkOutcome>(raw_in_word(word, kOutcome));
+  f.iterations = static_cast<int>(raw_in_word(word, kIterations));
+  f.cycles = static_cast<int>(raw_in_word(word, kCycles));
+  f.position_residual_mm = physical_in_word(word, kPositionResidual);
+  f.orientation_residual_rad = physical_in_word(word, kOrientationResidual);
   return DecodeStatus::ok;
 }
 
 inline void encode(const Status& f, hal::CanFrame& frame) {
   using namespace status;
   frame = empty_frame(kMessage);
-  put_integer(frame, kState, static_cast<std::int64_t>(f.state));
-  put_integer(frame, kFault, static_cast<std::int64_t>(f.fault));
-  put_integer(frame, kOverruns, f.overruns);
-  put_integer(frame, kExecMax, f.exec_max_us);
-  put_integer(frame, kExecMean, f.exec_mean_us);
+  set_data_word(frame, placed_integer(kState, static_cast<std::int64_t>(f.state)) |
+                           placed_integer(kFault, static_cast<std::int64_t>(f.fault)) |
+                           placed_integer(kOverruns, f.overruns) | placed_integer(kExecMax, f.exec_max_us) |
+                           placed_integer(kExecMean, f.exec_mean_us));
 }
 inline DecodeStatus decode(const hal::CanFrame& frame, Status& f) {
   using namespace status;
   if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
-  f.state = static_cast<RuntimeState>(read_raw(frame, kState));
-  f.fault = static_cast<FaultCode>(read_raw(frame, kFault));
-  f.overruns = read_raw(frame, kOverruns);
-  f.exec_max_us = read_raw(frame, kExecMax);
-  f.exec_mean_us = read_raw(frame, kExecMean);
+  const std::uint64_t word = data_word(frame);
+  f.state = static_cast<RuntimeState>(raw_in_word(word, kState));
+  f.fault = static_cast<FaultCode>(raw_in_word(word, kFault));
+  f.overruns = raw_in_word(word, kOverruns);
+  f.exec_max_us = raw_in_word(word, kExecMax);
+  f.exec_mean_us = raw_in_word(word, kExecMean);
   return DecodeStatus::ok;
 }
 
 inline void encode(const Stats& f, hal::CanFrame& frame) {
   using namespace stats;
   frame = empty_frame(kMessage);
-  put_integer(frame, kJitterMax, f.jitter_max_us);
-  put_integer(frame, kRejectedFrames, f.rejected_frames);
-  put_integer(frame, kCycleCount, f.cycle_count);
-  put_integer(frame, kFaultDetail, f.fault_detail.wire_value());
-  put_integer(frame, kStaleEvents, f.stale_events);
+  set_data_word(frame, placed_integer(kJitterMax, f.jitter_max_us) |
+                           placed_integer(kRejectedFrames, f.rejected_frames) |
+                           placed_integer(kCycleCount, f.cycle_count) |
+                           placed_integer(kFaultDetail, f.fault_detail.wire_value()) |
+                           placed_integer(kStaleEvents, f.stale_events));
 }
 // FAULT_DETAIL means something only with the FAULT it details: `reported_fault`
 // is the FAULT of the STATUS frame sent with this one.
 inline DecodeStatus decode(const hal::CanFrame& frame, FaultCode reported_fault, Stats& f) {
   using namespace stats;
   if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
-  f.jitter_max_us = read_raw(frame, kJitterMax);
-  f.rejected_frames = read_raw(frame, kRejectedFrames);
-  f.cycle_count = static_cast<std::uint16_t>(read_raw(frame, kCycleCount));
-  f.fault_detail = FaultDetail::from_wire(reported_fault, static_cast<std::uint8_t>(read_raw(frame, kFaultDetail)));
-  f.stale_events = read_raw(frame, kStaleEvents);
+  const std::uint64_t word = data_word(frame);
+  f.jitter_max_us = raw_in_word(word, kJitterMax);
+  f.rejected_frames = raw_in_word(word, kRejectedFrames);
+  f.cycle_count = static_cast<std::uint16_t>(raw_in_word(word, kCycleCount));
+  f.fault_detail = FaultDetail::from_wire(reported_fault, static_cast<std::uint8_t>(raw_in_word(word, kFaultDetail)));
+  f.stale_events = raw_in_word(word, kStaleEvents);
   return DecodeStatus::ok;
 }
 

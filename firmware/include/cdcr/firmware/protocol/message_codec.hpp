@@ -89,9 +89,10 @@ inline hal::CanFrame empty_frame(const MessageSpec& message, int index = 0) {
 inline DecodeStatus check_frame(const MessageSpec& message, const hal::CanFrame& frame) {
   if (!message.carries(frame.id)) return DecodeStatus::wrong_id;
   if (frame.dlc != message.dlc) return DecodeStatus::wrong_dlc;
-  if ((data_word(frame) & length_bits(message) & ~defined_bits(message)) != 0) return DecodeStatus::reserved_bits_set;
+  const std::uint64_t word = data_word(frame);
+  if ((word & length_bits(message) & ~defined_bits(message)) != 0) return DecodeStatus::reserved_bits_set;
   for (const SignalSpec* signal : message.signals) {
-    if (!raw_in_range(*signal, read_raw(frame, *signal))) return DecodeStatus::out_of_range;
+    if (!raw_in_range(*signal, raw_in_word(word, *signal))) return DecodeStatus::out_of_range;
   }
   return DecodeStatus::ok;
 }

@@ -194,10 +194,10 @@ inline constexpr MessageSpec kMessage{"STATS", 0x151, 1, 8, "RUNTIME", signal_li
 
 // Every message of the protocol, as the DBC lists them.
 inline constexpr const MessageSpec* kMessages[] = {
-    &cable_feedback::kMessage,   &cable_setpoint::kMessage,   &target_orientation::kMessage,
+    &cable_feedback::kMessage,     &cable_setpoint::kMessage,   &target_orientation::kMessage,
     &target_position_xy::kMessage, &target_position_z::kMessage, &pose_position_xy::kMessage,
-    &pose_position_z::kMessage,  &pose_orientation::kMessage, &ik_report::kMessage,
-    &status::kMessage,           &stats::kMessage,
+    &pose_position_z::kMessage,    &pose_orientation::kMessage, &ik_report::kMessage,
+    &status::kMessage,             &stats::kMessage,
 };
 
 }  // namespace cdcr::firmware::protocol

@@ -32,7 +32,47 @@ constexpr ValueTable value_table(const ValueName (&entries)[N]) {
   return {entries, static_cast<std::uint8_t>(N)};
 }
 
-struct SignalSpec {
+// What a field of `length_bits` can hold.
+constexpr std::int64_t raw_type_minimum(bool is_signed, int length_bits) {
+  return is_signed ? -(std::int64_t{1} << (length_bits - 1)) : 0;
+}
+constexpr std::int64_t raw_type_maximum(bool is_signed, int length_bits) {
+  return is_signed ? (std::int64_t{1} << (length_bits - 1)) - 1 : (std::int64_t{1} << length_bits) - 1;
+}
+
+// floor() and ceil() for the range computation below, constexpr so that it
+// runs at compile time; x is clamped to [low, high] first.
+constexpr std::int64_t floor_within(double x, std::int64_t low, std::int64_t high) {
+  if (!(x > double(low))) return low;
+  if (!(x < double(high))) return high;
+  const auto truncated = static_cast<std::int64_t>(x);
+  return double(truncated) > x ? truncated - 1 : truncated;
+}
+constexpr std::int64_t ceil_within(double x, std::int64_t low, std::int64_t high) {
+  return -floor_within(-x, -high, -low);
+}
+
+class SignalSpec {
+ public:
+  constexpr SignalSpec(const char* name_, std::uint8_t start_bit_, std::uint8_t length_bits_, bool is_signed_,
+                       double factor_, double offset_, double minimum_, double maximum_, const char* unit_,
+                       ValueTable values_ = {})
+      : name(name_),
+        start_bit(start_bit_),
+        length_bits(length_bits_),
+        is_signed(is_signed_),
+        factor(factor_),
+        offset(offset_),
+        minimum(minimum_),
+        maximum(maximum_),
+        unit(unit_),
+        values(values_),
+        // The slack absorbs the rounding of a decimal range (655.35 / 0.01).
+        raw_minimum(ceil_within((minimum_ - offset_) / factor_ - 1e-6, raw_type_minimum(is_signed_, length_bits_),
+                                raw_type_maximum(is_signed_, length_bits_))),
+        raw_maximum(floor_within((maximum_ - offset_) / factor_ + 1e-6, raw_type_minimum(is_signed_, length_bits_),
+                                 raw_type_maximum(is_signed_, length_bits_))) {}
+
   const char* name;          // as in the DBC
   std::uint8_t start_bit;    // least significant bit; frame bit k is bit k % 8 of data[k / 8]
   std::uint8_t length_bits;  // 1..32
@@ -42,7 +82,13 @@ struct SignalSpec {
   double minimum;  // physical range: what a receiver accepts, what an encoder saturates to
   double maximum;
   const char* unit;
-  ValueTable values = {};  // names of an enum signal's values
+  ValueTable values;  // names of an enum signal's values
+  // The raw values whose physical value lies within [minimum, maximum],
+  // worked out once: a board decodes several frames a cycle, and on a core
+  // without a double-precision FPU each division here costs hundreds of
+  // instructions.
+  std::int64_t raw_minimum;
+  std::int64_t raw_maximum;
 };
 
 // The bits a signal occupies, as a mask over the frame's 64 data bits.
@@ -61,8 +107,9 @@ inline void set_data_word(hal::CanFrame& frame, std::uint64_t word) {
   for (int i = 0; i < 8; ++i) frame.data[i] = static_cast<std::uint8_t>(word >> (8 * i));
 }
 
-inline std::int64_t read_raw(const hal::CanFrame& frame, const SignalSpec& spec) {
-  const std::uint64_t bits = (data_word(frame) & signal_mask(spec)) >> spec.start_bit;
+// The signal's raw value in a frame's data word.
+constexpr std::int64_t raw_in_word(std::uint64_t word, const SignalSpec& spec) {
+  const std::uint64_t bits = (word & signal_mask(spec)) >> spec.start_bit;
   const std::uint64_t sign_bit = std::uint64_t{1} << (spec.length_bits - 1);
   if (spec.is_signed && (bits & sign_bit) != 0) {
     return static_cast<std::int64_t>(bits) - (std::int64_t{1} << spec.length_bits);
@@ -70,45 +117,27 @@ inline std::int64_t read_raw(const hal::CanFrame& frame, const SignalSpec& spec)
   return static_cast<std::int64_t>(bits);
 }
 
-// Writes the low length_bits of `raw` (two's complement for negative values);
-// the frame's other bits are kept.
+inline std::int64_t read_raw(const hal::CanFrame& frame, const SignalSpec& spec) {
+  return raw_in_word(data_word(frame), spec);
+}
+
+// The low length_bits of `raw` (two's complement for negative values), in
+// the signal's place in a data word. Encoders OR a frame's signals together
+// and store the word once.
+constexpr std::uint64_t placed(const SignalSpec& spec, std::int64_t raw) {
+  return (static_cast<std::uint64_t>(raw) << spec.start_bit) & signal_mask(spec);
+}
+
+// Writes one signal; the frame's other bits are kept.
 inline void write_raw(hal::CanFrame& frame, const SignalSpec& spec, std::int64_t raw) {
-  const std::uint64_t mask = signal_mask(spec);
-  const std::uint64_t bits = (static_cast<std::uint64_t>(raw) << spec.start_bit) & mask;
-  set_data_word(frame, (data_word(frame) & ~mask) | bits);
+  set_data_word(frame, (data_word(frame) & ~signal_mask(spec)) | placed(spec, raw));
 }
 
-// What the field can hold.
-constexpr std::int64_t raw_type_minimum(const SignalSpec& spec) {
-  return spec.is_signed ? -(std::int64_t{1} << (spec.length_bits - 1)) : 0;
-}
-constexpr std::int64_t raw_type_maximum(const SignalSpec& spec) {
-  return spec.is_signed ? (std::int64_t{1} << (spec.length_bits - 1)) - 1 : (std::int64_t{1} << spec.length_bits) - 1;
-}
-
-// floor() and ceil() for the range computations below, constexpr so that a
-// constant signal's range folds away; x is clamped to the field first.
-constexpr std::int64_t floor_within(double x, std::int64_t low, std::int64_t high) {
-  if (!(x > double(low))) return low;
-  if (!(x < double(high))) return high;
-  const auto truncated = static_cast<std::int64_t>(x);
-  return double(truncated) > x ? truncated - 1 : truncated;
-}
-constexpr std::int64_t ceil_within(double x, std::int64_t low, std::int64_t high) {
-  return -floor_within(-x, -high, -low);
-}
-
-// The raw values whose physical value lies within [minimum, maximum]. The
-// slack absorbs the rounding of a decimal range (655.35 / 0.01).
-constexpr std::int64_t raw_minimum(const SignalSpec& spec) {
-  return ceil_within((spec.minimum - spec.offset) / spec.factor - 1e-6, raw_type_minimum(spec), raw_type_maximum(spec));
-}
-constexpr std::int64_t raw_maximum(const SignalSpec& spec) {
-  return floor_within((spec.maximum - spec.offset) / spec.factor + 1e-6, raw_type_minimum(spec), raw_type_maximum(spec));
-}
+constexpr std::int64_t raw_minimum(const SignalSpec& spec) { return spec.raw_minimum; }
+constexpr std::int64_t raw_maximum(const SignalSpec& spec) { return spec.raw_maximum; }
 
 constexpr bool raw_in_range(const SignalSpec& spec, std::int64_t raw) {
-  return raw >= raw_minimum(spec) && raw <= raw_maximum(spec);
+  return raw >= spec.raw_minimum && raw <= spec.raw_maximum;
 }
 
 inline double to_physical(const SignalSpec& spec, std::int64_t raw) { return double(raw) * spec.factor + spec.offset; }
@@ -117,8 +146,8 @@ inline double to_physical(const SignalSpec& spec, std::int64_t raw) { return dou
 // the saturating signals are residuals and counters, where unknown is worst.
 inline std::int64_t to_raw_saturating(const SignalSpec& spec, double physical) {
   const double scaled = (physical - spec.offset) / spec.factor;
-  if (!(scaled < double(raw_maximum(spec)))) return raw_maximum(spec);
-  if (!(scaled > double(raw_minimum(spec)))) return raw_minimum(spec);
+  if (!(scaled < double(spec.raw_maximum))) return spec.raw_maximum;
+  if (!(scaled > double(spec.raw_minimum))) return spec.raw_minimum;
   return static_cast<std::int64_t>(std::llround(scaled));
 }
 
@@ -126,27 +155,27 @@ inline std::int64_t to_raw_saturating(const SignalSpec& spec, double physical) {
 // anything outside, where a clipped value would be a wrong one.
 inline bool to_raw_checked(const SignalSpec& spec, double physical, std::int64_t& raw) {
   const double scaled = (physical - spec.offset) / spec.factor;
-  if (!(scaled >= double(raw_minimum(spec)) - 0.5) || !(scaled < double(raw_maximum(spec)) + 0.5)) return false;
+  if (!(scaled >= double(spec.raw_minimum) - 0.5) || !(scaled < double(spec.raw_maximum) + 0.5)) return false;
   raw = static_cast<std::int64_t>(std::llround(scaled));
   return raw_in_range(spec, raw);
 }
 
 // Integer signals (counters, sequence numbers, enums) saturate at their range.
-inline std::int64_t saturate_raw(const SignalSpec& spec, std::int64_t raw) {
-  if (raw < raw_minimum(spec)) return raw_minimum(spec);
-  return raw > raw_maximum(spec) ? raw_maximum(spec) : raw;
+constexpr std::int64_t saturate_raw(const SignalSpec& spec, std::int64_t raw) {
+  if (raw < spec.raw_minimum) return spec.raw_minimum;
+  return raw > spec.raw_maximum ? spec.raw_maximum : raw;
 }
 
-inline void put_saturating(hal::CanFrame& frame, const SignalSpec& spec, double physical) {
-  write_raw(frame, spec, to_raw_saturating(spec, physical));
+inline std::uint64_t placed_saturating(const SignalSpec& spec, double physical) {
+  return placed(spec, to_raw_saturating(spec, physical));
 }
 
-inline void put_integer(hal::CanFrame& frame, const SignalSpec& spec, std::int64_t value) {
-  write_raw(frame, spec, saturate_raw(spec, value));
+constexpr std::uint64_t placed_integer(const SignalSpec& spec, std::int64_t value) {
+  return placed(spec, saturate_raw(spec, value));
 }
 
-inline double get_physical(const hal::CanFrame& frame, const SignalSpec& spec) {
-  return to_physical(spec, read_raw(frame, spec));
+inline double physical_in_word(std::uint64_t word, const SignalSpec& spec) {
+  return to_physical(spec, raw_in_word(word, spec));
 }
 
 // The value a receiver decodes for `physical` after the signal's quantum and
