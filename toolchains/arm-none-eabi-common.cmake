@@ -1,6 +1,7 @@
 # Shared part of the arm-none-eabi toolchain files. The including file sets
 # CDCR_CORTEXM_CPU (the -mcpu value), CDCR_CORTEXM_FPU (the -mfpu value) and
-# CDCR_CORTEXM_BOARD (the QEMU machine the startup code targets) first.
+# CDCR_CORTEXM_BOARD (the QEMU machine the startup code targets) first; it also
+# sets CDCR_MODEL_ARCH, the GP loops' architecture code that model/ selects.
 set(CMAKE_SYSTEM_NAME Generic)
 set(CMAKE_SYSTEM_PROCESSOR arm)
 

@@ -8,17 +8,17 @@
 #
 # Needs clang++ and its libFuzzer/sanitizer runtimes (Debian: clang and
 # libclang-rt-14-dev, plus llvm-14 for symbolized reports; `bash
-# tools/install-deps.sh fuzz`). Without clang++ the tests are not added.
+# tools/install-deps.sh fuzz`). fuzz.dependencies checks for them, and every
+# other fuzz test requires it: without them the group fails, naming the
+# install command.
 
 find_program(CDCR_CLANGXX NAMES clang++ clang++-14 DOC "clang++ for the libFuzzer targets")
 set(CDCR_FUZZ_SECONDS 20 CACHE STRING "How long ctest runs each fuzzer (seconds)")
 
-if(NOT CDCR_CLANGXX)
-  message(STATUS "clang++ not found: the fuzz tests are not added")
-  return()
-endif()
-
 set(fuzz_dir ${CMAKE_BINARY_DIR}/fuzz)
+
+cdcr_add_dependency_check(fuzz
+  COMMAND sh ${CMAKE_CURRENT_LIST_DIR}/check_dependencies.sh ${CDCR_CLANGXX} ${fuzz_dir}/dependency-probe)
 
 # Debian installs the symbolizer under a versioned name only (llvm-14), where
 # the sanitizers do not look for it by themselves.
@@ -33,6 +33,7 @@ add_test(NAME fuzz.build
                  -DCXX=${CDCR_CLANGXX} -DCDCR_SOURCE_DIR=${PROJECT_SOURCE_DIR} "-DGENERATOR=${CMAKE_GENERATOR}"
                  -P ${CMAKE_CURRENT_LIST_DIR}/build_fuzzers.cmake)
 set_tests_properties(fuzz.build PROPERTIES LABELS fuzz FIXTURES_SETUP cdcr_fuzzers TIMEOUT 1200)
+cdcr_require_dependency_check(fuzz fuzz.build)
 
 # cdcr_fuzz_test(<name> SEEDS <seed dir> [FLAGS <libFuzzer flags...>])
 function(cdcr_fuzz_test name)
@@ -52,6 +53,7 @@ function(cdcr_fuzz_test name)
     FIXTURES_REQUIRED cdcr_fuzzers
     TIMEOUT ${timeout}
     FAIL_REGULAR_EXPRESSION "ERROR: AddressSanitizer;ERROR: LeakSanitizer;runtime error:;ERROR: libFuzzer;deadly signal")
+  cdcr_require_dependency_check(fuzz fuzz.${name})
 endfunction()
 
 cdcr_fuzz_test(image_parser SEEDS image FLAGS -max_len=8192)

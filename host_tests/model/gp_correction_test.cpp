@@ -1,5 +1,11 @@
 // The GP correction's gradient against central differences of its own mean,
-// and its fixed-size loops (4, 6 and 8 inputs) against the general one.
+// and its fixed-size loops (4, 6 and 8 inputs) against the general one; with
+// models of several chunks of the gradient pass, the mean against the dense
+// sum written out here and the gradient against central differences.
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -33,9 +39,9 @@ BoundModel make_model(int segments, InputEncoding encoding, int training_points)
   return b;
 }
 
-JointVector<double> random_bend(int segments, std::mt19937& rng) {
+JointVector<double> random_bend(int segments, std::mt19937& rng, double theta_min_rad = 0.05) {
   std::uniform_real_distribution<double> alpha_rad(-3.0, 3.0);
-  std::uniform_real_distribution<double> theta_rad(0.05, 1.2);
+  std::uniform_real_distribution<double> theta_rad(theta_min_rad, 1.2);
   JointVector<double> bend(2 * segments);
   for (int s = 0; s < segments; ++s) {
     const double a = alpha_rad(rng);
@@ -116,6 +122,160 @@ TEST_P(GpCorrectionSizes, FloatMeanAndGradientFollowDouble) {
       for (int d = 0; d < 2 * segments; ++d) EXPECT_NEAR(gradient_float(k, d), gradient(k, d), 1e-4 * gradient_scale);
     }
   }
+}
+
+// Models larger than one chunk of the gradient pass (kChunkPoints = 64): 203
+// points are three full chunks and a ragged tail of 11 (one block of 8 and 3
+// more), so a chunk that is skipped, summed twice or restarted shows up.
+constexpr int kMultiChunkPoints = 203;
+// Bends away from theta = 0, where the joint-angle encoding's derivatives
+// grow as 1/theta and central differences lose their accuracy: what is
+// tested here is the sum over chunks, not the encoding.
+constexpr double kThetaMinRad = 0.3;
+
+// The mean written out from the image, in long double:
+//   eps_k = output_mean_k + output_scale_k signal_variance_k sum_i exp(-|z - z_i|^2 / 2) alpha_ik,
+//   z_d = (x_d - input_mean_d) / (input_scale_d length_scale_d), x = encode(bend).
+std::array<long double, 6> dense_mean(const ImageView& image, const JointVector<double>& bend) {
+  Eigen::VectorXd x(bend.size());
+  encode_inputs(image.encoding, bend, x);
+  const int dims = image.input_dims;
+  std::vector<long double> z(dims);
+  for (int d = 0; d < dims; ++d) {
+    z[d] = (x[d] - static_cast<long double>(image.input_mean[d])) /
+           (static_cast<long double>(image.input_scale[d]) * image.length_scale[d]);
+  }
+  std::array<long double, 6> sums{};
+  for (std::uint32_t i = 0; i < image.training_points; ++i) {
+    long double distance_sq = 0;
+    for (int d = 0; d < dims; ++d) {
+      const long double difference = z[d] - image.inputs[i * dims + d];
+      distance_sq += difference * difference;
+    }
+    const long double k = std::exp(-distance_sq / 2);
+    for (int out = 0; out < 6; ++out) sums[out] += k * image.alpha[i * 6 + out];
+  }
+  std::array<long double, 6> eps{};
+  for (int out = 0; out < 6; ++out) {
+    eps[out] = image.output_mean[out] +
+               static_cast<long double>(image.output_scale[out]) * image.signal_variance[out] * sums[out];
+  }
+  return eps;
+}
+
+// What an output's sum can lose to rounding: its mean plus the gain times
+// the sum of |alpha| (every kernel value is at most 1).
+std::array<double, 6> output_magnitudes(const ImageView& image) {
+  std::array<double, 6> magnitude{};
+  for (int out = 0; out < 6; ++out) {
+    double alpha_sum = 0;
+    for (std::uint32_t i = 0; i < image.training_points; ++i) alpha_sum += std::abs(image.alpha[i * 6 + out]);
+    magnitude[out] = std::abs(image.output_mean[out]) + image.output_scale[out] * image.signal_variance[out] * alpha_sum;
+  }
+  return magnitude;
+}
+
+// 4, 6 and 8 inputs take the fixed-size loops, 10 (5 segments) the general one.
+class GpCorrectionChunks : public ::testing::TestWithParam<std::tuple<int, InputEncoding>> {};
+
+INSTANTIATE_TEST_SUITE_P(Segments, GpCorrectionChunks,
+                         ::testing::Combine(::testing::Values(2, 3, 4, 5),
+                                            ::testing::Values(InputEncoding::bend_vector,
+                                                              InputEncoding::joint_angles)));
+
+// predict and predict_with_gradient against the dense sum, in double and
+// in float with either accumulator the firmware uses.
+TEST_P(GpCorrectionChunks, MeanMatchesDenseSum) {
+  const auto [segments, encoding] = GetParam();
+  const BoundModel b = make_model(segments, encoding, kMultiChunkPoints);
+  GpCorrection<double, double> in_double;
+  GpCorrection<float, double> in_float;
+  GpCorrection<float, CompensatedFloat> in_compensated_float;
+  ASSERT_EQ(in_double.bind(b.view), Status::ok);
+  ASSERT_EQ(in_float.bind(b.view), Status::ok);
+  ASSERT_EQ(in_compensated_float.bind(b.view), Status::ok);
+  const std::array<double, 6> magnitude = output_magnitudes(b.view);
+  std::mt19937 rng(23);
+  for (int trial = 0; trial < 20; ++trial) {
+    const JointVector<double> bend = random_bend(segments, rng, kThetaMinRad);
+    const std::array<long double, 6> expected = dense_mean(b.view, bend);
+    Twist<double> eps;
+    Jacobian<double> gradient;
+    in_double.predict_with_gradient(bend, eps, gradient);
+    const Twist<double> mean = in_double.predict(bend);
+    const JointVector<float> bend_float = bend.cast<float>();
+    Twist<float> eps_float;
+    Jacobian<float> gradient_float;
+    in_float.predict_with_gradient(bend_float, eps_float, gradient_float);
+    const Twist<float> mean_float = in_float.predict(bend_float);
+    Twist<float> eps_compensated;
+    in_compensated_float.predict_with_gradient(bend_float, eps_compensated, gradient_float);
+    const Twist<float> mean_compensated = in_compensated_float.predict(bend_float);
+    for (int k = 0; k < 6; ++k) {
+      const double reference = static_cast<double>(expected[k]);
+      EXPECT_NEAR(mean[k], reference, 1e-13 * magnitude[k]) << "double predict, output " << k << ", trial " << trial;
+      EXPECT_NEAR(eps[k], reference, 1e-13 * magnitude[k]) << "double gradient pass, output " << k;
+      // The float query alone moves the kernel values by a few float ulp.
+      EXPECT_NEAR(mean_float[k], reference, 1e-6 * magnitude[k]) << "float predict, output " << k;
+      EXPECT_NEAR(eps_float[k], reference, 1e-6 * magnitude[k]) << "float gradient pass, output " << k;
+      EXPECT_NEAR(mean_compensated[k], reference, 1e-6 * magnitude[k]) << "compensated float predict, output " << k;
+      EXPECT_NEAR(eps_compensated[k], reference, 1e-6 * magnitude[k]) << "compensated float gradient pass, output " << k;
+    }
+  }
+}
+
+// The largest |central difference - gradient| relative to the output's
+// magnitude, over every output and input of `trials` random bends.
+template <typename S, typename Accumulator>
+double worst_gradient_error(const BoundModel& b, int segments, S step, int trials) {
+  GpCorrection<S, Accumulator> correction;
+  EXPECT_EQ(correction.bind(b.view), Status::ok);
+  const std::array<double, 6> magnitude = output_magnitudes(b.view);
+  std::mt19937 rng(29);
+  double worst = 0;
+  for (int trial = 0; trial < trials; ++trial) {
+    const JointVector<S> bend = random_bend(segments, rng, kThetaMinRad).template cast<S>();
+    Twist<S> eps;
+    Jacobian<S> gradient;
+    correction.predict_with_gradient(bend, eps, gradient);
+    EXPECT_EQ(gradient.cols(), 2 * segments);
+    for (int d = 0; d < 2 * segments; ++d) {
+      JointVector<S> plus = bend;
+      JointVector<S> minus = bend;
+      plus[d] += step;
+      minus[d] -= step;
+      // The step actually taken, after rounding to S.
+      const double taken = static_cast<double>(plus[d]) - static_cast<double>(minus[d]);
+      const Twist<S> up = correction.predict(plus);
+      const Twist<S> down = correction.predict(minus);
+      for (int k = 0; k < 6; ++k) {
+        const double difference = (static_cast<double>(up[k]) - static_cast<double>(down[k])) / taken;
+        worst = std::max(worst, std::abs(static_cast<double>(gradient(k, d)) - difference) / magnitude[k]);
+      }
+    }
+  }
+  return worst;
+}
+
+TEST_P(GpCorrectionChunks, DoubleGradientMatchesCentralDifferences) {
+  const auto [segments, encoding] = GetParam();
+  const BoundModel b = make_model(segments, encoding, kMultiChunkPoints);
+  const double worst = worst_gradient_error<double, double>(b, segments, 1e-5, 20);
+  std::printf("double: worst gradient error %.3g of the output magnitude\n", worst);
+  EXPECT_LT(worst, 1e-9);  // measured: at most 5e-11
+}
+
+// Central differences in float are noisy (the mean's own rounding over the
+// step): a looser bound, still far below what a lost chunk costs.
+TEST_P(GpCorrectionChunks, FloatGradientMatchesCentralDifferences) {
+  const auto [segments, encoding] = GetParam();
+  const BoundModel b = make_model(segments, encoding, kMultiChunkPoints);
+  const double worst = worst_gradient_error<float, double>(b, segments, 1e-2f, 20);
+  const double worst_compensated = worst_gradient_error<float, CompensatedFloat>(b, segments, 1e-2f, 20);
+  std::printf("float: worst gradient error %.3g (double sums), %.3g (compensated float sums) of the output magnitude\n",
+              worst, worst_compensated);
+  EXPECT_LT(worst, 3e-4);  // measured: at most 5e-5
+  EXPECT_LT(worst_compensated, 3e-4);
 }
 
 }  // namespace

@@ -35,9 +35,9 @@ struct ForwardResult {
 };
 
 // Outputs are written only when the cables are valid.
-template <typename S, typename Accumulator, int Max>
+template <typename S, typename Accumulator, int Max, typename Arch>
 Status compensated_forward(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
-                           const GpCorrection<S, Accumulator, Max>& correction, ForwardResult<S, Max>& result) {
+                           const GpCorrection<S, Accumulator, Max, Arch>& correction, ForwardResult<S, Max>& result) {
   JointVector<S, Max> joints;
   if (const Status s = joints_from_cables(cables_mm, geometry, joints); s != Status::ok) return s;
   const JointVector<S, Max> bend = bend_from_joints(joints);

@@ -15,87 +15,26 @@
 // training points, and each block into the Accumulator, double where the FPU
 // has it (host, Cortex-M7) and a compensated float sum where it does not
 // (Cortex-M4F).
+//
+// Arch holds the loops' architecture hooks (block loads, a hand-written mean
+// loop; model/arch/): arch::Selected, the one the build picks with
+// CDCR_MODEL_ARCH, by default, and arch::Portable for the plain C++
+// reference, which a board program compares its own loops against.
 
 #include <array>
 #include <cmath>
 #include <cstdint>
 #include <type_traits>
 
+#include "cdcr/model/arch/selected.hpp"
 #include "cdcr/model/chain.hpp"
 #include "cdcr/model/flash_image.hpp"
-#include "cdcr/model/gp_mean_fpv5.hpp"
 #include "cdcr/model/input_encoding.hpp"
 #include "cdcr/model/kernel_exp.hpp"
 #include "cdcr/model/status.hpp"
 #include "cdcr/model/types.hpp"
 
 namespace cdcr::model {
-
-// The loops over a training point's inputs and outputs have a handful of
-// iterations known at compile time; unrolled, their values stay in registers
-// at any optimisation level a board build uses (-O2 does not unroll them).
-#if defined(__clang__)
-#define CDCR_UNROLL_SMALL_LOOP _Pragma("unroll")
-#elif defined(__GNUC__)
-#define CDCR_UNROLL_SMALL_LOOP _Pragma("GCC unroll 16")
-#else
-#define CDCR_UNROLL_SMALL_LOOP
-#endif
-
-namespace detail {
-
-// Consecutive floats from flash or RAM into FPU registers. On a Cortex-M
-// with an FPU, GCC issues one VLDR per float; VLDMIA moves a whole training
-// point (or its six alphas) in one instruction, about a fifth of the loop's
-// instructions. The registers are fixed (s16 up) only at the load; the
-// compiler allocates everything else around them. The image's blocks are
-// 8-byte aligned, more than VLDMIA's word alignment needs.
-#if defined(__GNUC__) && !defined(__clang__) && defined(__arm__) && defined(__ARM_FP) && (__ARM_FP & 0x4)
-inline constexpr bool kHasBlockLoads = true;
-
-#define CDCR_VLDM_OUT(i) "=t"(r##i)
-template <int Count>
-inline void load_block(const float*& from, float (&to)[Count]) {
-  static_assert(Count == 4 || Count == 6 || Count == 8, "block loads of 4, 6 or 8 floats");
-  register float r0 asm("s16");
-  register float r1 asm("s17");
-  register float r2 asm("s18");
-  register float r3 asm("s19");
-  register float r4 asm("s20");
-  register float r5 asm("s21");
-  register float r6 asm("s22");
-  register float r7 asm("s23");
-  if constexpr (Count == 4) {
-    asm("vldmia %[p]!, {s16-s19}"
-        : CDCR_VLDM_OUT(0), CDCR_VLDM_OUT(1), CDCR_VLDM_OUT(2), CDCR_VLDM_OUT(3), [p] "+r"(from)
-        : "m"(*reinterpret_cast<const float(*)[4]>(from)));
-  } else if constexpr (Count == 6) {
-    asm("vldmia %[p]!, {s16-s21}"
-        : CDCR_VLDM_OUT(0), CDCR_VLDM_OUT(1), CDCR_VLDM_OUT(2), CDCR_VLDM_OUT(3), CDCR_VLDM_OUT(4),
-          CDCR_VLDM_OUT(5), [p] "+r"(from)
-        : "m"(*reinterpret_cast<const float(*)[6]>(from)));
-  } else {
-    asm("vldmia %[p]!, {s16-s23}"
-        : CDCR_VLDM_OUT(0), CDCR_VLDM_OUT(1), CDCR_VLDM_OUT(2), CDCR_VLDM_OUT(3), CDCR_VLDM_OUT(4),
-          CDCR_VLDM_OUT(5), CDCR_VLDM_OUT(6), CDCR_VLDM_OUT(7), [p] "+r"(from)
-        : "m"(*reinterpret_cast<const float(*)[8]>(from)));
-  }
-  const float loaded[8] = {r0, r1, r2, r3, r4, r5, r6, r7};
-  CDCR_UNROLL_SMALL_LOOP
-  for (int i = 0; i < Count; ++i) to[i] = loaded[i];
-}
-#undef CDCR_VLDM_OUT
-#else
-inline constexpr bool kHasBlockLoads = false;
-
-template <int Count>
-inline void load_block(const float*& from, float (&to)[Count]) {
-  for (int i = 0; i < Count; ++i) to[i] = from[i];
-  from += Count;
-}
-#endif
-
-}  // namespace detail
 
 // Neumaier's compensated sum: a float accumulator that carries its own
 // rounding error.
@@ -116,7 +55,7 @@ struct CompensatedFloat {
   float value() const { return sum + compensation; }
 };
 
-template <typename S, typename Accumulator = double, int MaxSegments = kMaxSegments>
+template <typename S, typename Accumulator = double, int MaxSegments = kMaxSegments, typename Arch = arch::Selected>
 class GpCorrection {
  public:
   static constexpr int kMaxInputs = 2 * MaxSegments;
@@ -239,16 +178,14 @@ class GpCorrection {
     const float* zi = inputs_;
     const float* a = alpha_;
     const std::uint32_t full_blocks = training_points_ / kBlockPoints;
-#if defined(CDCR_GP_MEAN_FPV5)
-    if constexpr (Dims == 8 && std::is_same_v<S, float> && std::is_same_v<Accumulator, double> &&
-                  kBlockPoints == detail::kFpv5BlockPoints) {
-      if (full_blocks > 0) detail::gp_mean_blocks_fpv5(query, zi, a, full_blocks, sums);
-    } else
-#endif
-    for (std::uint32_t b = 0; b < full_blocks; ++b) {
-      S block[kImageOutputs] = {};
-      for (std::uint32_t j = 0; j < kBlockPoints; ++j) add_point<Dims>(query, dims, zi, a, block);
-      for (int k = 0; k < kImageOutputs; ++k) accumulate(sums[k], block[k]);
+    if constexpr (Arch::template has_mean_blocks<Dims, S, Accumulator, kBlockPoints>()) {
+      if (full_blocks > 0) Arch::mean_blocks(query, zi, a, full_blocks, sums);
+    } else {
+      for (std::uint32_t b = 0; b < full_blocks; ++b) {
+        S block[kImageOutputs] = {};
+        for (std::uint32_t j = 0; j < kBlockPoints; ++j) add_point<Dims>(query, dims, zi, a, block);
+        for (int k = 0; k < kImageOutputs; ++k) accumulate(sums[k], block[k]);
+      }
     }
     S rest[kImageOutputs] = {};
     for (std::uint32_t i = full_blocks * kBlockPoints; i < training_points_; ++i) {
@@ -257,15 +194,23 @@ class GpCorrection {
     for (int k = 0; k < kImageOutputs; ++k) accumulate(sums[k], rest[k]);
   }
 
+  // The loops over a training point's inputs and outputs have a handful of
+  // iterations known at compile time; unrolled, their values stay in
+  // registers at any optimisation level a board build uses (-O2 does not
+  // unroll them). `#pragma GCC unroll` says so to GCC and clang alike and,
+  // unlike a macro, reaches no includer. (A template helper calling a lambda
+  // per iteration cost the Cortex-M4F 9 % more instructions in the mean:
+  // GCC then keeps the sums in memory.)
+
   // One training point's six terms k(z, z_i) alpha_i, added to `block`;
   // advances zi and a past the point and returns k(z, z_i).
   template <int Dims>
   static S add_point(const S* query, int dims, const float*& zi, const float*& a, S* block) {
     S distance_sq = S(0);
-    if constexpr (detail::kHasBlockLoads && std::is_same_v<S, float> && Dims > 0) {
+    if constexpr (Arch::kBlockLoads && std::is_same_v<S, float> && Dims > 0) {
       float row[Dims];
-      detail::load_block<Dims>(zi, row);
-      CDCR_UNROLL_SMALL_LOOP
+      Arch::template load_block<Dims>(zi, row);
+#pragma GCC unroll 16
       for (int d = 0; d < Dims; ++d) {
         const S difference = query[d] - row[d];
         distance_sq = multiply_add(difference, difference, distance_sq);
@@ -278,13 +223,13 @@ class GpCorrection {
       zi += dims;
     }
     const S r = gaussian(distance_sq);
-    if constexpr (detail::kHasBlockLoads && std::is_same_v<S, float>) {
+    if constexpr (Arch::kBlockLoads && std::is_same_v<S, float>) {
       float alpha[kImageOutputs];
-      detail::load_block<kImageOutputs>(a, alpha);
-      CDCR_UNROLL_SMALL_LOOP
+      Arch::template load_block<kImageOutputs>(a, alpha);
+#pragma GCC unroll 16
       for (int k = 0; k < kImageOutputs; ++k) block[k] = multiply_add(r, alpha[k], block[k]);
     } else {
-      CDCR_UNROLL_SMALL_LOOP
+#pragma GCC unroll 16
       for (int k = 0; k < kImageOutputs; ++k) block[k] = multiply_add(r, S(a[k]), block[k]);
       a += kImageOutputs;
     }
@@ -326,10 +271,10 @@ class GpCorrection {
           const S w_first = r[j] * S(alpha_pair[0]);
           const S w_second = r[j] * S(alpha_pair[1]);
           alpha_pair += kImageOutputs;
-          if constexpr (detail::kHasBlockLoads && std::is_same_v<S, float> && Dims > 0) {
+          if constexpr (Arch::kBlockLoads && std::is_same_v<S, float> && Dims > 0) {
             float row[Dims];
-            detail::load_block<Dims>(row_pointer, row);
-            CDCR_UNROLL_SMALL_LOOP
+            Arch::template load_block<Dims>(row_pointer, row);
+#pragma GCC unroll 16
             for (int d = 0; d < Dims; ++d) {
               first[d] = multiply_add(w_first, row[d], first[d]);
               second[d] = multiply_add(w_second, row[d], second[d]);

@@ -15,7 +15,7 @@
 // put into the exponent bits. Within 1.5 ulp of exp(-y/2) for y <= 40 and 5
 // ulp down to e^-86.5, where k ln 2 carries the float rounding of ln 2
 // (tested against std::exp in host_tests/model/kernel_exp_test.cpp). The Cortex-M7 assembly
-// loop (gp_mean_fpv5.hpp) performs the same operations in the same order and
+// loop (model/arch/fpv5/.../gp_mean_fpv5.hpp) performs the same operations in the same order and
 // so gives the same bits.
 
 #include <cmath>

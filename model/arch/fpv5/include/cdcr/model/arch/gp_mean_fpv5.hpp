@@ -15,10 +15,11 @@
 
 #include "cdcr/model/kernel_exp.hpp"
 
-#if defined(__GNUC__) && !defined(__clang__) && defined(__ARM_ARCH_7EM__) && defined(__ARM_FP) && (__ARM_FP & 0x8)
-#define CDCR_GP_MEAN_FPV5 1
+#if !(defined(__GNUC__) && !defined(__clang__) && defined(__ARM_ARCH_7EM__) && defined(__ARM_FP) && (__ARM_FP & 0x8))
+#error "model/arch/fpv5 needs GCC targeting an Armv7E-M core with a double-precision FPU (check CDCR_MODEL_ARCH)"
+#endif
 
-namespace cdcr::model::detail {
+namespace cdcr::model::arch::detail {
 
 inline constexpr std::uint32_t kFpv5BlockPoints = 8;
 
@@ -133,6 +134,4 @@ inline void gp_mean_blocks_fpv5(const float* query, const float*& inputs, const 
 #undef CDCR_FPV5_POINT
 #undef CDCR_FPV5_BLOCK_INTO_DOUBLES
 
-}  // namespace cdcr::model::detail
-
-#endif
+}  // namespace cdcr::model::arch::detail

@@ -1,0 +1,58 @@
+#pragma once
+// GpCorrection's loops on a Cortex-M with a single-precision FPU (FPv4-SP,
+// the Cortex-M4F; FPv5 builds on it): the portable loops, with block loads.
+//
+// On such a core GCC issues one VLDR per float; VLDMIA moves a whole training
+// point (or its six alphas) in one instruction, about a fifth of the loop's
+// instructions. The registers are fixed (s16 up) only at the load; the
+// compiler allocates everything else around them. The image's blocks are
+// 8-byte aligned, more than VLDMIA's word alignment needs. Only the
+// instructions change: the arithmetic, and so every bit of the result, is
+// the portable loop's.
+
+#if !(defined(__GNUC__) && !defined(__clang__) && defined(__arm__) && defined(__ARM_FP) && (__ARM_FP & 0x4))
+#error "model/arch/fpv4 needs GCC targeting an Arm core with a single-precision FPU (check CDCR_MODEL_ARCH)"
+#endif
+
+#include "cdcr/model/arch/portable.hpp"
+
+namespace cdcr::model::arch {
+
+struct Fpv4 : Portable {
+  static constexpr bool kBlockLoads = true;
+
+#define CDCR_VLDM_OUT(i) "=t"(r##i)
+  template <int Count>
+  static void load_block(const float*& from, float (&to)[Count]) {
+    static_assert(Count == 4 || Count == 6 || Count == 8, "block loads of 4, 6 or 8 floats");
+    register float r0 asm("s16");
+    register float r1 asm("s17");
+    register float r2 asm("s18");
+    register float r3 asm("s19");
+    register float r4 asm("s20");
+    register float r5 asm("s21");
+    register float r6 asm("s22");
+    register float r7 asm("s23");
+    if constexpr (Count == 4) {
+      asm("vldmia %[p]!, {s16-s19}"
+          : CDCR_VLDM_OUT(0), CDCR_VLDM_OUT(1), CDCR_VLDM_OUT(2), CDCR_VLDM_OUT(3), [p] "+r"(from)
+          : "m"(*reinterpret_cast<const float(*)[4]>(from)));
+    } else if constexpr (Count == 6) {
+      asm("vldmia %[p]!, {s16-s21}"
+          : CDCR_VLDM_OUT(0), CDCR_VLDM_OUT(1), CDCR_VLDM_OUT(2), CDCR_VLDM_OUT(3), CDCR_VLDM_OUT(4),
+            CDCR_VLDM_OUT(5), [p] "+r"(from)
+          : "m"(*reinterpret_cast<const float(*)[6]>(from)));
+    } else {
+      asm("vldmia %[p]!, {s16-s23}"
+          : CDCR_VLDM_OUT(0), CDCR_VLDM_OUT(1), CDCR_VLDM_OUT(2), CDCR_VLDM_OUT(3), CDCR_VLDM_OUT(4),
+            CDCR_VLDM_OUT(5), CDCR_VLDM_OUT(6), CDCR_VLDM_OUT(7), [p] "+r"(from)
+          : "m"(*reinterpret_cast<const float(*)[8]>(from)));
+    }
+    const float loaded[8] = {r0, r1, r2, r3, r4, r5, r6, r7};
+#pragma GCC unroll 16
+    for (int i = 0; i < Count; ++i) to[i] = loaded[i];
+  }
+#undef CDCR_VLDM_OUT
+};
+
+}  // namespace cdcr::model::arch

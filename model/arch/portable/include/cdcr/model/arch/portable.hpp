@@ -1,0 +1,32 @@
+#pragma once
+// The architecture hooks of GpCorrection's loops in plain C++: the reference
+// the other architectures (model/arch/fpv4, model/arch/fpv5) must match bit
+// for bit, and what every host build runs. An architecture may replace
+//   - load_block: a training point's floats (or its alphas) into registers;
+//   - mean_blocks: the mean's whole loop over full blocks of training points,
+//     for the configurations has_mean_blocks() names.
+// Here there is no hand-written mean loop, so GpCorrection's own C++ loop
+// runs: that loop is the reference.
+
+#include <cstdint>
+
+namespace cdcr::model::arch {
+
+struct Portable {
+  // Whether load_block is worth calling: the loops read the floats one by
+  // one where it is not.
+  static constexpr bool kBlockLoads = false;
+
+  template <int Count>
+  static void load_block(const float*& from, float (&to)[Count]) {
+    for (int i = 0; i < Count; ++i) to[i] = from[i];
+    from += Count;
+  }
+
+  template <int Dims, typename S, typename Accumulator, std::uint32_t BlockPoints>
+  static constexpr bool has_mean_blocks() {
+    return false;
+  }
+};
+
+}  // namespace cdcr::model::arch
