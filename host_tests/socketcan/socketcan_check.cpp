@@ -352,10 +352,18 @@ int check(const Model& m, const std::string& log_path) {
     }
     c.expect(first_fault != nullptr && status_of(first_fault).fault == FaultCode::cable_input_stale,
              "stale: STATUS goes to FAULT, cable input stale");
+    // A pose may follow a FAULT only if cable feedback came after it: under
+    // load the input turns stale now and then before the feeders stop, and
+    // the runtime rightly returns to RUN on the next complete set. After the
+    // feeders stop, nothing may.
     int poses_after = 0;
+    bool fault_without_input = false;
     for (const LoggedFrame& f : phases[4].frames) {
-      if (first_fault != nullptr && f.time_s > first_fault->time_s &&
-          protocol::pose_orientation::kMessage.carries(f.frame.id)) {
+      if (protocol::status::kMessage.carries(f.frame.id) && state_of(&f) == RuntimeState::fault) {
+        fault_without_input = true;
+      } else if (protocol::cable_feedback::kMessage.carries(f.frame.id)) {
+        fault_without_input = false;
+      } else if (protocol::pose_orientation::kMessage.carries(f.frame.id) && fault_without_input) {
         ++poses_after;
       }
     }

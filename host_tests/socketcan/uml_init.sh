@@ -14,6 +14,12 @@ if insmod "$modules/net/can/can.ko" &&
   insmod "$modules/drivers/net/can/dev/can-dev.ko" &&
   insmod "$modules/drivers/net/can/vcan.ko" &&
   ip link add dev vcan0 type vcan && ip link set up vcan0; then
+  # Room for frames while the guest's CPU falls behind for a moment on a
+  # busy host: vcan hands every frame to the receive backlog (1000 frames by
+  # default), which drops it for every listener, candump and the runtime
+  # alike, when full; a full transmit queue refuses cansend (ENOBUFS).
+  echo 100000 > /proc/sys/net/core/netdev_max_backlog
+  ip link set vcan0 txqueuelen 10000
   sh "$CDCR_TEST_DRIVER"
   status=$?
 else
