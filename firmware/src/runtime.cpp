@@ -10,6 +10,10 @@ namespace {
 
 std::int64_t to_us(std::int64_t ns) { return (ns + 500) / 1000; }
 
+// The drives report cable lengths in the protocol's steps: a segment at its
+// bending limit may read one step beyond it.
+constexpr Scalar kCableResolutionMm = Scalar(protocol::kLengthScaleMm);
+
 // Hamilton quaternion, w first, with w >= 0 so each rotation has one encoding.
 protocol::PoseOrientation orientation_frame(const model::Mat3<Scalar>& rotation) {
   Eigen::Quaternion<Scalar> quaternion(rotation);
@@ -93,8 +97,10 @@ RuntimeState Runtime::init() {
   solver_options.max_iterations = kMaxIkIterations;
   compensated_solver_.configure(geometry_, correction_, solver_options, kIkWorkCosts);
   nominal_solver_.configure(geometry_, no_correction_, solver_options, kIkWorkCosts);
-  // The forward path spends one unit per training point; IK gets the rest.
-  const std::uint32_t forward_units = mode_ == RuntimeState::run ? correction_.training_points() : 0;
+  // The forward path spends one unit per training point and the overhead;
+  // IK gets the rest.
+  const std::uint32_t forward_units =
+      kWorkCosts.cycle_overhead + (mode_ == RuntimeState::run ? correction_.training_points() : 0);
   ik_units_per_cycle_ = forward_units + kMinIkUnitsPerCycle < kCycleWorkUnits ? kCycleWorkUnits - forward_units
                                                                                : kMinIkUnitsPerCycle;
   enter(mode_);
@@ -129,7 +135,8 @@ FaultDetail Runtime::active_fault_detail() const {
 model::Status Runtime::estimate_pose(const Cables& cables_mm, PoseEstimate& estimate) const {
   if (mode_ == RuntimeState::run) {
     model::ForwardResult<Scalar, kMaxSegments> result;
-    if (const model::Status s = model::compensated_forward(cables_mm, geometry_, correction_, result);
+    if (const model::Status s =
+            model::compensated_forward(cables_mm, geometry_, correction_, result, kCableResolutionMm);
         s != model::Status::ok) {
       return s;
     }
@@ -139,7 +146,10 @@ model::Status Runtime::estimate_pose(const Cables& cables_mm, PoseEstimate& esti
     return model::Status::ok;
   }
   Joints joints;
-  if (const model::Status s = model::joints_from_cables(cables_mm, geometry_, joints); s != model::Status::ok) return s;
+  if (const model::Status s = model::joints_from_cables(cables_mm, geometry_, joints, kCableResolutionMm);
+      s != model::Status::ok) {
+    return s;
+  }
   estimate.pose = model::forward_kinematics_bend(model::bend_from_joints(joints), geometry_);
   estimate.joints = joints;
   estimate.compensated = false;
@@ -150,6 +160,7 @@ void Runtime::run_cycle(const hal::TimerTick& tick) {
   const std::int64_t start_ns = hal_.clock.now_ns();
   ++cycle_;
   fresh_cables_ = false;
+  ik_units_last_cycle_ = 0;
 
   hal::CanFrame frame;
   for (int i = 0; i < kMaxRxFramesPerCycle && hal_.can.receive(frame) == hal::CanStatus::ok; ++i) handle_frame(frame);
@@ -210,10 +221,11 @@ void Runtime::handle_target_position(const hal::CanFrame& frame) {
   if (!has_pending_position_) reject_frame(FaultCode::target_malformed);
 }
 
-// A segment's cables are used for a pose while they are younger than the
-// stale limit, so segments reporting in different cycles still make a set.
+// A segment's cables are used for a pose until they are stale (the same
+// limit as input_stale()), so segments reporting in different cycles still
+// make a set, and every cycle in RUN has a pose.
 bool Runtime::segment_current(int segment) const {
-  return segment_seen_[segment] && cycle_ - segment_updated_cycle_[segment] < std::uint32_t(kStaleInputCycles);
+  return segment_seen_[segment] && cycle_ - segment_updated_cycle_[segment] <= std::uint32_t(kStaleInputCycles);
 }
 
 // Stale: one segment silent, or no valid cable set, for more than
@@ -330,7 +342,9 @@ void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& c
   solving_mode_ = commit.mode;
   solving_tracking_ = commit.tracking;
   solving_cycles_ = 0;
-  published_best_bend_.resize(0);
+  // A streamed target that takes over the work may still send the point
+  // already sent only once.
+  if (!retarget) published_best_bend_.resize(0);
   if (started != model::Status::ok) {
     last_ik_report_ = IkReport{};
     last_ik_report_.sequence = commit.sequence;
@@ -340,31 +354,53 @@ void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& c
     publish_ik_report();
     return;
   }
+  solving_end_ = model::IkSolveState::running;
   solving_ = true;
 }
 
+// A cycle's IK slice: solver steps within ik_units_per_cycle_, and the
+// request's end (setpoints and report, kWorkCosts.ik_finish) when what is
+// left of the slice pays for it; otherwise the end goes out first thing in
+// the next cycle's slice.
 void Runtime::continue_solve() {
   if (state_ != RuntimeState::run && state_ != RuntimeState::degraded) return;
   ++solving_cycles_;
+  if (solving_end_ != model::IkSolveState::running) {
+    ik_units_last_cycle_ = kWorkCosts.ik_finish;
+    finish_solve(solving_end_);
+    return;
+  }
   model::IkSolveState end = model::IkSolveState::running;
+  std::uint32_t spent = 0;
   with_solver(mode_, compensated_solver_, nominal_solver_, [&](auto& solver) {
-    solver.run(ik_units_per_cycle_);
+    spent = solver.run(ik_units_per_cycle_);
     end = solver.state();
     if (end != model::IkSolveState::running || !solving_tracking_ || !solver.has_best()) return;
+    if (ik_units_per_cycle_ - spent < kWorkCosts.ik_finish) return;
     // Streamed targets: the best point so far, when it is close and new.
     const bool close = solver.best_position_error_mm() <= kTrackingPublishPositionErrorMm &&
                        (solving_mode_ == protocol::TargetMode::position ||
                         solver.best_orientation_error_rad() <= kTrackingPublishOrientationErrorRad);
     const bool is_new = published_best_bend_.size() != solver.best_bend().size() ||
                         published_best_bend_ != solver.best_bend();
-    if (close && is_new && set_setpoints(solver.best_joints())) {
-      published_best_bend_ = solver.best_bend();
-      publish_setpoints();
+    if (close && is_new) {
+      spent += kWorkCosts.ik_finish;
+      if (set_setpoints(solver.best_joints())) {
+        published_best_bend_ = solver.best_bend();
+        publish_setpoints();
+      }
     }
   });
+  ik_units_last_cycle_ = spent;
   if (end != model::IkSolveState::running) {
-    finish_solve(end);
+    if (ik_units_per_cycle_ - spent >= kWorkCosts.ik_finish) {
+      ik_units_last_cycle_ += kWorkCosts.ik_finish;
+      finish_solve(end);
+    } else {
+      solving_end_ = end;
+    }
   } else if (solving_cycles_ >= kMaxIkCycles) {
+    ik_units_last_cycle_ += kWorkCosts.ik_finish;
     finish_solve(model::IkSolveState::not_converged);
   } else if (solving_cycles_ % kIkProgressEveryCycles == 0) {
     fill_ik_report(protocol::IkOutcome::in_progress);

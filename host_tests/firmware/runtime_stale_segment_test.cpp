@@ -23,8 +23,14 @@ TEST_F(RuntimeTest, OneSilentSegmentFaultsAndItsReturnRecovers) {
   drives->set_segment_silent(1, true);
   int cycles_to_fault = 0;
   while (runtime->state() != RuntimeState::fault && cycles_to_fault < 5 * kStaleInputCycles) {
+    const std::uint32_t poses_before = runtime->statistics().poses_published;
     cycles(1);
     ++cycles_to_fault;
+    // Until the fault, every cycle publishes a pose: no cycle in RUN is
+    // silent while the segment's last frames are still within the limit.
+    if (runtime->state() == RuntimeState::run) {
+      EXPECT_EQ(runtime->statistics().poses_published, poses_before + 1) << "cycle " << cycles_to_fault;
+    }
   }
   ASSERT_EQ(runtime->state(), RuntimeState::fault);
   // The segment's frames may be up to kStaleInputCycles old; one more and

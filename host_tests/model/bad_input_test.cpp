@@ -146,6 +146,30 @@ TEST(BadSegmentCables, ThetaBeyondLimit) {
   EXPECT_EQ(segment_joints_status({120, 120, 120, 120}, stiff), Status::ok);
 }
 
+TEST(BadSegmentCables, LimitWithinMeasurementResolution) {
+  // A segment at theta_max = pi/2, its cables in 0.01 mm steps rounded away
+  // from the straight pose: beyond the limit by the rounding, which is the
+  // limit itself for a drive that reports in such steps.
+  const SegmentGeometry<double> g{120, 10, 1.5707963267948966};
+  const double step = 0.01;
+  const double alpha = 0.4;
+  Vec4<double> cables;
+  ASSERT_EQ(cables_from_joints(SegmentJoints<double>{alpha, g.theta_max_rad}, g, cables), Status::ok);
+  // l3 - l1 = 4r sin(theta/2) cos(alpha) and l2 - l4 likewise with sin:
+  // round l3 and l2 up, l1 and l4 down.
+  Vec4<double> measured(std::floor(cables[0] / step) * step, std::ceil(cables[1] / step) * step,
+                        std::ceil(cables[2] / step) * step, std::floor(cables[3] / step) * step);
+  SegmentJoints<double> joints;
+  EXPECT_EQ(joints_from_cables(measured, g, joints), Status::theta_beyond_limit);
+  ASSERT_EQ(joints_from_cables(measured, g, joints, step), Status::ok);
+  EXPECT_DOUBLE_EQ(joints.theta_rad, g.theta_max_rad);
+  EXPECT_NEAR(joints.alpha_rad, alpha, 1e-3);
+  // Two steps beyond on both differences is beyond any rounding.
+  measured[2] += 2 * step;
+  measured[1] += 2 * step;
+  EXPECT_EQ(joints_from_cables(measured, g, joints, step), Status::theta_beyond_limit);
+}
+
 TEST(BadSegmentCables, BadGeometry) {
   EXPECT_EQ(segment_joints_status(Vec4<double>::Constant(120), SegmentGeometry<double>{120, 0, 1}),
             Status::invalid_geometry);

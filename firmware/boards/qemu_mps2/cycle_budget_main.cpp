@@ -63,6 +63,20 @@ std::uint32_t counted_cycle() {
   return ticks_to_instructions(ticks > overhead_ticks ? ticks - overhead_ticks : 0);
 }
 
+// Instructions of one call of work(), as counted_cycle() counts a cycle.
+template <typename Work>
+std::uint32_t counted(Work&& work) {
+  asm volatile("" ::: "memory");
+  const std::uint64_t start = board.timer.now_ticks();
+  asm volatile("" ::: "memory");
+  work();
+  asm volatile("" ::: "memory");
+  const std::uint64_t end = board.timer.now_ticks();
+  asm volatile("" ::: "memory");
+  const std::uint64_t ticks = end - start;
+  return ticks_to_instructions(ticks > overhead_ticks ? ticks - overhead_ticks : 0);
+}
+
 // xorshift32: the same workload on every run and both boards.
 std::uint32_t rng_state = 0x2545F491u;
 float uniform(float lo, float hi) {
@@ -118,8 +132,14 @@ model::Pose<float> reachable_target(float theta_max_rad) {
   return model::exp(correction.predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
 }
 
+// Where the compensated model puts the tip for the given joints.
+model::Vec3<float> reachable_tip(const model::JointVector<float>& joints) {
+  const model::JointVector<float> bend = model::bend_from_joints(joints);
+  return (model::exp(correction.predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry())).position_mm;
+}
+
 // Latencies in cycles, per kind of request.
-constexpr int kMaxSamples = 400;
+constexpr int kMaxSamples = 800;
 struct Latencies {
   const char* name;
   std::uint16_t cycles[kMaxSamples];
@@ -151,10 +171,14 @@ struct Latencies {
 Latencies paper_pose{"paper_pose"};
 Latencies paper_position{"paper_position"};
 Latencies full_range_pose{"full_range_pose"};
-Latencies streamed{"streamed_setpoint_age"};
+Latencies streamed{"streamed_setpoint_lag"};
 
 std::uint32_t worst = 0;
 std::uint32_t cycles_run = 0;
+// Instructions of the cheapest cycle's GP mean point, and the most any cycle
+// spent beyond what its units account for.
+std::uint32_t mean_point_instructions = 0;
+std::int32_t worst_unaccounted = 0;
 std::uint32_t over_budget = 0;
 std::uint32_t poses_missing = 0;
 
@@ -164,6 +188,9 @@ void cycle() {
   const std::uint32_t published = runtime.statistics().poses_published;
   const std::uint32_t instructions = counted_cycle();
   worst = std::max(worst, instructions);
+  const std::int32_t accounted = std::int32_t(mean_point_instructions * (correction.training_points() +
+                                                                         runtime.ik_units_last_cycle()));
+  worst_unaccounted = std::max(worst_unaccounted, std::int32_t(instructions) - accounted);
   if (instructions > kBudgetInstructions) ++over_budget;
   if (runtime.state() == firmware::RuntimeState::run && runtime.statistics().poses_published != published + 1) {
     ++poses_missing;
@@ -186,6 +213,69 @@ int solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies
                   runtime.last_ik_report().outcome == protocol::IkOutcome::converged;
   if (latencies != nullptr) latencies->add(spent, ok);
   return spent;
+}
+
+// What each kind of IK work costs on this core, in instructions: the
+// figures behind the work-unit costs the board's architecture file states
+// (model/arch/<arch>). A training point of the mean is the unit.
+model::IkSolver<float, firmware::kMaxSegments, firmware::Correction> probe_solver;
+
+void report_unit_costs() {
+  const std::uint32_t points = correction.training_points();
+  model::JointVector<float> bend = model::JointVector<float>::Zero(2 * segments);
+  for (int s = 0; s < segments; ++s) bend[2 * s] = 0.1f;
+  firmware::Correction::Evaluation evaluation;
+  correction.begin_evaluation(bend, evaluation, false);
+  const std::uint32_t mean = counted([&] { correction.continue_evaluation(evaluation, points); });
+  correction.begin_evaluation(bend, evaluation, true);
+  const std::uint32_t gradient =
+      counted([&] { correction.continue_evaluation(evaluation, points * firmware::Correction::kGradientPointUnits); });
+  // Each run(kProbeBudget) call of a solver charged these costs does one
+  // step, told apart by the units it returns.
+  constexpr std::uint32_t kProbeJacobian = 100'000, kProbeStep = 99'999, kProbeOuter = 99'998;
+  constexpr std::uint32_t kProbeBudget = 100'000;
+  model::IkSolverOptions<float> options;
+  probe_solver.configure(runtime.geometry(), correction, options,
+                         model::IkWorkCosts{kProbeJacobian, kProbeStep, kProbeOuter});
+  std::uint32_t start_max = 0;
+  struct Step {
+    std::uint32_t units, max = 0, count = 0;
+    std::uint64_t total = 0;
+  } steps[3] = {{kProbeJacobian}, {kProbeStep}, {kProbeOuter}};
+  for (int t = 0; t < 16; ++t) {
+    const model::Pose<float> target = reachable_target(t % 2 ? 0.2f : 1.5f);
+    model::JointVector<float> initial(2 * segments);
+    for (int s = 0; s < segments; ++s) {
+      initial[2 * s] = 0.0f;
+      initial[2 * s + 1] = 0.1f;
+    }
+    const model::IkTargetKind kind = t % 4 < 2 ? model::IkTargetKind::pose : model::IkTargetKind::position;
+    start_max = std::max(start_max, counted([&] { probe_solver.start(target, kind, initial); }));
+    for (int call = 0; call < 4000 && probe_solver.state() == model::IkSolveState::running; ++call) {
+      std::uint32_t units = 0;
+      const std::uint32_t instructions = counted([&] { units = probe_solver.run(kProbeBudget); });
+      for (Step& step : steps) {
+        if (units != step.units) continue;
+        step.max = std::max(step.max, instructions);
+        step.total += instructions;
+        ++step.count;
+      }
+    }
+  }
+  const auto write = [](const char* label, std::uint32_t value) {
+    console::console_write(label);
+    console::console_write_int(static_cast<std::int32_t>(value));
+  };
+  mean_point_instructions = (mean + points / 2) / points;
+  write("unit costs (instructions): mean point ", mean_point_instructions);
+  write(", gradient point ", (gradient + points / 2) / points);
+  const char* const names[3] = {"; nominal jacobian mean ", "; nominal step mean ", "; outer step mean "};
+  for (int i = 0; i < 3; ++i) {
+    write(names[i], steps[i].count ? std::uint32_t(steps[i].total / steps[i].count) : 0);
+    write(" max ", steps[i].max);
+  }
+  write("; start max ", start_max);
+  console::console_write("\n");
 }
 
 }  // namespace
@@ -219,6 +309,7 @@ int main() {
   console::console_write(" training points; IK work per cycle ");
   console::console_write_int(static_cast<std::int32_t>(runtime.ik_units_per_cycle()));
   console::console_write(" units\n");
+  report_unit_costs();
 
   // The drives start where golden case 0 has them.
   for (int s = 0; s < segments; ++s) {
@@ -251,15 +342,18 @@ int main() {
     return p;
   };
   solve(on_circle(0), protocol::TargetMode::position, nullptr);
-  int arrival_of_setpoint_target = 0;
+  // How far the drives lag: the compensated model's tip at the setpoints
+  // they hold, against the target of this cycle, in cycles of path (0.1 mm
+  // each at 100 mm/s and 1 kHz).
+  constexpr float kPathPerCycleMm = 0.1f;
+  model::Vec3<float> held_tip = reachable_tip(runtime.setpoint_joints());
   for (int step = 1; step <= 800; ++step) {
     deliver_target(on_circle(step), protocol::TargetMode::position, true, next_sequence++);
     const std::uint32_t before = runtime.setpoints_published();
     cycle();
-    // The age of what the drives were last sent: the target being solved
-    // arrived in this cycle whenever setpoints went out in it.
-    if (runtime.setpoints_published() != before) arrival_of_setpoint_target = step;
-    if (step > 20) streamed.add(step - arrival_of_setpoint_target + 1, true);
+    if (runtime.setpoints_published() != before) held_tip = reachable_tip(runtime.setpoint_joints());
+    const float lag = (held_tip - on_circle(step).position_mm).norm() / kPathPerCycleMm;
+    if (step > 20) streamed.add(static_cast<int>(std::ceil(lag)), true);
   }
   while (runtime.ik_running()) cycle();
 
@@ -292,6 +386,9 @@ int main() {
   paper_position.report();
   full_range_pose.report();
   streamed.report();
+  console::console_write("cycle overhead (beyond the units spent): at most ");
+  console::console_write_int(worst_unaccounted);
+  console::console_write(" instructions\n");
   console::console_write("worst cycle: ");
   console::console_write_int(static_cast<std::int32_t>(worst));
   console::console_write(" instructions over ");

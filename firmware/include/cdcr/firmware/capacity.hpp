@@ -2,9 +2,13 @@
 // Every capacity of the runtime, fixed at compile time: storage is sized for
 // these and nothing is allocated after init. A board build may lower them.
 
+#include <algorithm>
 #include <cstdint>
 
+#include "cdcr/model/arch/selected.hpp"
+#include "cdcr/model/gp_correction.hpp"
 #include "cdcr/model/ik_solver.hpp"
+#include "cdcr/model/work_costs.hpp"
 #include "cdcr/model/limits.hpp"
 
 namespace cdcr::firmware {
@@ -29,23 +33,28 @@ inline constexpr int kRxQueueDepth = 128;
 // Acceptance filters a controller must offer the runtime.
 inline constexpr int kMaxCanFilters = 4;
 
-// The cycle budget, in work units: one unit is one training point of a GP
-// mean evaluation (47 instructions on the Cortex-M7, 69 on the Cortex-M4F);
-// a nominal IK iteration and the IK bookkeeping are charged in the same
-// units (kIkWorkCosts). Each cycle's forward path costs one unit per
-// training point; the IK solver gets what is left, and at least
-// kMinIkUnitsPerCycle. The qemu.cycle_budget_* tests hold the default to
-// 80,000 instructions per cycle on the Cortex-M7 and 120,000 on the
-// Cortex-M4F with the demo's model, and the README gives the figures at the
-// full kMaxTrainingPoints. A board build may set its own with
+// The cycle budget, in work units (model/work_costs.hpp): one unit is one
+// training point of a GP mean evaluation on the board's core, and every other
+// kind of work is charged in the same units, measured on that core and stated
+// in its architecture file (model/arch/<arch>). A cycle's forward path costs
+// one unit per training point plus the fixed overhead; the IK solver gets
+// what is left of kCycleWorkUnits, and at least kMinIkUnitsPerCycle, its
+// costliest single step, so that a request advances in every cycle even at
+// the full kMaxTrainingPoints. The qemu.cycle_budget_* tests hold the
+// defaults to 80,000 instructions per cycle on the Cortex-M7 and 120,000 on
+// the Cortex-M4F with the demo's model; the README gives the figures at the
+// full capacity. A board build may set its own budget with
 // -DCDCR_CYCLE_WORK_UNITS=...
+inline constexpr model::WorkCosts kWorkCosts = model::arch::Selected::kWorkCosts;
 #ifdef CDCR_CYCLE_WORK_UNITS
 inline constexpr std::uint32_t kCycleWorkUnits = CDCR_CYCLE_WORK_UNITS;
 #else
-inline constexpr std::uint32_t kCycleWorkUnits = 1000;
+inline constexpr std::uint32_t kCycleWorkUnits = kWorkCosts.cycle;
 #endif
-inline constexpr std::uint32_t kMinIkUnitsPerCycle = 300;
-inline constexpr model::IkWorkCosts kIkWorkCosts{300, 100};
+inline constexpr model::IkWorkCosts kIkWorkCosts = kWorkCosts.ik;
+inline constexpr std::uint32_t kMinIkUnitsPerCycle =
+    std::max({kIkWorkCosts.nominal_jacobian, kIkWorkCosts.nominal_step, kIkWorkCosts.outer_step, kWorkCosts.ik_finish,
+              model::GpCorrection<float>::kChunkPoints * kWorkCosts.gradient_point});
 
 // Bounds of one IK request: correction evaluations and nominal LM
 // iterations (see model::IkSolverOptions), and the cycles it may span
@@ -85,8 +94,11 @@ inline constexpr float kIkAcceptedOrientationErrorRad = 1e-3f;
 
 // Streamed (TRACKING) targets: while a request runs, the best point found so
 // far is sent as setpoints whenever it improves and is within these of the
-// target; the final answer follows on convergence.
-inline constexpr float kTrackingPublishPositionErrorMm = 0.1f;
-inline constexpr float kTrackingPublishOrientationErrorRad = 1e-3f;
+// newest target; the final answer follows on convergence. A planner streams
+// points a fraction of a millimetre apart (0.1 mm per cycle at 100 mm/s and
+// 1 kHz): a point a few targets behind is still worth sending, one far off
+// the path is not.
+inline constexpr float kTrackingPublishPositionErrorMm = 1.0f;
+inline constexpr float kTrackingPublishOrientationErrorRad = 0.01f;
 
 }  // namespace cdcr::firmware

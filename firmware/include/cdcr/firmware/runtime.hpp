@@ -118,12 +118,18 @@ class Runtime {
   FaultCode last_event() const { return last_event_; }
   const CycleStatistics& statistics() const { return statistics_; }
   const Geometry& geometry() const { return geometry_; }
+  // The correction the image bound (unbound in DEGRADED).
+  const Correction& correction() const { return correction_; }
   const IkReport& last_ik_report() const { return last_ik_report_; }
   // A target being solved, and the IK work units a cycle may spend on it.
   bool ik_running() const { return solving_; }
   std::uint32_t ik_units_per_cycle() const { return ik_units_per_cycle_; }
+  // Units the IK solver spent in the last cycle.
+  std::uint32_t ik_units_last_cycle() const { return ik_units_last_cycle_; }
   // Setpoint frames sent, final and best-so-far.
   std::uint32_t setpoints_published() const { return setpoints_published_; }
+  // The joints of the last setpoints sent (valid once one was sent).
+  const Joints& setpoint_joints() const { return setpoint_joints_; }
   bool has_setpoints() const { return has_setpoints_; }
   const Cables& setpoints_mm() const { return setpoints_mm_; }
   bool has_pose() const { return has_pose_; }
@@ -192,8 +198,11 @@ class Runtime {
   protocol::TargetMode solving_mode_ = protocol::TargetMode::position;
   std::uint8_t solving_sequence_ = 0;
   int solving_cycles_ = 0;
+  // How the solver ended, when its end did not fit in that cycle's slice.
+  model::IkSolveState solving_end_ = model::IkSolveState::running;
   Joints published_best_bend_;
   std::uint32_t ik_units_per_cycle_ = kMinIkUnitsPerCycle;
+  std::uint32_t ik_units_last_cycle_ = 0;
   std::uint32_t setpoints_published_ = 0;
   bool has_setpoints_ = false;
   Cables setpoints_mm_;

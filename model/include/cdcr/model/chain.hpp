@@ -22,14 +22,17 @@ SegmentJoints<typename Derived::Scalar> segment_joints(const Eigen::MatrixBase<D
 
 template <typename S, int Max>
 Status joints_from_cables(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
-                          JointVector<S, Max>& joints) {
+                          JointVector<S, Max>& joints, S cable_resolution_mm = S(0)) {
   if (const Status s = geometry.validate(); s != Status::ok) return s;
   if (cables_mm.size() != 4 * geometry.segment_count) return Status::invalid_segment_count;
   JointVector<S, Max> result(2 * geometry.segment_count);
   for (int i = 0; i < geometry.segment_count; ++i) {
     SegmentJoints<S> q;
     const Vec4<S> segment_cables = cables_mm.template segment<4>(4 * i);
-    if (const Status s = joints_from_cables(segment_cables, geometry.segments[i], q); s != Status::ok) return s;
+    if (const Status s = joints_from_cables(segment_cables, geometry.segments[i], q, cable_resolution_mm);
+        s != Status::ok) {
+      return s;
+    }
     result[2 * i] = q.alpha_rad;
     result[2 * i + 1] = q.theta_rad;
   }

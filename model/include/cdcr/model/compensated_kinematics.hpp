@@ -34,12 +34,14 @@ struct ForwardResult {
   Pose<S> compensated;
 };
 
-// Outputs are written only when the cables are valid.
+// Outputs are written only when the cables are valid. cable_resolution_mm as
+// in joints_from_cables.
 template <typename S, typename Accumulator, int Max, typename Arch>
 Status compensated_forward(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
-                           const GpCorrection<S, Accumulator, Max, Arch>& correction, ForwardResult<S, Max>& result) {
+                           const GpCorrection<S, Accumulator, Max, Arch>& correction, ForwardResult<S, Max>& result,
+                           S cable_resolution_mm = S(0)) {
   JointVector<S, Max> joints;
-  if (const Status s = joints_from_cables(cables_mm, geometry, joints); s != Status::ok) return s;
+  if (const Status s = joints_from_cables(cables_mm, geometry, joints, cable_resolution_mm); s != Status::ok) return s;
   const JointVector<S, Max> bend = bend_from_joints(joints);
   result.joints = joints;
   result.nominal = forward_kinematics_bend(bend, geometry);

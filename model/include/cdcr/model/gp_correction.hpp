@@ -114,8 +114,8 @@ class GpCorrection {
   // pass, so the result has the same bits. Work is counted in units: a
   // training point of the mean is one unit, of the mean with the gradient
   // kGradientPointUnits (the ratio of their instruction counts, measured on
-  // the Cortex-M boards).
-  static constexpr std::uint32_t kGradientPointUnits = 4;
+  // the architecture's core, model/arch/<arch>).
+  static constexpr std::uint32_t kGradientPointUnits = Arch::kWorkCosts.gradient_point;
   // The gradient pass goes over chunks of this many training points.
   static constexpr std::uint32_t kChunkPoints = 8 * kBlockPoints;
 

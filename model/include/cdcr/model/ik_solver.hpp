@@ -58,6 +58,7 @@
 #include "cdcr/model/se3.hpp"
 #include "cdcr/model/status.hpp"
 #include "cdcr/model/types.hpp"
+#include "cdcr/model/work_costs.hpp"
 
 namespace cdcr::model {
 
@@ -98,12 +99,6 @@ struct IkSolverOptions {
   S gradient_refresh_ratio = S(0.1);
 };
 
-// What run() charges for each kind of step, in units of one training point
-// of a correction evaluation. Firmware builds measure these on their core.
-struct IkWorkCosts {
-  std::uint32_t nominal_iteration = 160;
-  std::uint32_t outer_step = 60;
-};
 
 // Corrections the solver can evaluate in slices. A correction type provides
 //   using Evaluation = ...;   // the state of one evaluation in progress
@@ -272,22 +267,33 @@ class IkSolver {
   Status retarget(const Pose<S>& target, IkTargetKind kind, const Joints& fallback_joints) {
     if (state_ != IkSolveState::running) return start_warm(target, kind, fallback_joints);
     if (!target.all_finite()) return fail(Status::non_finite_input);
+    const IkTargetKind previous_kind = kind_;
     target_ = target;
     kind_ = kind;
     corrections_ = 0;
     iterations_ = 0;
     restarts_ = 0;
     units_spent_ = 0;
-    have_previous_ = false;
     stalled_outer_ = 0;
+    // The secant pair stays (the correction does not depend on the target);
+    // the last residual, measured against the old target, does not count.
+    previous_cost_ = std::numeric_limits<S>::infinity();
     const Pose<S> tip = exp(warm_eps_) * forward_kinematics_bend(warm_bend_, *geometry_);
     Residual residual;
     residual_of(tip, residual, best_position_error_, best_orientation_error_);
     best_cost_ = residual.squaredNorm();
     best_bend_ = warm_bend_;
-    // A linearised solve aimed at the old target ends here; its point is
-    // evaluated next.
-    if (phase_ == Phase::inner) begin_outer(inner_bend_);
+    if (phase_ == Phase::inner) {
+      // The linearised model and its Jacobian do not depend on the target
+      // either: the solve on it goes on towards the new one.
+      if (kind != previous_kind) rows_current_ = false;
+      residual_of(inner_tip_, inner_residual_, inner_position_error_, inner_orientation_error_);
+      inner_cost_ = inner_residual_.squaredNorm();
+      // Its iteration bounds and damping carry on: a target that moves every
+      // cycle must not keep the solve from ever reaching the next evaluation,
+      // nor hold the damping where it hides the weakly actuated directions.
+      if (inner_done()) finish_inner();
+    }
     return status_;
   }
 
@@ -321,8 +327,14 @@ class IkSolver {
         continue;
       }
       // Phase::inner
-      if (left < costs_.nominal_iteration) break;
-      spent += costs_.nominal_iteration;
+      if (!rows_current_) {
+        if (left < costs_.nominal_jacobian) break;
+        spent += costs_.nominal_jacobian;
+        update_rows();
+        continue;
+      }
+      if (left < costs_.nominal_step) break;
+      spent += costs_.nominal_step;
       inner_iteration();
     }
     units_spent_ += spent;
@@ -574,6 +586,14 @@ class IkSolver {
   void finish_inner() { begin_outer(inner_bend_); }
 
   // One LM iteration on the linearised model.
+  void update_rows() {
+    if (kind_ == IkTargetKind::pose) {
+      update_rows_of<6>();
+    } else {
+      update_rows_of<3>();
+    }
+  }
+
   void inner_iteration() {
     if (kind_ == IkTargetKind::pose) {
       inner_iteration_rows<6>();
@@ -582,38 +602,42 @@ class IkSolver {
     }
   }
 
+  // The linearised model's Jacobian at inner_bend_, as residual rows.
+  template <int Rows>
+  void update_rows_of() {
+    const int segments = geometry_->segment_count;
+    Pose<S> tip;
+    Jacobian<S, Max> spatial;
+    tip_jacobian_bend(inner_bend_, *geometry_, tip, spatial);
+    const Twist<S> eps = linearised_eps(inner_bend_);
+    const Pose<S> correction_pose = exp(eps);
+    apply_adjoint(correction_pose, spatial);
+    if (slope_known_) spatial.noalias() += left_jacobian(eps).lazyProduct(slope_);
+    tip = correction_pose * tip;
+    rows_.setZero();
+    rows_.template topLeftCorner<3, kMaxColumns>().leftCols(2 * segments) =
+        spatial.template topRows<3>() - hat3<S>(tip.position_mm) * spatial.template bottomRows<3>();
+    if constexpr (Rows == 6) {
+      rows_.template bottomLeftCorner<3, kMaxColumns>().leftCols(2 * segments) =
+          weight_ * spatial.template bottomRows<3>();
+    }
+    rows_current_ = true;
+    // Segments on the limit leave the active set when descent points inside.
+    for (int i = 0; i < segments; ++i) {
+      if (!active_[i]) continue;
+      const Vec2<S> b = inner_bend_.template segment<2>(2 * i);
+      const Vec2<S> descent = rows_.template topRows<Rows>().template middleCols<2>(2 * i).transpose() *
+                              inner_residual_.template head<Rows>();
+      if (b.dot(descent) < S(0)) active_[i] = false;
+    }
+  }
+
+  // The damped step from inner_bend_ on the current rows, and its test.
   template <int Rows>
   void inner_iteration_rows() {
     ++iterations_;
     ++inner_iterations_;
     const int segments = geometry_->segment_count;
-    if (!rows_current_) {
-      Pose<S> tip;
-      Jacobian<S, Max> spatial;
-      tip_jacobian_bend(inner_bend_, *geometry_, tip, spatial);
-      const Twist<S> eps = linearised_eps(inner_bend_);
-      const Pose<S> correction_pose = exp(eps);
-      apply_adjoint(correction_pose, spatial);
-      if (slope_known_) spatial.noalias() += left_jacobian(eps).lazyProduct(slope_);
-      tip = correction_pose * tip;
-      rows_.setZero();
-      rows_.template topLeftCorner<3, kMaxColumns>().leftCols(2 * segments) =
-          spatial.template topRows<3>() - hat3<S>(tip.position_mm) * spatial.template bottomRows<3>();
-      if constexpr (Rows == 6) {
-        rows_.template bottomLeftCorner<3, kMaxColumns>().leftCols(2 * segments) =
-            weight_ * spatial.template bottomRows<3>();
-      }
-      rows_current_ = true;
-      // Segments on the limit leave the active set when descent points inside.
-      for (int i = 0; i < segments; ++i) {
-        if (!active_[i]) continue;
-        const Vec2<S> b = inner_bend_.template segment<2>(2 * i);
-        const Vec2<S> descent = rows_.template topRows<Rows>().template middleCols<2>(2 * i).transpose() *
-                                inner_residual_.template head<Rows>();
-        if (b.dot(descent) < S(0)) active_[i] = false;
-      }
-    }
-
     Joints trial;
     bool stepped = false;
     // Each pass may add segments to the active set; at most one pass per segment.
@@ -648,6 +672,7 @@ class IkSolver {
       // is not exact far from b_k): better spent on a new evaluation.
       if (trial_cost > S(0.25) * inner_cost_) ++inner_slow_steps_;
       inner_bend_ = trial;
+      inner_tip_ = trial_tip;
       inner_residual_ = trial_residual;
       inner_cost_ = trial_cost;
       inner_position_error_ = trial_position_error;

@@ -41,8 +41,12 @@ SegmentJoints<S> joints_from_bend(const Vec2<S>& b) {
 
 // Eqs. (2)-(5). alpha = atan2(l2 - l4, l3 - l1): eq. (4) as printed has the
 // opposite sign and loses the quadrant; this form reproduces Table 1.
+// cable_resolution_mm: the step of the measured lengths (the drives report
+// in steps of the protocol's scale). A segment at its limit reads up to one
+// step of each cable difference beyond it; that is still the limit.
 template <typename S>
-Status joints_from_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry, SegmentJoints<S>& joints) {
+Status joints_from_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry, SegmentJoints<S>& joints,
+                          S cable_resolution_mm = S(0)) {
   if (const Status s = geometry.validate(); s != Status::ok) return s;
   if (!cables_mm.allFinite()) return Status::non_finite_input;
   if (!(cables_mm.minCoeff() > S(0))) return Status::cable_length_not_positive;
@@ -56,7 +60,10 @@ Status joints_from_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& ge
   // to about eps * l / r above the limit (one rounding of each cable length,
   // divided by the lever arm). That is the limit itself, not beyond it.
   const S rounding_rad = S(16) * std::numeric_limits<S>::epsilon() * cables_mm.maxCoeff() / geometry.anchor_radius_mm;
-  if (theta > geometry.theta_max_rad + rounding_rad) return Status::theta_beyond_limit;
+  // Both differences may be off by one step: the chord by up to sqrt(2) steps.
+  const S chord_within_resolution = std::max(S(0), chord - S(1.41421356) * cable_resolution_mm);
+  const S theta_within_resolution = S(2) * std::asin(chord_within_resolution / reach);
+  if (theta_within_resolution > geometry.theta_max_rad + rounding_rad) return Status::theta_beyond_limit;
   joints = SegmentJoints<S>{std::atan2(d24, d31), std::min(theta, geometry.theta_max_rad)};
   return Status::ok;
 }

@@ -10,9 +10,15 @@
 
 #include <cstdint>
 
+#include "cdcr/model/work_costs.hpp"
+
 namespace cdcr::model::arch {
 
 struct Portable {
+  // A host core: the costs only steer how IK work is spread over cycles (a
+  // host has no instruction budget), so round figures of the Cortex-M kind.
+  static constexpr WorkCosts kWorkCosts{3, {300, 400, 120}, 150, 150, 2000};
+
   // Whether load_block is worth calling: the loops read the floats one by
   // one where it is not.
   static constexpr bool kBlockLoads = false;

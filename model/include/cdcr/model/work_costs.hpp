@@ -1,0 +1,38 @@
+#pragma once
+// The cost model of the fixed-rate cycle. Work is counted in units: one unit
+// is one training point of a GP mean evaluation on the core at hand. Every
+// other kind of work is charged as a whole number of such units, measured on
+// that core (each architecture file, model/arch/<arch>, states its own), so
+// a budget in units bounds a cycle's instructions.
+
+#include <cstdint>
+
+namespace cdcr::model {
+
+// What the resumable IK solver charges for each kind of step. A nominal LM
+// iteration is two steps: the linearised model's Jacobian at the current
+// point, then the damped step and the evaluation of where it lands (a
+// rejected step repeats only the second).
+struct IkWorkCosts {
+  std::uint32_t nominal_jacobian = 80;
+  std::uint32_t nominal_step = 80;
+  std::uint32_t outer_step = 60;
+};
+
+struct WorkCosts {
+  // A training point of the mean together with its gradient.
+  std::uint32_t gradient_point = 3;
+  IkWorkCosts ik{};
+  // The end of an IK request, or a streamed target's best point so far:
+  // the cable lengths of the joints, the setpoint frames and the report.
+  std::uint32_t ik_finish = 150;
+  // A cycle's work beyond the GP sum and the IK slice: the cables' joints,
+  // the nominal forward kinematics and the exponential, the frames it sends,
+  // a target's start and an in-progress report.
+  std::uint32_t cycle_overhead = 150;
+  // The default budget of one cycle, overhead and GP sum included: what the
+  // boards this architecture targets can do in one period.
+  std::uint32_t cycle = 2000;
+};
+
+}  // namespace cdcr::model
