@@ -95,8 +95,8 @@ RuntimeState Runtime::init() {
   model::IkSolverOptions<Scalar> solver_options;
   solver_options.max_corrections = kMaxIkCorrections;
   solver_options.max_iterations = kMaxIkIterations;
-  compensated_solver_.configure(geometry_, correction_, solver_options, kIkWorkCosts);
-  nominal_solver_.configure(geometry_, no_correction_, solver_options, kIkWorkCosts);
+  // In DEGRADED the same solver solves the nominal model.
+  solver_.configure(geometry_, mode_ == RuntimeState::run ? &correction_ : nullptr, solver_options, kIkWorkCosts);
   // The forward path spends one unit per training point and the overhead;
   // IK gets the rest.
   const std::uint32_t forward_units =
@@ -302,175 +302,6 @@ void Runtime::handle_target_commit(const hal::CanFrame& frame) {
   publish_ik_report();
 }
 
-// The solver of the current mode: compensated in RUN, nominal in DEGRADED.
-template <typename Work>
-static void with_solver(RuntimeState mode, CompensatedSolver& compensated, NominalSolver& nominal, Work&& work) {
-  if (mode == RuntimeState::run) {
-    work(compensated);
-  } else {
-    work(nominal);
-  }
-}
-
-void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& commit) {
-  // A streamed target continues the running streamed request's work.
-  const bool retarget = solving_ && solving_tracking_ && commit.tracking;
-  if (solving_) end_solve(protocol::IkOutcome::superseded);
-  Joints initial(2 * geometry_.segment_count);
-  if (has_setpoints_) {
-    initial = setpoint_joints_;
-  } else if (has_pose_) {
-    initial = latest_pose_.joints;
-  } else {
-    // A slight bend keeps the first Jacobian away from the straight pose.
-    for (int s = 0; s < geometry_.segment_count; ++s) {
-      initial[2 * s] = Scalar(0);
-      initial[2 * s + 1] = Scalar(0.1);
-    }
-  }
-  const model::IkTargetKind kind =
-      commit.mode == protocol::TargetMode::pose ? model::IkTargetKind::pose : model::IkTargetKind::position;
-  model::Status started = model::Status::ok;
-  with_solver(mode_, compensated_solver_, nominal_solver_, [&](auto& solver) {
-    // A streamed target starts where the last request's best point is, with
-    // the correction there and its slope known; any other from the setpoints.
-    started = retarget          ? solver.retarget(target, kind, initial)
-              : commit.tracking ? solver.start_warm(target, kind, initial)
-                                : solver.start(target, kind, initial);
-  });
-  solving_sequence_ = commit.sequence;
-  solving_mode_ = commit.mode;
-  solving_tracking_ = commit.tracking;
-  solving_cycles_ = 0;
-  // A streamed target that takes over the work may still send the point
-  // already sent only once.
-  if (!retarget) published_best_bend_.resize(0);
-  if (started != model::Status::ok) {
-    last_ik_report_ = IkReport{};
-    last_ik_report_.sequence = commit.sequence;
-    last_ik_report_.model_status = started;
-    last_ik_report_.outcome = protocol::IkOutcome::unreachable;
-    record_event(FaultCode::target_unreachable, FaultDetail(started));
-    publish_ik_report();
-    return;
-  }
-  solving_end_ = model::IkSolveState::running;
-  solving_ = true;
-}
-
-// A cycle's IK slice: solver steps within ik_units_per_cycle_, and the
-// request's end (setpoints and report, kWorkCosts.ik_finish) when what is
-// left of the slice pays for it; otherwise the end goes out first thing in
-// the next cycle's slice.
-void Runtime::continue_solve() {
-  if (state_ != RuntimeState::run && state_ != RuntimeState::degraded) return;
-  ++solving_cycles_;
-  if (solving_end_ != model::IkSolveState::running) {
-    ik_units_last_cycle_ = kWorkCosts.ik_finish;
-    finish_solve(solving_end_);
-    return;
-  }
-  model::IkSolveState end = model::IkSolveState::running;
-  std::uint32_t spent = 0;
-  with_solver(mode_, compensated_solver_, nominal_solver_, [&](auto& solver) {
-    spent = solver.run(ik_units_per_cycle_);
-    end = solver.state();
-    if (end != model::IkSolveState::running || !solving_tracking_ || !solver.has_best()) return;
-    if (ik_units_per_cycle_ - spent < kWorkCosts.ik_finish) return;
-    // Streamed targets: the best point so far, when it is close and new.
-    const bool close = solver.best_position_error_mm() <= kTrackingPublishPositionErrorMm &&
-                       (solving_mode_ == protocol::TargetMode::position ||
-                        solver.best_orientation_error_rad() <= kTrackingPublishOrientationErrorRad);
-    const bool is_new = published_best_bend_.size() != solver.best_bend().size() ||
-                        published_best_bend_ != solver.best_bend();
-    if (close && is_new) {
-      spent += kWorkCosts.ik_finish;
-      if (set_setpoints(solver.best_joints())) {
-        published_best_bend_ = solver.best_bend();
-        publish_setpoints();
-      }
-    }
-  });
-  ik_units_last_cycle_ = spent;
-  if (end != model::IkSolveState::running) {
-    if (ik_units_per_cycle_ - spent >= kWorkCosts.ik_finish) {
-      ik_units_last_cycle_ += kWorkCosts.ik_finish;
-      finish_solve(end);
-    } else {
-      solving_end_ = end;
-    }
-  } else if (solving_cycles_ >= kMaxIkCycles) {
-    ik_units_last_cycle_ += kWorkCosts.ik_finish;
-    finish_solve(model::IkSolveState::not_converged);
-  } else if (solving_cycles_ % kIkProgressEveryCycles == 0) {
-    fill_ik_report(protocol::IkOutcome::in_progress);
-    publish_ik_report();
-  }
-}
-
-void Runtime::fill_ik_report(protocol::IkOutcome outcome) {
-  last_ik_report_ = IkReport{};
-  last_ik_report_.sequence = solving_sequence_;
-  last_ik_report_.outcome = outcome;
-  last_ik_report_.cycles = solving_cycles_;
-  with_solver(mode_, compensated_solver_, nominal_solver_, [&](auto& solver) {
-    last_ik_report_.model_status = solver.state() == model::IkSolveState::failed ? solver.status()
-                                   : solver.state() == model::IkSolveState::converged
-                                       ? model::Status::ok
-                                       : model::Status::ik_not_converged;
-    last_ik_report_.iterations = solver.iterations();
-    last_ik_report_.position_error_mm = solver.best_position_error_mm();
-    last_ik_report_.orientation_error_rad =
-        solving_mode_ == protocol::TargetMode::pose ? solver.best_orientation_error_rad() : Scalar(0);
-  });
-}
-
-void Runtime::finish_solve(model::IkSolveState end) {
-  bool reached = false;
-  Joints joints;
-  with_solver(mode_, compensated_solver_, nominal_solver_, [&](auto& solver) {
-    if (end == model::IkSolveState::failed || !solver.has_best()) return;
-    // A residual within the accepted one counts, even if the solver's own
-    // (float rounding-level) tolerance was not met.
-    reached = end == model::IkSolveState::converged ||
-              (solver.best_position_error_mm() <= kIkAcceptedPositionErrorMm &&
-               (solving_mode_ == protocol::TargetMode::position ||
-                solver.best_orientation_error_rad() <= kIkAcceptedOrientationErrorRad));
-    joints = solver.best_joints();
-  });
-  fill_ik_report(protocol::IkOutcome::converged);
-  if (end != model::IkSolveState::converged && end != model::IkSolveState::failed) {
-    last_ik_report_.model_status = model::Status::ik_not_converged;
-  }
-  if (reached && set_setpoints(joints)) {
-    publish_setpoints();
-  } else {
-    // Setpoints held: the drives keep the last commanded lengths.
-    last_ik_report_.outcome = protocol::IkOutcome::unreachable;
-    record_event(FaultCode::target_unreachable, FaultDetail(last_ik_report_.model_status));
-  }
-  solving_ = false;
-  publish_ik_report();
-}
-
-void Runtime::end_solve(protocol::IkOutcome outcome) {
-  fill_ik_report(outcome);
-  solving_ = false;
-  publish_ik_report();
-}
-
-bool Runtime::set_setpoints(const Joints& joints) {
-  Cables cables;
-  if (model::cables_from_joints(joints, geometry_, cables) != model::Status::ok) return false;
-  for (int i = 0; i < cables.size(); ++i) {
-    if (!protocol::cable_length_encodable(double(cables[i]))) return false;
-  }
-  setpoints_mm_ = cables;
-  setpoint_joints_ = joints;
-  has_setpoints_ = true;
-  return true;
-}
-
 void Runtime::publish_pose() {
   const Pose& pose = latest_pose_.pose;
   hal::CanFrame frame;
@@ -483,25 +314,6 @@ void Runtime::publish_pose() {
   protocol::encode(orientation_frame(pose.rotation), frame);
   send(frame);
   statistics_.poses_published += 1;
-}
-
-void Runtime::publish_setpoints() {
-  for (int s = 0; s < geometry_.segment_count; ++s) {
-    const protocol::CableSetpoint setpoint{
-        s, {setpoints_mm_[4 * s], setpoints_mm_[4 * s + 1], setpoints_mm_[4 * s + 2], setpoints_mm_[4 * s + 3]}};
-    hal::CanFrame frame;
-    if (protocol::encode(setpoint, frame)) send(frame);
-  }
-  setpoints_published_ += 1;
-}
-
-void Runtime::publish_ik_report() {
-  const IkReport& r = last_ik_report_;
-  hal::CanFrame frame;
-  protocol::encode(protocol::IkReport{r.sequence, r.outcome, r.iterations, r.cycles, double(r.position_error_mm),
-                                      double(r.orientation_error_rad)},
-                   frame);
-  send(frame);
 }
 
 void Runtime::publish_status() {

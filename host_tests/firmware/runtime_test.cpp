@@ -68,6 +68,28 @@ TEST_F(RuntimeTest, CorruptedImageDegradesToNominalKinematics) {
   EXPECT_EQ(stats.fault_detail.image_status(), model::ImageStatus::checksum_mismatch);
 }
 
+// Without a valid image the same solver solves the nominal model: the
+// setpoints put the nominal tip (computed here from their joints) on the target.
+TEST_F(RuntimeTest, DegradedRuntimeSolvesTargetsOnTheNominalModel) {
+  std::vector<std::uint8_t> image = test_support::small_image();
+  image[image.size() / 2] ^= 0x40;
+  boot(image);
+  cycles(3);
+  ASSERT_EQ(runtime->state(), RuntimeState::degraded);
+  const model::Vec3<Scalar> target = runtime->latest_pose().pose.position_mm + model::Vec3<Scalar>(4, -3, 0);
+  host_frames();
+  send_position_target(target.x(), target.y(), target.z(), 9);
+  cycles_until_ik_done();
+  protocol::IkReport report;
+  ASSERT_TRUE(last_ik_report(report));
+  EXPECT_EQ(report.sequence, 9);
+  EXPECT_EQ(report.outcome, protocol::IkOutcome::converged);
+  ASSERT_TRUE(runtime->has_setpoints());
+  const model::Pose<Scalar> nominal =
+      model::forward_kinematics_bend(model::bend_from_joints(runtime->setpoint_joints()), runtime->geometry());
+  EXPECT_LT((nominal.position_mm - target).norm(), kIkAcceptedPositionErrorMm);
+}
+
 TEST_F(RuntimeTest, TruncatedImageDegrades) {
   std::vector<std::uint8_t> image = test_support::small_image();
   image.resize(image.size() - 9);

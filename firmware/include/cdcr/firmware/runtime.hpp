@@ -47,8 +47,7 @@ using Cables = model::CableVector<Scalar, kMaxSegments>;
 using Joints = model::JointVector<Scalar, kMaxSegments>;
 using Correction = model::GpCorrection<Scalar, Accumulator, kMaxSegments>;
 using Pose = model::Pose<Scalar>;
-using CompensatedSolver = model::IkSolver<Scalar, kMaxSegments, Correction>;
-using NominalSolver = model::IkSolver<Scalar, kMaxSegments, model::NoCorrection>;
+using Solver = model::IkSolver<Scalar, kMaxSegments, Correction>;
 
 struct CycleStatistics {
   std::uint32_t cycles = 0;
@@ -189,10 +188,9 @@ class Runtime {
   protocol::TargetPositionXy pending_position_;
   protocol::TargetOrientation pending_orientation_;
   IkReport last_ik_report_;
-  // The IK request in progress: one solver per mode, both in static memory.
-  CompensatedSolver compensated_solver_;
-  model::NoCorrection no_correction_;
-  NominalSolver nominal_solver_;
+  // The IK request in progress, its whole state in static memory; the
+  // solver works on the compensated model in RUN, the nominal in DEGRADED.
+  Solver solver_;
   bool solving_ = false;
   bool solving_tracking_ = false;
   protocol::TargetMode solving_mode_ = protocol::TargetMode::position;

@@ -210,11 +210,19 @@ class IkSolver {
   // forgets every target and the learned slope.
   void configure(const RobotGeometry<S, Max>& geometry, const Correction& correction,
                  const IkSolverOptions<S>& options = {}, const IkWorkCosts& costs = {}) {
+    configure(geometry, &correction, options, costs);
+  }
+  // Without a correction (nullptr) the solver solves the nominal model: a
+  // runtime without a valid image needs no second solver type for that.
+  void configure(const RobotGeometry<S, Max>& geometry, const Correction* correction,
+                 const IkSolverOptions<S>& options = {}, const IkWorkCosts& costs = {}) {
     geometry_ = &geometry;
-    if constexpr (kSliced) {
-      evaluator_ = &correction;
+    if (correction == nullptr) {
+      evaluator_ = nullptr;
+    } else if constexpr (kSliced) {
+      evaluator_ = correction;
     } else {
-      whole_.correction = &correction;
+      whole_.correction = correction;
       evaluator_ = &whole_;
     }
     options_ = options;
@@ -424,6 +432,15 @@ class IkSolver {
 
   void begin_outer(const Joints& bend) {
     point_ = bend;
+    if (evaluator_ == nullptr) {
+      // The nominal model: the correction and its slope are zero.
+      point_eps_.setZero();
+      point_gradient_.setZero(6, point_.size());
+      point_has_gradient_ = true;
+      ++corrections_;
+      phase_ = Phase::outer_step;
+      return;
+    }
     if (const Status s = evaluator_->begin_evaluation(point_, evaluation_, wants_gradient()); s != Status::ok) {
       fail(s);
       return;
