@@ -96,7 +96,8 @@ RuntimeState Runtime::init() {
   solver_options.max_corrections = kMaxIkCorrections;
   solver_options.max_iterations = kMaxIkIterations;
   // In DEGRADED the same solver solves the nominal model.
-  solver_.configure(geometry_, mode_ == RuntimeState::run ? &correction_ : nullptr, solver_options, kIkWorkCosts);
+  solver_.configure(geometry_, mode_ == RuntimeState::run ? &solver_correction_ : nullptr, solver_options,
+                    kIkWorkCosts);
   // The forward path spends one unit per training point and the overhead;
   // IK gets the rest.
   const std::uint32_t forward_units =
@@ -361,6 +362,28 @@ void Runtime::enter(RuntimeState next) {
   LogLine line;
   line << "state " << to_string(next);
   hal_.console.write_line(line.c_str());
+}
+
+model::Status SolverCorrection::begin_evaluation(const Joints& bend, Evaluation& evaluation,
+                                               bool with_gradient) const {
+  return correction_->begin_evaluation(bend, evaluation, with_gradient);
+}
+
+std::uint32_t SolverCorrection::continue_evaluation(Evaluation& evaluation, std::uint32_t max_units) const {
+  return correction_->continue_evaluation(evaluation, max_units);
+}
+
+bool SolverCorrection::evaluation_finished(const Evaluation& evaluation) const {
+  return correction_->evaluation_finished(evaluation);
+}
+
+bool SolverCorrection::evaluation_has_gradient(const Evaluation& evaluation) const {
+  return correction_->evaluation_has_gradient(evaluation);
+}
+
+void SolverCorrection::evaluation_result(const Evaluation& evaluation, model::Twist<Scalar>& eps,
+                                         model::Jacobian<Scalar, kMaxSegments>& d_eps_d_bend) const {
+  correction_->evaluation_result(evaluation, eps, d_eps_d_bend);
 }
 
 }  // namespace cdcr::firmware

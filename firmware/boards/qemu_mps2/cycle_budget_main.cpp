@@ -218,24 +218,25 @@ int solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies
 // What each kind of IK work costs on this core, in instructions: the
 // figures behind the work-unit costs the board's architecture file states
 // (model/arch/<arch>). A training point of the mean is the unit.
-model::IkSolver<float, firmware::kMaxSegments, firmware::Correction> probe_solver;
+firmware::Solver probe_solver;
+firmware::SolverCorrection probe_correction(correction);
 
 void report_unit_costs() {
   const std::uint32_t points = correction.training_points();
   model::JointVector<float> bend = model::JointVector<float>::Zero(2 * segments);
   for (int s = 0; s < segments; ++s) bend[2 * s] = 0.1f;
   firmware::Correction::Evaluation evaluation;
-  correction.begin_evaluation(bend, evaluation, false);
-  const std::uint32_t mean = counted([&] { correction.continue_evaluation(evaluation, points); });
-  correction.begin_evaluation(bend, evaluation, true);
+  probe_correction.begin_evaluation(bend, evaluation, false);
+  const std::uint32_t mean = counted([&] { probe_correction.continue_evaluation(evaluation, points); });
+  probe_correction.begin_evaluation(bend, evaluation, true);
   const std::uint32_t gradient =
-      counted([&] { correction.continue_evaluation(evaluation, points * firmware::Correction::kGradientPointUnits); });
+      counted([&] { probe_correction.continue_evaluation(evaluation, points * firmware::Correction::kGradientPointUnits); });
   // Each run(kProbeBudget) call of a solver charged these costs does one
   // step, told apart by the units it returns.
   constexpr std::uint32_t kProbeJacobian = 100'000, kProbeStep = 99'999, kProbeOuter = 99'998;
   constexpr std::uint32_t kProbeBudget = 100'000;
   model::IkSolverOptions<float> options;
-  probe_solver.configure(runtime.geometry(), correction, options,
+  probe_solver.configure(runtime.geometry(), probe_correction, options,
                          model::IkWorkCosts{kProbeJacobian, kProbeStep, kProbeOuter});
   std::uint32_t start_max = 0;
   struct Step {

@@ -47,7 +47,25 @@ using Cables = model::CableVector<Scalar, kMaxSegments>;
 using Joints = model::JointVector<Scalar, kMaxSegments>;
 using Correction = model::GpCorrection<Scalar, Accumulator, kMaxSegments>;
 using Pose = model::Pose<Scalar>;
-using Solver = model::IkSolver<Scalar, kMaxSegments, Correction>;
+// The correction as the IK solver sees it: the GP's evaluation in slices.
+// Its functions are defined in runtime.cpp, beside the forward path, so the
+// GP loops are compiled as the forward path's are wherever the solver is
+// compiled (firmware/CMakeLists.txt).
+class SolverCorrection {
+ public:
+  using Evaluation = Correction::Evaluation;
+  explicit SolverCorrection(const Correction& correction) : correction_(&correction) {}
+  model::Status begin_evaluation(const Joints& bend, Evaluation& evaluation, bool with_gradient) const;
+  std::uint32_t continue_evaluation(Evaluation& evaluation, std::uint32_t max_units) const;
+  bool evaluation_finished(const Evaluation& evaluation) const;
+  bool evaluation_has_gradient(const Evaluation& evaluation) const;
+  void evaluation_result(const Evaluation& evaluation, model::Twist<Scalar>& eps,
+                         model::Jacobian<Scalar, kMaxSegments>& d_eps_d_bend) const;
+
+ private:
+  const Correction* correction_;
+};
+using Solver = model::IkSolver<Scalar, kMaxSegments, SolverCorrection>;
 
 struct CycleStatistics {
   std::uint32_t cycles = 0;
@@ -190,6 +208,7 @@ class Runtime {
   IkReport last_ik_report_;
   // The IK request in progress, its whole state in static memory; the
   // solver works on the compensated model in RUN, the nominal in DEGRADED.
+  SolverCorrection solver_correction_{correction_};
   Solver solver_;
   bool solving_ = false;
   bool solving_tracking_ = false;

@@ -603,21 +603,11 @@ class IkSolver {
   void finish_inner() { begin_outer(inner_bend_); }
 
   // One LM iteration on the linearised model.
-  void update_rows() {
-    if (kind_ == IkTargetKind::pose) {
-      update_rows_of<6>();
-    } else {
-      update_rows_of<3>();
-    }
-  }
-
-  void inner_iteration() {
-    if (kind_ == IkTargetKind::pose) {
-      inner_iteration_rows<6>();
-    } else {
-      inner_iteration_rows<3>();
-    }
-  }
+  // Position targets use the same six rows with the orientation rows and
+  // residual zero: the damped step is then the three-row one, and the
+  // firmware carries one copy of the code.
+  void update_rows() { update_rows_of<6>(); }
+  void inner_iteration() { inner_iteration_rows<6>(); }
 
   // The linearised model's Jacobian at inner_bend_, as residual rows.
   template <int Rows>
@@ -634,7 +624,7 @@ class IkSolver {
     rows_.setZero();
     rows_.template topLeftCorner<3, kMaxColumns>().leftCols(2 * segments) =
         spatial.template topRows<3>() - hat3<S>(tip.position_mm) * spatial.template bottomRows<3>();
-    if constexpr (Rows == 6) {
+    if (kind_ == IkTargetKind::pose) {
       rows_.template bottomLeftCorner<3, kMaxColumns>().leftCols(2 * segments) =
           weight_ * spatial.template bottomRows<3>();
     }
@@ -742,7 +732,7 @@ class IkSolver {
     // to heap workspace, which a board build must not link.
     const auto used = reduced.leftCols(columns);
     Eigen::Matrix<S, Rows, Rows> normal = used.lazyProduct(used.transpose());
-    const S scale = normal.trace() / S(Rows);
+    const S scale = normal.trace() / S(kind_ == IkTargetKind::pose ? 6 : 3);
     normal.diagonal().array() += damping_ * scale + std::numeric_limits<S>::min();
     const Eigen::Matrix<S, Rows, 1> y = normal.ldlt().solve(inner_residual_.template head<Rows>());
     Eigen::Matrix<S, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxColumns, 1> step = used.transpose().lazyProduct(y);
