@@ -181,8 +181,23 @@ int main() {
       runtime.run_cycle(next);
       drain_transmitted();
     }
-    ok = ok && runtime.last_ik_report().sequence == c &&
-         runtime.last_ik_report().outcome == cdcr::firmware::protocol::IkOutcome::converged;
+    if (runtime.last_ik_report().sequence != c ||
+        runtime.last_ik_report().outcome != cdcr::firmware::protocol::IkOutcome::converged) {
+      console::console_write("FAIL: the runtime's request of case ");
+      console::console_write_int(c);
+      console::console_write(" ended with outcome ");
+      console::console_write_int(static_cast<std::int32_t>(runtime.last_ik_report().outcome));
+      console::console_write(" after ");
+      console::console_write_int(runtime.last_ik_report().cycles);
+      console::console_write(" cycles and ");
+      console::console_write_int(runtime.last_ik_report().iterations);
+      console::console_write(" iterations, position residual ");
+      console::console_write_fixed(runtime.last_ik_report().position_error_mm, 5);
+      console::console_write(" mm, orientation ");
+      console::console_write_fixed(runtime.last_ik_report().orientation_error_rad, 6);
+      console::console_write(" rad\n");
+      ok = false;
+    }
     // Keep the STATUS heartbeat (every tenth cycle) out of the counted ones.
     while ((runtime.statistics().cycles + 1) % cdcr::firmware::kStatusEveryCycles == 0 ||
            (runtime.statistics().cycles + 2) % cdcr::firmware::kStatusEveryCycles == 0) {
@@ -221,6 +236,11 @@ int main() {
     if (!ik_result.converged() && !(ik_result.position_error_mm <= cdcr::firmware::kIkAcceptedPositionErrorMm &&
                                     ik_result.orientation_error_rad <= cdcr::firmware::kIkAcceptedOrientationErrorRad)) {
       ++not_converged;
+      console::console_write("FAIL: solve_ik of case ");
+      console::console_write_int(c);
+      console::console_write(" stopped at orientation error ");
+      console::console_write_fixed(ik_result.orientation_error_rad, 6);
+      console::console_write(" rad\n");
     }
     // Per GP evaluation (the solver's outer iteration), the unit of its cost.
     ik_per_iteration[c] = ik_result.corrections > 0 ? ik[c] / static_cast<std::uint32_t>(ik_result.corrections) : ik[c];

@@ -87,8 +87,9 @@ struct IkSolverOptions {
   int max_iterations = 400;
   // Nominal LM iterations between two correction evaluations.
   int max_inner_iterations = 12;
-  // Starts after the first one, when a start stalls further than
-  // restart_above_mm from the target.
+  // Starts after the first one, when a start stalls above the arithmetic's
+  // floor (20 position tolerances), or when no step helps at all further
+  // than restart_above_mm from the target.
   int max_restarts = 3;
   S restart_above_mm = S(1);
   // Learn the correction's slope from the evaluations (Broyden).
@@ -517,8 +518,10 @@ class IkSolver {
       return;
     }
     if (stalled_outer_ >= 2) {
-      // Close to the target a stall is the arithmetic's floor, not a bad start.
-      if (position_error <= options_.restart_above_mm || !restart()) state_ = IkSolveState::not_converged;
+      // Near the tolerance a stall is the arithmetic's floor, not a bad
+      // start (the gradient was evaluated after the first stalled step).
+      const bool at_floor = position_error <= S(20) * options_.position_tolerance_mm;
+      if (at_floor || !restart()) state_ = IkSolveState::not_converged;
       return;
     }
     // A stale slope shows as poor contraction: evaluate the gradient with
