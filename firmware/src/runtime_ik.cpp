@@ -67,16 +67,23 @@ void Runtime::continue_solve() {
     end = solver.state();
     if (end != model::IkSolveState::running || !solving_tracking_ || !solver.has_best()) return;
     if (ik_units_per_cycle_ - spent < kWorkCosts.ik_finish) return;
-    // Streamed targets: the best point so far, when it is close and new.
-    const bool close = solver.best_position_error_mm() <= kTrackingPublishPositionErrorMm &&
+    // Streamed targets: the best point so far, when it is close and new;
+    // between evaluations the linearised solve's point, when it is closer.
+    const bool linearised = solver.has_linearised_point() &&
+                            solver.linearised_position_error_mm() < solver.best_position_error_mm();
+    const Joints& bend = linearised ? solver.linearised_bend() : solver.best_bend();
+    const Scalar position_error =
+        linearised ? solver.linearised_position_error_mm() : solver.best_position_error_mm();
+    const Scalar orientation_error =
+        linearised ? solver.linearised_orientation_error_rad() : solver.best_orientation_error_rad();
+    const bool close = position_error <= kTrackingPublishPositionErrorMm &&
                        (solving_mode_ == protocol::TargetMode::position ||
-                        solver.best_orientation_error_rad() <= kTrackingPublishOrientationErrorRad);
-    const bool is_new = published_best_bend_.size() != solver.best_bend().size() ||
-                        published_best_bend_ != solver.best_bend();
+                        orientation_error <= kTrackingPublishOrientationErrorRad);
+    const bool is_new = published_best_bend_.size() != bend.size() || published_best_bend_ != bend;
     if (close && is_new) {
       spent += kWorkCosts.ik_finish;
-      if (set_setpoints(solver.best_joints())) {
-        published_best_bend_ = solver.best_bend();
+      if (set_setpoints(linearised ? solver.linearised_joints() : solver.best_joints())) {
+        published_best_bend_ = bend;
         publish_setpoints();
       }
     }

@@ -181,5 +181,37 @@ TEST(IkSolver, WarmStartsAlongAPathNeedFewEvaluations) {
   EXPECT_LE(evaluations, 50 * 3);
 }
 
+// Between evaluations the solver offers the linearised solve's point; its
+// residual is the linearised model's, which near the last evaluation is the
+// compensated model's (computed here from its joints) to well within the
+// tracking threshold, and it is offered only while that solve runs.
+TEST(IkSolver, LinearisedPointIsWhereItsResidualSays) {
+  Fixture f;
+  make(f, 203);
+  static IkSolver<float, kMaxSegments, Correction> solver;
+  solver.configure(f.geometry, f.correction);
+  std::mt19937 rng(7);
+  int checked = 0;
+  for (int t = 0; t < 10; ++t) {
+    const JointVector<float> start = random_joints(rng, 4, 0.2);
+    JointVector<float> goal = start;
+    for (int s = 0; s < 4; ++s) goal[2 * s + 1] += 0.02f;
+    const JointVector<float> goal_bend = bend_from_joints(goal);
+    const Pose<float> target = exp(f.correction.predict(goal_bend)) * forward_kinematics_bend(goal_bend, f.geometry);
+    ASSERT_EQ(solver.start(target, IkTargetKind::position, start), Status::ok);
+    while (solver.state() == IkSolveState::running) {
+      solver.run(400);
+      if (!solver.has_linearised_point()) continue;
+      const JointVector<float> bend = bend_from_joints(solver.linearised_joints());
+      const Pose<float> tip = exp(f.correction.predict(bend)) * forward_kinematics_bend(bend, f.geometry);
+      const float exact = (target.position_mm - tip.position_mm).norm();
+      EXPECT_NEAR(exact, solver.linearised_position_error_mm(), 0.05f) << "target " << t;
+      ++checked;
+    }
+    EXPECT_FALSE(solver.has_linearised_point());
+  }
+  EXPECT_GT(checked, 20);
+}
+
 }  // namespace
 }  // namespace cdcr::model

@@ -369,20 +369,30 @@ class IkSolver {
   bool has_best() const { return best_cost_ < std::numeric_limits<S>::infinity(); }
   // The best point whose compensated residual has been evaluated exactly,
   // as (alpha, theta) pairs, and its residual.
-  Joints best_joints() const {
-    Joints joints = joints_from_bend(best_bend_);
+  Joints best_joints() const { return clamped_joints(best_bend_); }
+  S best_position_error_mm() const { return best_position_error_; }
+  // The linearised solve's current point, while one runs: its correction is
+  // predicted from the last evaluation and the slope, not evaluated, so it is
+  // for following a stream of targets between evaluations.
+  bool has_linearised_point() const { return state_ == IkSolveState::running && phase_ == Phase::inner; }
+  const Joints& linearised_bend() const { return inner_bend_; }
+  Joints linearised_joints() const { return clamped_joints(inner_bend_); }
+  S linearised_position_error_mm() const { return inner_position_error_; }
+  S linearised_orientation_error_rad() const { return inner_orientation_error_; }
+  const Joints& best_bend() const { return best_bend_; }
+  S best_orientation_error_rad() const { return best_orientation_error_; }
+
+ private:
+  enum class Phase : std::uint8_t { evaluate, outer_step, inner };
+
+  Joints clamped_joints(const Joints& bend) const {
+    Joints joints = joints_from_bend(bend);
     for (int i = 0; i < geometry_->segment_count; ++i) {
       // A point on the limit circle can sit one rounding step outside it.
       joints[2 * i + 1] = std::min(joints[2 * i + 1], geometry_->segments[i].theta_max_rad);
     }
     return joints;
   }
-  S best_position_error_mm() const { return best_position_error_; }
-  const Joints& best_bend() const { return best_bend_; }
-  S best_orientation_error_rad() const { return best_orientation_error_; }
-
- private:
-  enum class Phase : std::uint8_t { evaluate, outer_step, inner };
 
   // Residual of the target against a tip pose: position (mm) and, for pose
   // targets, the weighted rotation vector of R_target R^T.

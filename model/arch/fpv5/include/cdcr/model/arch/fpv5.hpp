@@ -15,11 +15,10 @@ namespace cdcr::model::arch {
 struct Fpv5 : Fpv4 {
   // Measured on the Cortex-M7 (qemu.cycle_budget_m7 prints the figures): a
   // mean point 47 instructions, with the gradient 142; the IK Jacobian at
-  // most 19,900, the damped step 21,500, the outer step 7,300 (the IK code is
-  // built at -O2, firmware/CMakeLists.txt); a request's end 6,300; the rest
-  // of a cycle about 9,000 beyond its GP sum. 1,600 units are 75,200
-  // instructions, within the board's 80,000.
-  static constexpr WorkCosts kWorkCosts{3, {430, 465, 160}, 140, 200, 1600};
+  // most 13,500, the damped step 18,000, the outer step 6,200; a request's
+  // end 6,300; the rest of a cycle about 9,000 beyond its GP sum. 1,600
+  // units are 75,200 instructions, within the board's 80,000.
+  static constexpr WorkCosts kWorkCosts{3, {290, 390, 135}, 140, 200, 1600};
 
   template <int Dims, typename S, typename Accumulator, std::uint32_t BlockPoints>
   static constexpr bool has_mean_blocks() {
