@@ -1,13 +1,17 @@
-# cmake -DCDCR= -DMAKE_GOLDEN= -DOUT_DIR= -P make_golden_model.cmake
+# cmake -DCDCR= -DMAKE_GOLDEN= -DOUT_DIR= [-DSAMPLES=750] -P make_golden_model.cmake
 # The model the board programs carry, made the way a user makes one: the
 # simulated robot's default data set (750 samples, 4 segments), trained on
-# 700 of them, then the image and the host's golden results.
+# 700 of them, then the image and the host's golden results. SAMPLES makes a
+# larger one (1,074 samples give the runtime's capacity, 1,024 points).
 foreach(variable CDCR MAKE_GOLDEN OUT_DIR)
   if(NOT ${variable})
     message(FATAL_ERROR "make_golden_model.cmake: ${variable} is not set")
   endif()
 endforeach()
 file(MAKE_DIRECTORY ${OUT_DIR})
+if(NOT SAMPLES)
+  set(SAMPLES 750)
+endif()
 
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE status)
@@ -18,7 +22,7 @@ function(run)
 endfunction()
 
 # Training takes seconds; keep a model whose data set has not changed.
-run(${CDCR} simulate --samples 750 --seed 1 --out ${OUT_DIR}/robot.csv.new)
+run(${CDCR} simulate --samples ${SAMPLES} --seed 1 --out ${OUT_DIR}/robot.csv.new)
 execute_process(COMMAND ${CMAKE_COMMAND} -E compare_files ${OUT_DIR}/robot.csv.new ${OUT_DIR}/robot.csv
                 RESULT_VARIABLE changed)
 if(changed OR NOT EXISTS ${OUT_DIR}/model.img)
