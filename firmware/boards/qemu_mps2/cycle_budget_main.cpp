@@ -321,7 +321,7 @@ int main() {
 
   // Targets anywhere in the paper's workspace, pose and position, with an
   // unreachable one every eighth.
-  for (int t = 0; t < 60; ++t) {
+  for (int t = 0; t < 240; ++t) {
     if (t % 8 == 7) {
       model::Pose<float> far;
       far.position_mm = model::Vec3<float>(900.0f, 0.0f, 50.0f);
