@@ -121,21 +121,20 @@ void deliver_target(const model::Pose<float>& target, protocol::TargetMode mode,
   board.can.deliver(frame);
 }
 
-// Where the compensated model puts the tip for random joints.
+// Where the compensated model puts the tip for the given joints.
+model::Pose<float> compensated_tip(const model::JointVector<float>& joints) {
+  const model::JointVector<float> bend = model::bend_from_joints(joints);
+  return model::exp(correction.predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
+}
+
+// ... and for random joints.
 model::Pose<float> reachable_target(float theta_max_rad) {
   model::JointVector<float> joints(2 * segments);
   for (int s = 0; s < segments; ++s) {
     joints[2 * s] = uniform(-3.14159f, 3.14159f);
     joints[2 * s + 1] = uniform(0.0f, std::min(theta_max_rad, runtime.geometry().segments[s].theta_max_rad));
   }
-  const model::JointVector<float> bend = model::bend_from_joints(joints);
-  return model::exp(correction.predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
-}
-
-// Where the compensated model puts the tip for the given joints.
-model::Vec3<float> reachable_tip(const model::JointVector<float>& joints) {
-  const model::JointVector<float> bend = model::bend_from_joints(joints);
-  return (model::exp(correction.predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry())).position_mm;
+  return compensated_tip(joints);
 }
 
 // Latencies in cycles, per kind of request.
@@ -347,12 +346,12 @@ int main() {
   // they hold, against the target of this cycle, in cycles of path (0.1 mm
   // each at 100 mm/s and 1 kHz).
   constexpr float kPathPerCycleMm = 0.1f;
-  model::Vec3<float> held_tip = reachable_tip(runtime.setpoint_joints());
+  model::Vec3<float> held_tip = compensated_tip(runtime.setpoint_joints()).position_mm;
   for (int step = 1; step <= 800; ++step) {
     deliver_target(on_circle(step), protocol::TargetMode::position, true, next_sequence++);
     const std::uint32_t before = runtime.setpoints_published();
     cycle();
-    if (runtime.setpoints_published() != before) held_tip = reachable_tip(runtime.setpoint_joints());
+    if (runtime.setpoints_published() != before) held_tip = compensated_tip(runtime.setpoint_joints()).position_mm;
     const float lag = (held_tip - on_circle(step).position_mm).norm() / kPathPerCycleMm;
     if (step > 20) streamed.add(static_cast<int>(std::ceil(lag)), true);
   }

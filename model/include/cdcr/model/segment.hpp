@@ -60,10 +60,14 @@ Status joints_from_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& ge
   // to about eps * l / r above the limit (one rounding of each cable length,
   // divided by the lever arm). That is the limit itself, not beyond it.
   const S rounding_rad = S(16) * std::numeric_limits<S>::epsilon() * cables_mm.maxCoeff() / geometry.anchor_radius_mm;
-  // Both differences may be off by one step: the chord by up to sqrt(2) steps.
-  const S chord_within_resolution = std::max(S(0), chord - S(1.41421356) * cable_resolution_mm);
-  const S theta_within_resolution = S(2) * std::asin(chord_within_resolution / reach);
-  if (theta_within_resolution > geometry.theta_max_rad + rounding_rad) return Status::theta_beyond_limit;
+  if (theta > geometry.theta_max_rad + rounding_rad) {
+    // Both differences may be off by one step: the chord by up to sqrt(2)
+    // steps. Only cables past the limit pay for the second arcsine.
+    const S chord_within_resolution = std::max(S(0), chord - S(1.41421356) * cable_resolution_mm);
+    if (S(2) * std::asin(chord_within_resolution / reach) > geometry.theta_max_rad + rounding_rad) {
+      return Status::theta_beyond_limit;
+    }
+  }
   joints = SegmentJoints<S>{std::atan2(d24, d31), std::min(theta, geometry.theta_max_rad)};
   return Status::ok;
 }
