@@ -7,7 +7,9 @@
 #   6.   the image checked and exported for a board;
 #   7.   accuracy on an independent test set of the same robot;
 #   8.   the firmware runtime with that image in closed loop with the
-#        simulated robot over the simulated bus at 1 kHz.
+#        simulated robot over the simulated bus at 1 kHz;
+#   9.   the same loop following a streamed circle (a TRACKING target
+#        every cycle, 40 mm radius at 50 mm/s).
 # Everything it writes goes to build/demo/.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
@@ -92,3 +94,6 @@ run "$cdcr" eval --model "$out/model.img" --data "$out/test.csv"
 heading "8. The firmware runtime in closed loop with the simulated robot, 1 kHz for 3 s"
 echo "(the same robot: targets it can reach, cable drives on the simulated bus)"
 run build/bin/cdcr-runtime --image "$out/model.img" --sim --rate 1000 --seconds 3
+
+heading "9. The same loop following a streamed circle: a target every cycle, 40 mm radius at 50 mm/s"
+run build/bin/cdcr-runtime --image "$out/model.img" --sim --circle --circle-radius 40 --circle-speed 50

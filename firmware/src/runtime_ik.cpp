@@ -63,46 +63,57 @@ void Runtime::continue_solve() {
   model::IkSolveState end = model::IkSolveState::running;
   std::uint32_t spent = 0;
   [&](Solver& solver) {
-    spent = solver.run(ik_units_per_cycle_);
-    end = solver.state();
-    if (end != model::IkSolveState::running || !solving_tracking_ || !solver.has_best()) return;
-    if (ik_units_per_cycle_ - spent < kWorkCosts.ik_finish) return;
-    // Streamed targets: the best point so far, when it is close and new;
-    // between evaluations the linearised solve's point, when it is closer.
-    const bool linearised = solver.has_linearised_point() &&
-                            solver.linearised_position_error_mm() < solver.best_position_error_mm();
-    const Joints& bend = linearised ? solver.linearised_bend() : solver.best_bend();
-    const Scalar position_error =
-        linearised ? solver.linearised_position_error_mm() : solver.best_position_error_mm();
-    const Scalar orientation_error =
-        linearised ? solver.linearised_orientation_error_rad() : solver.best_orientation_error_rad();
-    const bool close = position_error <= kTrackingPublishPositionErrorMm &&
-                       (solving_mode_ == protocol::TargetMode::position ||
-                        orientation_error <= kTrackingPublishOrientationErrorRad);
-    const bool is_new = published_best_bend_.size() != bend.size() || published_best_bend_ != bend;
-    if (close && is_new) {
+    // A streamed request keeps room for its setpoints in every cycle; on a
+    // core where a step and the setpoints do not fit in one slice, a cycle
+    // first sends what the last one's step found, then steps again.
+    const bool room_for_both = ik_units_per_cycle_ >= spent + kWorkCosts.ik_finish + kIkWorkCosts.nominal_step;
+    if (solving_tracking_ && !room_for_both && spent + kWorkCosts.ik_finish <= ik_units_per_cycle_ &&
+        publish_tracking_point(solver)) {
       spent += kWorkCosts.ik_finish;
-      if (set_setpoints(linearised ? solver.linearised_joints() : solver.best_joints())) {
-        published_best_bend_ = bend;
-        publish_setpoints();
-      }
     }
+    const std::uint32_t reserved = solving_tracking_ && room_for_both ? kWorkCosts.ik_finish : 0;
+    spent += solver.run(ik_units_per_cycle_ - spent - reserved);
+    end = solver.state();
+    if (end != model::IkSolveState::running || !solving_tracking_) return;
+    if (spent + kWorkCosts.ik_finish > ik_units_per_cycle_) return;
+    if (publish_tracking_point(solver)) spent += kWorkCosts.ik_finish;
   }(solver_);
   ik_units_last_cycle_ = spent;
+  // A request that has used its cycles ends as not converged.
+  if (end == model::IkSolveState::running && solving_cycles_ >= kMaxIkCycles) end = model::IkSolveState::not_converged;
   if (end != model::IkSolveState::running) {
-    if (ik_units_per_cycle_ - spent >= kWorkCosts.ik_finish) {
+    if (spent + kWorkCosts.ik_finish <= ik_units_per_cycle_) {
       ik_units_last_cycle_ += kWorkCosts.ik_finish;
       finish_solve(end);
     } else {
       solving_end_ = end;
     }
-  } else if (solving_cycles_ >= kMaxIkCycles) {
-    ik_units_last_cycle_ += kWorkCosts.ik_finish;
-    finish_solve(model::IkSolveState::not_converged);
   } else if (solving_cycles_ % kIkProgressEveryCycles == 0) {
     fill_ik_report(protocol::IkOutcome::in_progress);
     publish_ik_report();
   }
+}
+
+// Streamed targets: the best point so far, when it is close and new;
+// between evaluations the linearised solve's point, when it is closer.
+// Returns whether setpoints went out.
+bool Runtime::publish_tracking_point(Solver& solver) {
+  if (!solver.has_best()) return false;
+  const bool linearised =
+      solver.has_linearised_point() && solver.linearised_position_error_mm() < solver.best_position_error_mm();
+  const Joints& bend = linearised ? solver.linearised_bend() : solver.best_bend();
+  const Scalar position_error = linearised ? solver.linearised_position_error_mm() : solver.best_position_error_mm();
+  const Scalar orientation_error =
+      linearised ? solver.linearised_orientation_error_rad() : solver.best_orientation_error_rad();
+  const bool close = position_error <= kTrackingPublishPositionErrorMm &&
+                     (solving_mode_ == protocol::TargetMode::position ||
+                      orientation_error <= kTrackingPublishOrientationErrorRad);
+  const bool is_new = published_best_bend_.size() != bend.size() || published_best_bend_ != bend;
+  if (!close || !is_new) return false;
+  if (!set_setpoints(linearised ? solver.linearised_joints() : solver.best_joints())) return false;
+  published_best_bend_ = bend;
+  publish_setpoints();
+  return true;
 }
 
 void Runtime::fill_ik_report(protocol::IkOutcome outcome) {
@@ -156,12 +167,17 @@ void Runtime::end_solve(protocol::IkOutcome outcome) {
   publish_ik_report();
 }
 
+// The frames are encoded here, where each length is checked, and kept for
+// publish_setpoints().
 bool Runtime::set_setpoints(const Joints& joints) {
   Cables cables;
   if (model::cables_from_joints(joints, geometry_, cables) != model::Status::ok) return false;
-  for (int i = 0; i < cables.size(); ++i) {
-    if (!protocol::cable_length_encodable(double(cables[i]))) return false;
+  hal::CanFrame frames[kMaxSegments];
+  for (int s = 0; s < geometry_.segment_count; ++s) {
+    const protocol::CableSetpoint setpoint{s, {cables[4 * s], cables[4 * s + 1], cables[4 * s + 2], cables[4 * s + 3]}};
+    if (!protocol::encode(setpoint, frames[s])) return false;
   }
+  for (int s = 0; s < geometry_.segment_count; ++s) setpoint_frames_[s] = frames[s];
   setpoints_mm_ = cables;
   setpoint_joints_ = joints;
   has_setpoints_ = true;
@@ -169,12 +185,7 @@ bool Runtime::set_setpoints(const Joints& joints) {
 }
 
 void Runtime::publish_setpoints() {
-  for (int s = 0; s < geometry_.segment_count; ++s) {
-    const protocol::CableSetpoint setpoint{
-        s, {setpoints_mm_[4 * s], setpoints_mm_[4 * s + 1], setpoints_mm_[4 * s + 2], setpoints_mm_[4 * s + 3]}};
-    hal::CanFrame frame;
-    if (protocol::encode(setpoint, frame)) send(frame);
-  }
+  for (int s = 0; s < geometry_.segment_count; ++s) send(setpoint_frames_[s]);
   setpoints_published_ += 1;
 }
 

@@ -103,6 +103,56 @@ TEST(SignalCodec, CheckedEncodingRefusesWhatItCannotRepresent) {
 
 // --- the table ------------------------------------------------------------
 
+// The single-precision shortcut must give the double computation's raw
+// value for every float: random lengths over the whole range, and the floats
+// nearest each half-way point, where a rounding in single precision would
+// go the other way.
+TEST(SignalCodec, SinglePrecisionScalingMatchesTheDoubleOne) {
+  const SignalSpec& spec = cable_lengths::kL1;
+  std::uint32_t state = 12345;
+  const auto next = [&] {
+    state = state * 1664525u + 1013904223u;
+    return float(state >> 8) / 16777216.0f;
+  };
+  int compared = 0;
+  const auto same = [&](float length_mm) {
+    std::int64_t expected = -1, actual = -2;
+    const bool expected_ok = to_raw_checked(spec, double(length_mm), expected);
+    const bool actual_ok = to_raw_checked_single(spec, double(length_mm), actual);
+    ++compared;
+    if (expected_ok != actual_ok || (expected_ok && expected != actual)) {
+      ADD_FAILURE() << "length " << length_mm << ": double " << expected_ok << "/" << expected << ", single "
+                    << actual_ok << "/" << actual;
+      return false;
+    }
+    return true;
+  };
+  for (int i = 0; i < 200000; ++i) {
+    if (!same(-10.0f + 700.0f * next())) return;
+  }
+  for (int k = 0; k < 65600; ++k) {
+    const float halfway = (float(k) + 0.5f) * 0.01f;
+    float below = halfway, above = halfway;
+    for (int step = 0; step < 8; ++step) {
+      below = std::nextafter(below, 0.0f);
+      above = std::nextafter(above, 1e9f);
+      if (!same(below) || !same(above) || !same(halfway)) return;
+    }
+  }
+  for (const float special : {0.0f, -0.0f, std::numeric_limits<float>::quiet_NaN(),
+                              std::numeric_limits<float>::infinity(), 1e9f, -1e9f}) {
+    if (!same(special)) return;
+  }
+  // Doubles that are no float, next to a half-way point: the double's own
+  // rounding counts.
+  std::int64_t raw = 0;
+  ASSERT_TRUE(to_raw_checked_single(spec, 123.454999999, raw));
+  EXPECT_EQ(raw, 12345);
+  ASSERT_TRUE(to_raw_checked_single(spec, 123.455000001, raw));
+  EXPECT_EQ(raw, 12346);
+  EXPECT_GT(compared, 300000);
+}
+
 TEST(ProtocolTable, SignalsLieInsideTheirFrameAndApart) {
   for (const MessageSpec* message : kMessages) {
     SCOPED_TRACE(message->name);

@@ -6,6 +6,7 @@
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 #include <random>
 #include <string>
 
@@ -92,6 +93,47 @@ TEST(RuntimeReplay, CorruptImageIsOneLineErrorWithExitOne) {
   const int usage = std::system((std::string("\"") + CDCR_RUNTIME_EXE + "\" --replay x 2>/dev/null").c_str());
   ASSERT_TRUE(WIFEXITED(usage));
   EXPECT_EQ(WEXITSTATUS(usage), 2);
+}
+
+// The closed loop following a streamed circle (`--sim --circle`): a pose in
+// every cycle, no overrun, setpoints in every streamed cycle, and setpoints
+// that solve each cycle's target on the runtime's own compensated model.
+TEST(RuntimeClosedLoop, FollowsAStreamedCircle) {
+  const std::vector<std::uint8_t> image = exporting::write_image(test_support::small_correction_model(200));
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_circle";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream out(dir / "model.img", std::ios::binary);
+    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
+  }
+  const std::string command = std::string("\"") + CDCR_RUNTIME_EXE + "\" --image \"" + (dir / "model.img").string() +
+                              "\" --sim --circle --circle-radius 20 --circle-speed 100 > \"" +
+                              (dir / "out.txt").string() + "\"";
+  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  std::ifstream in(dir / "out.txt");
+  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  double following_mean = -1, following_max = -1;
+  long sent = -1, streamed = -1, cycles = -1, missing = -1;
+  unsigned overruns = 1;
+  const std::size_t at = text.find("of which following");
+  ASSERT_NE(at, std::string::npos) << text;
+  ASSERT_EQ(std::sscanf(text.c_str() + text.find(": mean", at), ": mean %lf mm, max %lf mm", &following_mean,
+                        &following_max),
+            2)
+      << text;
+  const std::size_t sent_at = text.find("setpoints sent in");
+  ASSERT_NE(sent_at, std::string::npos) << text;
+  ASSERT_EQ(std::sscanf(text.c_str() + sent_at,
+                        "setpoints sent in %ld of %ld streamed cycles; cycles %ld, poses missing %ld, overruns %u",
+                        &sent, &streamed, &cycles, &missing, &overruns),
+            5)
+      << text;
+  EXPECT_GT(streamed, 1000);
+  EXPECT_EQ(sent, streamed);
+  EXPECT_EQ(missing, 0);
+  EXPECT_EQ(overruns, 0u);
+  EXPECT_LT(following_mean, 0.05) << text;
+  EXPECT_LT(following_max, 0.2) << text;
 }
 
 }  // namespace

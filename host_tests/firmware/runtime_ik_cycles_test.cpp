@@ -64,22 +64,39 @@ TEST_F(IkCyclesTest, PosePublishedEveryCycleWhileSolving) {
 }
 
 // A planner streams a TRACKING target every cycle along a circle at 100 mm/s
-// (0.1 mm a cycle): the setpoints the drives hold must stay within a few
-// cycles of path behind the newest target. The median holds; the tail does
-// not yet (the README's latency table), so only the median is asserted.
-TEST_F(IkCyclesTest, StreamedTargetsAreFollowedWithinAFewCycles) {
+// (0.1 mm a cycle): the setpoints the drives hold must stay within 3 cycles
+// of path behind the newest target, at the 99th percentile. The circle lies
+// inside the workspace (a target the robot cannot reach is not followed,
+// by the policy), which a cold solve checks on the way.
+TEST_F(IkCyclesTest, StreamedTargetsAreFollowedWithinThreeCycles) {
   const auto tip_of = [&](const Joints& joints) -> Eigen::Vector3d {
     const Joints bend = model::bend_from_joints(joints);
     return (model::exp(runtime->correction().predict(bend)) * model::forward_kinematics_bend(bend, runtime->geometry()))
         .position_mm.cast<double>();
   };
-  const Eigen::Vector3d start = runtime->latest_pose().pose.position_mm.cast<double>();
   constexpr double kRadiusMm = 10.0, kPathPerCycleMm = 0.1;
-  const Eigen::Vector3d center = start - Eigen::Vector3d(kRadiusMm, 0, 0);
+  // The height at which the robot, every segment bent the same way, reaches
+  // three radii off its axis; the circle's centre half a radius off it.
+  const int segments = runtime->geometry().segment_count;
+  Joints equal_bend(2 * segments);
+  double low = 0, high = 1;
+  Eigen::Vector3d rim;
+  for (int i = 0; i < 40; ++i) {
+    for (int s = 0; s < segments; ++s) equal_bend.segment<2>(2 * s) << 0.0f, float(0.5 * (low + high));
+    rim = model::forward_kinematics_bend(model::bend_from_joints(equal_bend), runtime->geometry())
+              .position_mm.cast<double>();
+    (rim.head<2>().norm() < 3 * kRadiusMm ? low : high) = 0.5 * (low + high);
+  }
+  const Eigen::Vector3d center(0.5 * kRadiusMm, 0, rim.z());
   const auto on_circle = [&](int step) {
     const double angle = kPathPerCycleMm / kRadiusMm * step;
     return Eigen::Vector3d(center + kRadiusMm * Eigen::Vector3d(std::cos(angle), std::sin(angle), 0));
   };
+  Solver cold;
+  SolverCorrection cold_correction(runtime->correction());
+  cold.configure(runtime->geometry(), cold_correction);
+  Joints slight_bend(2 * segments);
+  for (int s = 0; s < segments; ++s) slight_bend.segment<2>(2 * s) << 0.0f, 0.1f;
   send_position_target(on_circle(0).x(), on_circle(0).y(), on_circle(0).z(), 1);
   cycles_until_ik_done();
   protocol::IkReport first;
@@ -89,8 +106,15 @@ TEST_F(IkCyclesTest, StreamedTargetsAreFollowedWithinAFewCycles) {
   ASSERT_LT((held - on_circle(0)).norm(), 0.01);
   std::vector<double> lag_cycles;
   const std::uint32_t setpoints_before = runtime->setpoints_published();
-  for (int step = 1; step <= 600; ++step) {
+  constexpr int kSteps = 630;  // once round the circle
+  for (int step = 1; step <= kSteps; ++step) {
     const Eigen::Vector3d target = on_circle(step);
+    if (step % 63 == 0) {
+      model::Pose<float> on_path;
+      on_path.position_mm = target.cast<float>();
+      cold.start(on_path, model::IkTargetKind::position, slight_bend);
+      ASSERT_EQ(cold.run_to_end(), model::IkSolveState::converged) << "step " << step << " is out of reach";
+    }
     send_frame(protocol::TargetPositionXy{target.x(), target.y()});
     send_frame(protocol::TargetPositionZ{target.z(), protocol::TargetMode::position, true,
                                          static_cast<std::uint8_t>(step)});
@@ -99,12 +123,12 @@ TEST_F(IkCyclesTest, StreamedTargetsAreFollowedWithinAFewCycles) {
     if (runtime->setpoints_published() != before) held = tip_of(runtime->setpoint_joints());
     if (step > 20) lag_cycles.push_back((held - target).norm() / kPathPerCycleMm);
   }
-  EXPECT_GT(runtime->setpoints_published() - setpoints_before, 100u);
+  EXPECT_GT(runtime->setpoints_published() - setpoints_before, unsigned(kSteps) * 9 / 10);
   std::sort(lag_cycles.begin(), lag_cycles.end());
   const double p99 = lag_cycles[lag_cycles.size() * 99 / 100];
-  std::printf("streamed lag: p50 %.1f p99 %.1f max %.1f cycles of path\n", lag_cycles[lag_cycles.size() / 2], p99,
+  std::printf("streamed lag: p50 %.2f p99 %.2f max %.2f cycles of path\n", lag_cycles[lag_cycles.size() / 2], p99,
               lag_cycles.back());
-  EXPECT_LE(lag_cycles[lag_cycles.size() / 2], 3.0);
+  EXPECT_LE(p99, 3.0);
 }
 
 TEST_F(IkCyclesTest, NewerTargetSupersedesTheRunningOne) {

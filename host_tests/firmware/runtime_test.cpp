@@ -294,7 +294,7 @@ TEST_F(RuntimeTest, TrackingTargetsAreSolvedLikeSingleOnes) {
     const model::Vec3<Scalar> target = start + model::Vec3<Scalar>(0.2f * k, -0.1f * k, 0);
     send_frame(protocol::TargetPositionXy{target.x(), target.y()});
     send_frame(protocol::TargetPositionZ{target.z(), protocol::TargetMode::position, true, std::uint8_t(k)});
-    cycles(1);
+    cycles_until_ik_done();
     protocol::IkReport report;
     ASSERT_TRUE(last_ik_report(report));
     EXPECT_EQ(report.sequence, k);

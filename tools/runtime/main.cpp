@@ -92,12 +92,153 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
   return 0;
 }
 
-void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, std::uint8_t sequence) {
+void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, std::uint8_t sequence,
+                 bool tracking = false) {
   cdcr::hal::CanFrame frame;
   protocol::encode(protocol::TargetPositionXy{target_mm.x(), target_mm.y()}, frame);
   host.send(frame);
-  protocol::encode(protocol::TargetPositionZ{target_mm.z(), protocol::TargetMode::position, false, sequence}, frame);
+  protocol::encode(protocol::TargetPositionZ{target_mm.z(), protocol::TargetMode::position, tracking, sequence},
+                   frame);
   host.send(frame);
+}
+
+// A circle in a horizontal plane that the robot reaches everywhere: at the
+// height where it reaches a quarter of its length off its axis with every
+// segment bent the same way, centred a quarter radius off the axis (points
+// nearer the axis than the rim take S-shaped bends of about the same size).
+struct Circle {
+  model::Vec3<double> center_mm;
+  double radius_mm;
+  model::Vec3<double> at(double angle_rad) const {
+    return center_mm + radius_mm * model::Vec3<double>(std::cos(angle_rad), std::sin(angle_rad), 0.0);
+  }
+};
+
+Circle reachable_circle(const model::RobotGeometry<double>& geometry, double radius_mm) {
+  double length_mm = 0;
+  for (int s = 0; s < geometry.segment_count; ++s) length_mm += geometry.segments[s].backbone_length_mm;
+  const double reach_mm = 0.25 * length_mm, offset_mm = 0.25 * radius_mm;
+  if (radius_mm + offset_mm > 0.8 * reach_mm) {
+    throw std::invalid_argument("--circle-radius must be at most " + std::to_string(0.8 * reach_mm / 1.25) +
+                                " mm for this robot");
+  }
+  double low = 0, high = 1;
+  model::Vec3<double> rim = model::Vec3<double>::Zero();
+  model::JointVector<double> equal_bend(2 * geometry.segment_count);
+  for (int i = 0; i < 60; ++i) {
+    for (int s = 0; s < geometry.segment_count; ++s) {
+      equal_bend[2 * s] = 0.0;
+      equal_bend[2 * s + 1] = 0.5 * (low + high);
+    }
+    model::Pose<double> tip;
+    model::forward_kinematics(equal_bend, geometry, tip);
+    rim = tip.position_mm;
+    (rim.head<2>().norm() < reach_mm ? low : high) = 0.5 * (low + high);
+  }
+  return Circle{model::Vec3<double>(offset_mm, 0.0, rim.z()), radius_mm};
+}
+
+// The closed loop following a streamed circle: the robot first goes to the
+// circle's start (a single target) and settles, then a planner streams a
+// TRACKING position target every cycle around the circle once. Every cycle
+// of the stream compares the simulated robot's true tip with the target of
+// that cycle: what a user of the robot sees.
+int follow_circle(const std::string& image_path, double rate_hz, double radius_mm, double speed_mm_s,
+                  bool ideal_robot) {
+  if (!(rate_hz > 0) || !(rate_hz <= 100000)) throw std::invalid_argument("--rate must be in (0, 100000] Hz");
+  if (!(radius_mm > 0) || !(radius_mm <= 100)) throw std::invalid_argument("--circle-radius must be in (0, 100] mm");
+  if (!(speed_mm_s > 0) || !(speed_mm_s <= 500)) {
+    throw std::invalid_argument("--circle-speed must be in (0, 500] mm/s");
+  }
+  sim::SimulatedPlatform platform;
+  if (!image_path.empty()) platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
+  fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
+  runtime.init();
+  model::RobotGeometry<double> geometry;
+  geometry.segment_count = runtime.geometry().segment_count;
+  for (int s = 0; s < geometry.segment_count; ++s) {
+    const auto& g = runtime.geometry().segments[s];
+    geometry.segments[s] = {double(g.backbone_length_mm), double(g.anchor_radius_mm), double(g.theta_max_rad)};
+  }
+  const sim::SimulatedRobot robot(geometry, ideal_robot ? sim::SimulatorConfig::nominal_only() : sim::SimulatorConfig{});
+  const Circle circle = reachable_circle(geometry, radius_mm);
+
+  model::JointVector<double> slight_bend(2 * geometry.segment_count);
+  for (int s = 0; s < geometry.segment_count; ++s) {
+    slight_bend[2 * s] = 0.0;
+    slight_bend[2 * s + 1] = 0.1;
+  }
+  model::CableVector<double> start_cables;
+  model::cables_from_joints(slight_bend, geometry, start_cables);
+  sim::SimulatedCableDrives drives(platform.bus.node(1), start_cables, 50.0);
+  cdcr::hal::CanBus& host = platform.bus.node(2);
+  host.set_filters(&protocol::kIkReportFrames, 1);
+  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
+  const double dt_s = double(period_ns) * 1e-9;
+  platform.timer.start(period_ns);
+
+  long cycles = 0, poses_missing = 0;
+  std::int64_t host_max_ns = 0;
+  const auto cycle = [&] {
+    const cdcr::hal::TimerTick tick = platform.timer.wait_next();
+    drives.step(dt_s);
+    const std::uint32_t poses = runtime.statistics().poses_published;
+    const auto begin = std::chrono::steady_clock::now();
+    runtime.run_cycle(tick);
+    host_max_ns = std::max<std::int64_t>(
+        host_max_ns,
+        std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - begin).count());
+    if (runtime.statistics().poses_published != poses + 1) ++poses_missing;
+    ++cycles;
+    cdcr::hal::CanFrame frame;
+    while (host.receive(frame) == cdcr::hal::CanStatus::ok) {
+    }
+  };
+
+  // To the start, then half a second to settle.
+  send_target(host, circle.at(0.0), 0);
+  for (int k = 0; k < fw::kMaxIkCycles + 2 && (k == 0 || runtime.ik_running()); ++k) cycle();
+  if (runtime.last_ik_report().outcome != protocol::IkOutcome::converged) {
+    throw std::runtime_error("the circle's start was not reached (IK_REPORT outcome " +
+                             std::to_string(int(runtime.last_ik_report().outcome)) + ")");
+  }
+  for (long k = 0; k < std::lround(0.5 * rate_hz); ++k) cycle();
+
+  const double step_rad = speed_mm_s / radius_mm / rate_hz;
+  const long stream_cycles = std::lround(2.0 * M_PI / step_rad);
+  const std::uint32_t setpoints_before = runtime.setpoints_published();
+  double error_sum_mm = 0, error_max_mm = 0, following_sum_mm = 0, following_max_mm = 0;
+  for (long k = 1; k <= stream_cycles; ++k) {
+    const model::Vec3<double> target_mm = circle.at(step_rad * double(k));
+    send_target(host, target_mm, static_cast<std::uint8_t>(k), true);
+    cycle();
+    const double error_mm = (robot.true_pose(drives.cables_mm()).position_mm - target_mm).norm();
+    error_sum_mm += error_mm;
+    error_max_mm = std::max(error_max_mm, error_mm);
+    // The part that is the IK's: where the runtime's own compensated model
+    // puts the tip at the setpoints it sent.
+    const fw::Joints bend = model::bend_from_joints(runtime.setpoint_joints());
+    const model::Pose<float> predicted =
+        model::exp(runtime.correction().predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
+    const double following_mm = (predicted.position_mm.cast<double>() - target_mm).norm();
+    following_sum_mm += following_mm;
+    following_max_mm = std::max(following_max_mm, following_mm);
+  }
+  const fw::CycleStatistics& stats = runtime.statistics();
+  std::printf("state %s, fault: %s\n", fw::to_string(runtime.state()), fw::to_string(runtime.active_fault()));
+  std::printf("streamed circle: radius %.1f mm at %.1f mm/s, centre (%.1f, %.1f, %.1f) mm, %ld targets at %.0f Hz\n",
+              radius_mm, speed_mm_s, circle.center_mm.x(), circle.center_mm.y(), circle.center_mm.z(), stream_cycles,
+              rate_hz);
+  std::printf("tip vs streamed target (simulated robot): mean %.3f mm, max %.3f mm\n",
+              error_sum_mm / double(stream_cycles), error_max_mm);
+  std::printf("  of which following (the compensated model at the setpoints vs the target): mean %.3f mm, "
+              "max %.3f mm\n",
+              following_sum_mm / double(stream_cycles), following_max_mm);
+  std::printf("setpoints sent in %u of %ld streamed cycles; cycles %ld, poses missing %ld, overruns %u, "
+              "rejected frames %u; slowest cycle on this host %.1f us\n",
+              runtime.setpoints_published() - setpoints_before, stream_cycles, cycles, poses_missing, stats.overruns,
+              stats.rejected_frames, double(host_max_ns) * 1e-3);
+  return 0;
 }
 
 int simulate(const std::string& image_path, double rate_hz, double seconds, bool ideal_robot) {
@@ -333,7 +474,8 @@ int main(int argc, char** argv) {
   bool run_sim = false;
   std::string can_interface;
   bool ideal_robot = false;
-  double rate_hz = 1000.0, seconds = 2.0;
+  bool circle = false;
+  double rate_hz = 1000.0, seconds = 2.0, circle_radius_mm = 40.0, circle_speed_mm_s = 50.0;
   app.add_option("--image", image_path, "model image (flash image v1)");
   auto* replay_option = app.add_option("--replay", replay_path, "cable-length CSV (dataset layout) to replay");
   app.add_option("--out", out_path, "pose CSV written by --replay");
@@ -343,6 +485,9 @@ int main(int argc, char** argv) {
   app.add_option("--rate", rate_hz, "cycle rate for --sim, Hz")->capture_default_str();
   app.add_option("--seconds", seconds, "simulated duration for --sim")->capture_default_str();
   app.add_flag("--ideal-robot", ideal_robot, "--sim with every simulated error source off (the nominal model)");
+  app.add_flag("--circle", circle, "--sim following a streamed circle (TRACKING targets every cycle), once round");
+  app.add_option("--circle-radius", circle_radius_mm, "--circle radius, mm")->capture_default_str();
+  app.add_option("--circle-speed", circle_speed_mm_s, "--circle tip speed, mm/s")->capture_default_str();
   replay_option->excludes(sim_option);
   can_option->excludes(sim_option)->excludes(replay_option);
   try {
@@ -350,6 +495,7 @@ int main(int argc, char** argv) {
     if (!run_sim && replay_path.empty() && can_interface.empty()) {
       throw CLI::ValidationError("one of --replay, --sim or --can is required");
     }
+    if (circle && !run_sim) throw CLI::ValidationError("--circle needs --sim");
     if (!replay_path.empty() && (image_path.empty() || out_path.empty())) {
       throw CLI::ValidationError("--replay needs --image and --out");
     }
@@ -363,6 +509,7 @@ int main(int argc, char** argv) {
     if (!can_interface.empty()) {
       return run_on_socketcan(image_path, can_interface, rate_hz, app.count("--seconds") > 0 ? seconds : 0.0);
     }
+    if (run_sim && circle) return follow_circle(image_path, rate_hz, circle_radius_mm, circle_speed_mm_s, ideal_robot);
     return run_sim ? simulate(image_path, rate_hz, seconds, ideal_robot) : replay(image_path, replay_path, out_path);
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());

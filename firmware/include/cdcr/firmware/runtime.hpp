@@ -163,6 +163,7 @@ class Runtime {
   void finish_solve(model::IkSolveState end);
   void end_solve(protocol::IkOutcome outcome);
   bool set_setpoints(const Joints& joints);
+  bool publish_tracking_point(Solver& solver);
   void fill_ik_report(protocol::IkOutcome outcome);
   bool segment_current(int segment) const;
   bool input_stale() const;
@@ -224,6 +225,7 @@ class Runtime {
   bool has_setpoints_ = false;
   Cables setpoints_mm_;
   Joints setpoint_joints_;
+  hal::CanFrame setpoint_frames_[kMaxSegments] = {};
 
   CycleStatistics statistics_;
 };

@@ -80,7 +80,17 @@ struct IkSolverOptions {
   // both parts; zero means the mean backbone length (1 rad of bend moves a
   // segment tip by about that much).
   S orientation_weight_mm_per_rad = S(0);
-  S initial_damping = S(1e-3);
+  // LM damping, relative to the normal matrix's mean diagonal. Near the
+  // target (within keep_damping_within_mm), the damping reached carries
+  // over from one outer iteration to the next, down to min_damping: a pose
+  // target's weakly actuated direction (the twist about the backbone that
+  // only combined bends give) converges at the rate the damping allows, and
+  // a damping reset every outer iteration held it to a crawl. Farther out,
+  // each outer iteration starts from initial_damping again, which keeps
+  // full-range solves from overshooting into other basins.
+  S initial_damping = S(1e-4);
+  S min_damping = std::is_same_v<S, float> ? S(1e-6) : S(1e-12);
+  S keep_damping_within_mm = S(1);
   // Correction evaluations per solve (each is one outer iteration).
   int max_corrections = 40;
   // Nominal LM iterations per solve, over all outer iterations and restarts.
@@ -97,7 +107,7 @@ struct IkSolverOptions {
   // Evaluate the correction's gradient (when it offers one) at a cold start
   // and after an outer iteration whose squared residual fell by less than
   // this factor. Zero: never (the fixed point with secant updates only).
-  S gradient_refresh_ratio = S(0.1);
+  S gradient_refresh_ratio = S(0.05);
 };
 
 
@@ -237,12 +247,14 @@ class IkSolver {
     state_ = IkSolveState::idle;
     slope_known_ = false;
     have_warm_start_ = false;
+    linearised_ = rows_valid_ = false;
   }
 
   // Starts a solve, abandoning any running one, from initial_joints ((alpha,
   // theta) pairs within the limits) with no knowledge of the correction.
   Status start(const Pose<S>& target, IkTargetKind kind, const Joints& initial_joints) {
     if (const Status s = reset(target, kind); s != Status::ok) return s;
+    linearised_ = rows_valid_ = false;
     if (const Status s = check_joints(initial_joints, *geometry_); s != Status::ok) return fail(s);
     slope_known_ = false;
     const Joints bend = bend_from_joints(initial_joints);
@@ -287,21 +299,28 @@ class IkSolver {
     // The secant pair stays (the correction does not depend on the target);
     // the last residual, measured against the old target, does not count.
     previous_cost_ = std::numeric_limits<S>::infinity();
-    const Pose<S> tip = exp(warm_eps_) * forward_kinematics_bend(warm_bend_, *geometry_);
-    Residual residual;
-    residual_of(tip, residual, best_position_error_, best_orientation_error_);
-    best_cost_ = residual.squaredNorm();
-    best_bend_ = warm_bend_;
-    if (phase_ == Phase::inner) {
+    if (have_warm_start_) {
+      // The best point's tip was kept: only its residual is new.
+      Residual residual;
+      residual_of(warm_tip_, residual, best_position_error_, best_orientation_error_);
+      best_cost_ = residual.squaredNorm();
+      best_bend_ = warm_bend_;
+    } else {
+      best_cost_ = std::numeric_limits<S>::infinity();
+      best_position_error_ = best_orientation_error_ = std::numeric_limits<S>::infinity();
+    }
+    if (kind != previous_kind) rows_current_ = rows_valid_ = false;
+    if (linearised_) {
       // The linearised model and its Jacobian do not depend on the target
-      // either: the solve on it goes on towards the new one.
-      if (kind != previous_kind) rows_current_ = false;
+      // either: the solve on it goes on towards the new one, with a step
+      // first thing in the next run().
       residual_of(inner_tip_, inner_residual_, inner_position_error_, inner_orientation_error_);
       inner_cost_ = inner_residual_.squaredNorm();
+      track_pending_ = true;
       // Its iteration bounds and damping carry on: a target that moves every
       // cycle must not keep the solve from ever reaching the next evaluation,
       // nor hold the damping where it hides the weakly actuated directions.
-      if (inner_done()) finish_inner();
+      if (phase_ == Phase::inner && inner_done()) finish_inner();
     }
     return status_;
   }
@@ -312,8 +331,45 @@ class IkSolver {
   // cost fits.
   std::uint32_t run(std::uint32_t budget) {
     std::uint32_t spent = 0;
+    if (track_pending_ && state_ == IkSolveState::running) {
+      // A streamed target's step comes first, on the linearisation and the
+      // rows at hand (a Jacobian from a step or two back does for a target
+      // a fraction of a millimetre on): the setpoints follow the stream
+      // every cycle while evaluations and Jacobians go on in the rest.
+      track_pending_ = false;
+      // New rows when the slice also holds the step, or when the old ones
+      // have served long enough (that cycle's step then waits a cycle).
+      const bool renew_rows = !rows_current_ && (budget >= costs_.nominal_jacobian + costs_.nominal_step ||
+                                                 stale_row_steps_ >= kMaxStaleRowSteps);
+      if (linearised_ && rows_valid_ && renew_rows && budget >= costs_.nominal_jacobian) {
+        spent += costs_.nominal_jacobian;
+        update_rows();
+      }
+      // An outer step waiting for its turn goes first when the slice cannot
+      // hold both: the stream's steps must not starve the evaluations.
+      const std::uint32_t waiting = phase_ == Phase::outer_step ? costs_.outer_step : 0;
+      if (linearised_ && rows_valid_ && budget - spent >= costs_.nominal_step + waiting) {
+        spent += costs_.nominal_step;
+        if (phase_ == Phase::inner) {
+          inner_iteration();
+        } else {
+          ++iterations_;
+          try_inner_step<6>();
+          tracked_since_outer_ = true;
+        }
+        if (!rows_current_) ++stale_row_steps_;
+      }
+    }
     while (state_ == IkSolveState::running) {
       const std::uint32_t left = budget - spent;
+      if (phase_ == Phase::evaluate && linearised_ && stale_row_steps_ >= kMaxStaleRowSteps &&
+          left >= costs_.nominal_jacobian) {
+        // Streamed steps have gone on on old rows for a while: new ones at
+        // the current point, before the evaluation's next slice.
+        spent += costs_.nominal_jacobian;
+        update_rows();
+        continue;
+      }
       if (phase_ == Phase::evaluate) {
         if (left == 0) break;
         const std::uint32_t used = continue_correction(left);
@@ -323,6 +379,7 @@ class IkSolver {
           if (used == 0) break;  // the next slice does not fit
           continue;
         }
+        point_ = evaluation_point_;
         point_has_gradient_ = evaluator_->evaluation_has_gradient(evaluation_);
         evaluator_->evaluation_result(evaluation_, point_eps_, point_gradient_);
         ++corrections_;
@@ -374,7 +431,7 @@ class IkSolver {
   // The linearised solve's current point, while one runs: its correction is
   // predicted from the last evaluation and the slope, not evaluated, so it is
   // for following a stream of targets between evaluations.
-  bool has_linearised_point() const { return state_ == IkSolveState::running && phase_ == Phase::inner; }
+  bool has_linearised_point() const { return state_ == IkSolveState::running && linearised_; }
   const Joints& linearised_bend() const { return inner_bend_; }
   Joints linearised_joints() const { return clamped_joints(inner_bend_); }
   S linearised_position_error_mm() const { return inner_position_error_; }
@@ -424,6 +481,9 @@ class IkSolver {
     have_previous_ = false;
     next_with_gradient_ = false;
     stalled_outer_ = 0;
+    have_damping_ = false;
+    track_pending_ = false;
+    tracked_since_outer_ = false;
     best_cost_ = std::numeric_limits<S>::infinity();
     best_position_error_ = best_orientation_error_ = std::numeric_limits<S>::infinity();
     if (geometry_ == nullptr) return status_ = Status::invalid_geometry;
@@ -442,9 +502,10 @@ class IkSolver {
   }
 
   void begin_outer(const Joints& bend) {
-    point_ = bend;
+    tracked_since_outer_ = false;
     if (evaluator_ == nullptr) {
       // The nominal model: the correction and its slope are zero.
+      point_ = bend;
       point_eps_.setZero();
       point_gradient_.setZero(6, point_.size());
       point_has_gradient_ = true;
@@ -452,7 +513,11 @@ class IkSolver {
       phase_ = Phase::outer_step;
       return;
     }
-    if (const Status s = evaluator_->begin_evaluation(point_, evaluation_, wants_gradient()); s != Status::ok) {
+    // The linearisation in use (point_) stays until this evaluation ends: a
+    // streamed target's steps go on on it meanwhile.
+    evaluation_point_ = bend;
+    if (const Status s = evaluator_->begin_evaluation(evaluation_point_, evaluation_, wants_gradient());
+        s != Status::ok) {
       fail(s);
       return;
     }
@@ -511,6 +576,7 @@ class IkSolver {
       // The next target may start here with the correction known.
       warm_bend_ = point_;
       warm_eps_ = point_eps_;
+      warm_tip_ = tip;
       have_warm_start_ = true;
     }
     if (within_tolerance(position_error, orientation_error)) {
@@ -545,11 +611,14 @@ class IkSolver {
     previous_cost_ = cost;
     have_previous_ = true;
 
-    // The linearised solve starts where the exact model was just evaluated.
-    inner_bend_ = point_;
+    // The linearised solve starts where the exact model was just evaluated,
+    // or where a streamed target's steps have taken it since.
+    if (!tracked_since_outer_) inner_bend_ = point_;
+    linearised_ = true;
     inner_iterations_ = 0;
     inner_slow_steps_ = 0;
-    damping_ = options_.initial_damping;
+    if (!have_damping_ || position_error > options_.keep_damping_within_mm) damping_ = options_.initial_damping;
+    have_damping_ = true;
     for (int i = 0; i < geometry_->segment_count; ++i) active_[i] = on_limit(i, inner_bend_);
     evaluate_inner_pose(inner_bend_, inner_tip_);
     residual_of(inner_tip_, inner_residual_, inner_position_error_, inner_orientation_error_);
@@ -641,7 +710,8 @@ class IkSolver {
       rows_.template bottomLeftCorner<3, kMaxColumns>().leftCols(2 * segments) =
           weight_ * spatial.template bottomRows<3>();
     }
-    rows_current_ = true;
+    rows_current_ = rows_valid_ = true;
+    stale_row_steps_ = 0;
     // Segments on the limit leave the active set when descent points inside.
     for (int i = 0; i < segments; ++i) {
       if (!active_[i]) continue;
@@ -657,6 +727,26 @@ class IkSolver {
   void inner_iteration_rows() {
     ++iterations_;
     ++inner_iterations_;
+    try_inner_step<Rows>();
+
+    const bool stalled = damping_ > S(1e8);
+    if (stalled && inner_bend_ == point_ && inner_position_error_ > options_.restart_above_mm) {
+      // No step helps at all: a local minimum of the model far from the target.
+      if (!restart()) state_ = IkSolveState::not_converged;
+      return;
+    }
+    const bool give_up_inner =
+        kSliced && (inner_slow_steps_ >= 2 || inner_iterations_ >= options_.max_inner_iterations);
+    if (inner_done() || stalled || give_up_inner ||
+        iterations_ >= options_.max_iterations) {
+      finish_inner();
+    }
+  }
+
+  // The damped step from inner_bend_ on the current rows, kept when the
+  // linearised model's cost falls; the damping adapts either way.
+  template <int Rows>
+  void try_inner_step() {
     const int segments = geometry_->segment_count;
     Joints trial;
     bool stepped = false;
@@ -698,25 +788,12 @@ class IkSolver {
       inner_position_error_ = trial_position_error;
       inner_orientation_error_ = trial_orientation_error;
       rows_current_ = false;
-      damping_ = std::max(damping_ * S(0.1), std::numeric_limits<S>::epsilon());
+      damping_ = std::max(damping_ * S(0.1), options_.min_damping);
     } else {
       damping_ *= S(10);
       // A rejected step may have put segments in the active set that the
       // accepted point does not have on its limit.
       for (int i = 0; i < segments; ++i) active_[i] = active_[i] && on_limit(i, inner_bend_);
-    }
-
-    const bool stalled = damping_ > S(1e8);
-    if (stalled && inner_bend_ == point_ && inner_position_error_ > options_.restart_above_mm) {
-      // No step helps at all: a local minimum of the model far from the target.
-      if (!restart()) state_ = IkSolveState::not_converged;
-      return;
-    }
-    const bool give_up_inner =
-        kSliced && (inner_slow_steps_ >= 2 || inner_iterations_ >= options_.max_inner_iterations);
-    if (inner_done() || stalled || give_up_inner ||
-        iterations_ >= options_.max_iterations) {
-      finish_inner();
     }
   }
 
@@ -784,6 +861,9 @@ class IkSolver {
   // evaluated, the previous one, and the learned slope.
   typename Evaluator::Evaluation evaluation_{};
   Joints point_;
+  Joints evaluation_point_;
+  // point_ holds an evaluated correction (the linearisation in use).
+  bool linearised_ = false;
   Twist<S> point_eps_ = Twist<S>::Zero();
   Jacobian<S, Max> point_gradient_;
   bool point_has_gradient_ = false;
@@ -797,6 +877,7 @@ class IkSolver {
   bool slope_known_ = false;
   Joints warm_bend_;
   Twist<S> warm_eps_ = Twist<S>::Zero();
+  Pose<S> warm_tip_{};
   bool have_warm_start_ = false;
 
   Joints best_bend_;
@@ -813,10 +894,21 @@ class IkSolver {
   S inner_orientation_error_ = S(0);
   S inner_position_goal_ = S(0);
   S inner_orientation_goal_ = S(0);
-  S damping_ = S(1e-3);
+  S damping_ = S(1e-4);
+  bool have_damping_ = false;
   int inner_iterations_ = 0;
   int inner_slow_steps_ = 0;
   bool rows_current_ = false;
+  // rows_ belong to this target kind, if not to inner_bend_.
+  bool rows_valid_ = false;
+  // A streamed target arrived: its step comes first in the next run().
+  bool track_pending_ = false;
+  // Streamed steps moved inner_bend_ while an evaluation ran.
+  bool tracked_since_outer_ = false;
+  // Streamed steps taken on rows of an earlier point, and how many are let go
+  // before the rows are renewed.
+  int stale_row_steps_ = 0;
+  static constexpr int kMaxStaleRowSteps = 4;
   bool active_[Max] = {};
   Eigen::Matrix<S, 6, kMaxColumns, Eigen::RowMajor> rows_ = Eigen::Matrix<S, 6, kMaxColumns, Eigen::RowMajor>::Zero();
 };

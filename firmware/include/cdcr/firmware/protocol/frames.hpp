@@ -101,9 +101,14 @@ inline bool encode(const MessageSpec& message, int segment, const double (&lengt
   if (segment < 0 || segment >= message.id_count) return false;
   std::uint64_t word = 0;
   int k = 0;
+  // One scaling per length: a core without a double-precision FPU pays
+  // for each in software.
   for (const SignalSpec* signal : message.signals) {
-    if (!cable_length_encodable(lengths_mm[k])) return false;
-    word |= placed_saturating(*signal, lengths_mm[k++]);
+    std::int64_t raw = 0;
+    if (!to_raw_checked_single(*signal, lengths_mm[k++], raw) || raw == 0 || raw == kCableNotAvailableRaw) {
+      return false;
+    }
+    word |= placed(*signal, raw);
   }
   frame = empty_frame(message, segment);
   set_data_word(frame, word);

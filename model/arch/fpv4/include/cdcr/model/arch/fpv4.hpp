@@ -26,12 +26,13 @@ struct Fpv4 : Portable {
   // a mean point 72 instructions in the forward path and 82 in the IK's
   // slices, with the gradient 148; the IK Jacobian at most 20,400, the
   // damped step 21,900, the outer step 7,800 (the IK code is built at -O2,
-  // firmware/CMakeLists.txt); a request's end 29,000 (the codec's doubles
-  // are software floating point here); the rest of a cycle about 21,000
-  // beyond its GP sum, with a target's start and a superseded report, and
-  // the IK slices' dearer mean points. 1,600 units are 115,200
+  // firmware/CMakeLists.txt); a request's end about 10,000 (the setpoint
+  // frames 7,800, scaled in single precision where that gives the double
+  // result; the report 1,100); the rest of a cycle at most about 14,000
+  // beyond the units spent, with a target's start and a superseded report,
+  // and the IK slices' dearer mean points. 1,600 units are 115,200
   // instructions, within the board's 120,000.
-  static constexpr WorkCosts kWorkCosts{3, {285, 305, 110}, 410, 360, 1600};
+  static constexpr WorkCosts kWorkCosts{3, {285, 305, 110}, 150, 330, 1600};
 
 #define CDCR_VLDM_OUT(i) "=t"(r##i)
   template <int Count>
