@@ -61,6 +61,14 @@ TEST(Gaussian, IsTheLibraryExpOffTheBoards) {
 #if !(defined(__arm__) && defined(__ARM_FP))
   // Not a Cortex-M: the float path uses the C library too.
   for (float y : {0.0f, 1e-9f, 1.0f, 20.0f, 160.0f}) EXPECT_EQ(gaussian(y), std::exp(-0.5f * y));
+  // ... with the polynomial's clamp, which keeps expf off its underflow path
+  // and maps NaN as the boards' VMINNM does.
+  const float floor_value = std::exp(-0.5f * 173.0f);
+  EXPECT_GT(floor_value, 0.0f);
+  for (float y : {173.0f, 200.0f, 1e6f, std::numeric_limits<float>::infinity(),
+                  std::numeric_limits<float>::quiet_NaN()}) {
+    EXPECT_EQ(gaussian(y), floor_value) << y;
+  }
 #endif
 }
 
