@@ -8,7 +8,7 @@
 #   7.   accuracy on an independent test set of the same robot;
 #   8.   the firmware runtime with that image in closed loop with the
 #        simulated robot over the simulated bus at 1 kHz;
-#   9.   the same loop following a streamed circle (a TRACKING target
+#   9.   the same loop following a streamed circle (a TRACKING pose target
 #        every cycle, 40 mm radius at 50 mm/s).
 # Everything it writes goes to build/demo/.
 set -euo pipefail
@@ -95,5 +95,5 @@ heading "8. The firmware runtime in closed loop with the simulated robot, 1 kHz 
 echo "(the same robot: targets it can reach, cable drives on the simulated bus)"
 run build/bin/cdcr-runtime --image "$out/model.img" --sim --rate 1000 --seconds 3
 
-heading "9. The same loop following a streamed circle: a target every cycle, 40 mm radius at 50 mm/s"
+heading "9. The same loop following a streamed circle: a pose target every cycle, 40 mm radius at 50 mm/s"
 run build/bin/cdcr-runtime --image "$out/model.img" --sim --circle --circle-radius 40 --circle-speed 50

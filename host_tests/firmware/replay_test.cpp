@@ -95,11 +95,21 @@ TEST(RuntimeReplay, CorruptImageIsOneLineErrorWithExitOne) {
   EXPECT_EQ(WEXITSTATUS(usage), 2);
 }
 
-// The closed loop following a streamed circle (`--sim --circle`): a pose in
-// every cycle, no overrun, setpoints in every streamed cycle, and setpoints
-// that solve each cycle's target on the runtime's own compensated model.
+// The closed loop following a streamed circle (`--sim --circle`) on the
+// ideal robot, with a model whose corrections are about a millimetre: a pose
+// in every cycle, no overrun, setpoints in every streamed cycle that solve
+// each cycle's target on the runtime's own compensated model, and the
+// robot's tip within those corrections of the targets.
 TEST(RuntimeClosedLoop, FollowsAStreamedCircle) {
-  const std::vector<std::uint8_t> image = exporting::write_image(test_support::small_correction_model(200));
+  test_support::SyntheticModelOptions options;
+  options.training_points = 200;
+  options.segments = 4;
+  training::TrainedModel m = test_support::synthetic_trained_model(options);
+  for (int k = 0; k < 6; ++k) {
+    m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
+    m.output_scale[k] *= k < 3 ? 0.1 : 0.001;
+  }
+  const std::vector<std::uint8_t> image = exporting::write_image(m);
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_circle";
   std::filesystem::create_directories(dir);
   {
@@ -107,14 +117,18 @@ TEST(RuntimeClosedLoop, FollowsAStreamedCircle) {
     out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
   }
   const std::string command = std::string("\"") + CDCR_RUNTIME_EXE + "\" --image \"" + (dir / "model.img").string() +
-                              "\" --sim --circle --circle-radius 20 --circle-speed 100 > \"" +
+                              "\" --sim --ideal-robot --circle --circle-radius 30 --circle-speed 100 > \"" +
                               (dir / "out.txt").string() + "\"";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   std::ifstream in(dir / "out.txt");
   const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
-  double following_mean = -1, following_max = -1;
+  double tip_mean = -1, tip_max = -1, following_mean = -1, following_max = -1;
   long sent = -1, streamed = -1, cycles = -1, missing = -1;
   unsigned overruns = 1;
+  const std::size_t tip_at = text.find("tip vs streamed target");
+  ASSERT_NE(tip_at, std::string::npos) << text;
+  ASSERT_EQ(std::sscanf(text.c_str() + text.find(": mean", tip_at), ": mean %lf mm, max %lf mm", &tip_mean, &tip_max), 2)
+      << text;
   const std::size_t at = text.find("of which following");
   ASSERT_NE(at, std::string::npos) << text;
   ASSERT_EQ(std::sscanf(text.c_str() + text.find(": mean", at), ": mean %lf mm, max %lf mm", &following_mean,
@@ -134,6 +148,8 @@ TEST(RuntimeClosedLoop, FollowsAStreamedCircle) {
   EXPECT_EQ(overruns, 0u);
   EXPECT_LT(following_mean, 0.05) << text;
   EXPECT_LT(following_max, 0.2) << text;
+  // The corrections are the only difference between the model and the robot.
+  EXPECT_LT(tip_mean, 2.0) << text;
 }
 
 }  // namespace

@@ -102,47 +102,30 @@ void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, 
   host.send(frame);
 }
 
-// A circle in a horizontal plane that the robot reaches everywhere: at the
-// height where it reaches a quarter of its length off its axis with every
-// segment bent the same way, centred a quarter radius off the axis (points
-// nearer the axis than the rim take S-shaped bends of about the same size).
-struct Circle {
-  model::Vec3<double> center_mm;
-  double radius_mm;
-  model::Vec3<double> at(double angle_rad) const {
-    return center_mm + radius_mm * model::Vec3<double>(std::cos(angle_rad), std::sin(angle_rad), 0.0);
-  }
-};
-
-Circle reachable_circle(const model::RobotGeometry<double>& geometry, double radius_mm) {
-  double length_mm = 0;
-  for (int s = 0; s < geometry.segment_count; ++s) length_mm += geometry.segments[s].backbone_length_mm;
-  const double reach_mm = 0.25 * length_mm, offset_mm = 0.25 * radius_mm;
-  if (radius_mm + offset_mm > 0.8 * reach_mm) {
-    throw std::invalid_argument("--circle-radius must be at most " + std::to_string(0.8 * reach_mm / 1.25) +
-                                " mm for this robot");
-  }
-  double low = 0, high = 1;
-  model::Vec3<double> rim = model::Vec3<double>::Zero();
-  model::JointVector<double> equal_bend(2 * geometry.segment_count);
-  for (int i = 0; i < 60; ++i) {
-    for (int s = 0; s < geometry.segment_count; ++s) {
-      equal_bend[2 * s] = 0.0;
-      equal_bend[2 * s + 1] = 0.5 * (low + high);
-    }
-    model::Pose<double> tip;
-    model::forward_kinematics(equal_bend, geometry, tip);
-    rim = tip.position_mm;
-    (rim.head<2>().norm() < reach_mm ? low : high) = 0.5 * (low + high);
-  }
-  return Circle{model::Vec3<double>(offset_mm, 0.0, rim.z()), radius_mm};
+void send_pose_target(cdcr::hal::CanBus& host, const model::Pose<double>& target, std::uint8_t sequence,
+                      bool tracking) {
+  cdcr::hal::CanFrame frame;
+  Eigen::Quaterniond q(target.rotation);
+  q.normalize();
+  protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, frame);
+  host.send(frame);
+  protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
+  host.send(frame);
+  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), protocol::TargetMode::pose, tracking, sequence},
+                   frame);
+  host.send(frame);
 }
 
 // The closed loop following a streamed circle: the robot first goes to the
 // circle's start (a single target) and settles, then a planner streams a
-// TRACKING position target every cycle around the circle once. Every cycle
-// of the stream compares the simulated robot's true tip with the target of
-// that cycle: what a user of the robot sees.
+// TRACKING pose target every cycle around the circle once. The circle is the
+// one the tip draws when every segment keeps the same bend and the bend
+// direction turns: the bend that puts the nominal tip `radius_mm` off the
+// axis, the targets the simulated robot's true poses along that motion (a
+// planner's targets are poses the robot can take, and these stay inside the
+// workspace the model was trained on). Every cycle of the stream compares
+// the simulated robot's true tip with the target of that cycle: what a
+// user of the robot sees.
 int follow_circle(const std::string& image_path, double rate_hz, double radius_mm, double speed_mm_s,
                   bool ideal_robot) {
   if (!(rate_hz > 0) || !(rate_hz <= 100000)) throw std::invalid_argument("--rate must be in (0, 100000] Hz");
@@ -161,15 +144,29 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
     geometry.segments[s] = {double(g.backbone_length_mm), double(g.anchor_radius_mm), double(g.theta_max_rad)};
   }
   const sim::SimulatedRobot robot(geometry, ideal_robot ? sim::SimulatorConfig::nominal_only() : sim::SimulatorConfig{});
-  const Circle circle = reachable_circle(geometry, radius_mm);
-
-  model::JointVector<double> slight_bend(2 * geometry.segment_count);
-  for (int s = 0; s < geometry.segment_count; ++s) {
-    slight_bend[2 * s] = 0.0;
-    slight_bend[2 * s + 1] = 0.1;
+  // The bend that puts the nominal tip radius_mm off the axis.
+  const auto joints_at = [&](double bend_rad, double direction_rad) {
+    model::JointVector<double> joints(2 * geometry.segment_count);
+    for (int s = 0; s < geometry.segment_count; ++s) {
+      joints[2 * s] = direction_rad;
+      joints[2 * s + 1] = bend_rad;
+    }
+    return joints;
+  };
+  double low = 0, high = geometry.segments[0].theta_max_rad;
+  for (int i = 0; i < 60; ++i) {
+    model::Pose<double> tip;
+    model::forward_kinematics(joints_at(0.5 * (low + high), 0.0), geometry, tip);
+    (tip.position_mm.head<2>().norm() < radius_mm ? low : high) = 0.5 * (low + high);
   }
+  const double bend_rad = 0.5 * (low + high);
+  const auto target_at = [&](double direction_rad) {
+    model::CableVector<double> cables;
+    model::cables_from_joints(joints_at(bend_rad, direction_rad), geometry, cables);
+    return robot.true_pose(cables);
+  };
   model::CableVector<double> start_cables;
-  model::cables_from_joints(slight_bend, geometry, start_cables);
+  model::cables_from_joints(joints_at(0.5 * bend_rad, 0.0), geometry, start_cables);
   sim::SimulatedCableDrives drives(platform.bus.node(1), start_cables, 50.0);
   cdcr::hal::CanBus& host = platform.bus.node(2);
   host.set_filters(&protocol::kIkReportFrames, 1);
@@ -196,7 +193,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   };
 
   // To the start, then half a second to settle.
-  send_target(host, circle.at(0.0), 0);
+  send_pose_target(host, target_at(0.0), 0, false);
   for (int k = 0; k < fw::kMaxIkCycles + 2 && (k == 0 || runtime.ik_running()); ++k) cycle();
   if (runtime.last_ik_report().outcome != protocol::IkOutcome::converged) {
     throw std::runtime_error("the circle's start was not reached (IK_REPORT outcome " +
@@ -208,9 +205,12 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   const long stream_cycles = std::lround(2.0 * M_PI / step_rad);
   const std::uint32_t setpoints_before = runtime.setpoints_published();
   double error_sum_mm = 0, error_max_mm = 0, following_sum_mm = 0, following_max_mm = 0;
+  model::Vec3<double> center_mm = model::Vec3<double>::Zero();
   for (long k = 1; k <= stream_cycles; ++k) {
-    const model::Vec3<double> target_mm = circle.at(step_rad * double(k));
-    send_target(host, target_mm, static_cast<std::uint8_t>(k), true);
+    const model::Pose<double> target = target_at(step_rad * double(k));
+    const model::Vec3<double> target_mm = target.position_mm;
+    center_mm += target_mm / double(stream_cycles);
+    send_pose_target(host, target, static_cast<std::uint8_t>(k), true);
     cycle();
     const double error_mm = (robot.true_pose(drives.cables_mm()).position_mm - target_mm).norm();
     error_sum_mm += error_mm;
@@ -226,9 +226,9 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   }
   const fw::CycleStatistics& stats = runtime.statistics();
   std::printf("state %s, fault: %s\n", fw::to_string(runtime.state()), fw::to_string(runtime.active_fault()));
-  std::printf("streamed circle: radius %.1f mm at %.1f mm/s, centre (%.1f, %.1f, %.1f) mm, %ld targets at %.0f Hz\n",
-              radius_mm, speed_mm_s, circle.center_mm.x(), circle.center_mm.y(), circle.center_mm.z(), stream_cycles,
-              rate_hz);
+  std::printf("streamed circle of pose targets: radius %.1f mm at %.1f mm/s (every segment bent %.4f rad), centre "
+              "(%.1f, %.1f, %.1f) mm, %ld targets at %.0f Hz\n",
+              radius_mm, speed_mm_s, bend_rad, center_mm.x(), center_mm.y(), center_mm.z(), stream_cycles, rate_hz);
   std::printf("tip vs streamed target (simulated robot): mean %.3f mm, max %.3f mm\n",
               error_sum_mm / double(stream_cycles), error_max_mm);
   std::printf("  of which following (the compensated model at the setpoints vs the target): mean %.3f mm, "
@@ -485,7 +485,8 @@ int main(int argc, char** argv) {
   app.add_option("--rate", rate_hz, "cycle rate for --sim, Hz")->capture_default_str();
   app.add_option("--seconds", seconds, "simulated duration for --sim")->capture_default_str();
   app.add_flag("--ideal-robot", ideal_robot, "--sim with every simulated error source off (the nominal model)");
-  app.add_flag("--circle", circle, "--sim following a streamed circle (TRACKING targets every cycle), once round");
+  app.add_flag("--circle", circle,
+               "--sim following a streamed circle (a TRACKING pose target every cycle), once round");
   app.add_option("--circle-radius", circle_radius_mm, "--circle radius, mm")->capture_default_str();
   app.add_option("--circle-speed", circle_speed_mm_s, "--circle tip speed, mm/s")->capture_default_str();
   replay_option->excludes(sim_option);
