@@ -28,6 +28,15 @@
 //     evaluation then computes the mean and the gradient in one pass.
 //   * E survives from one target to the next, so a target streamed along a
 //     path starts with the slope known and usually needs one mean evaluation.
+//   * A streamed target (retarget()) gets one damped step first thing in the
+//     next run(), on the linearisation and the rows in hand, while the
+//     evaluation at a newer point goes on in the rest of the budget (it runs
+//     at evaluation_point_; the linearisation point_ changes only when it
+//     ends). So the linearised point follows the stream every call, and the
+//     exact model catches up every few.
+//   * Within keep_damping_within_mm of the target the LM damping carries over
+//     between outer iterations: the weakly actuated twist about the backbone
+//     of a pose target converges at the rate the damping allows.
 //   * The limit theta_i <= theta_max is a disc in each segment's bend plane.
 //     A segment that a step would carry outside joins the active set: it then
 //     moves only along the limit circle (one tangential coordinate), and it
