@@ -66,11 +66,9 @@ void Runtime::continue_solve() {
     // A streamed request keeps room for its setpoints in every cycle; on a
     // core where a step and the setpoints do not fit in one slice, a cycle
     // first sends what the last one's step found, then steps again.
-    const bool room_for_both = ik_units_per_cycle_ >= spent + kWorkCosts.ik_finish + kIkWorkCosts.nominal_step;
-    if (solving_tracking_ && !room_for_both && spent + kWorkCosts.ik_finish <= ik_units_per_cycle_ &&
-        publish_tracking_point(solver)) {
-      spent += kWorkCosts.ik_finish;
-    }
+    // (kMinIkUnitsPerCycle covers the setpoints alone.)
+    const bool room_for_both = ik_units_per_cycle_ >= kWorkCosts.ik_finish + kIkWorkCosts.nominal_step;
+    if (solving_tracking_ && !room_for_both && publish_tracking_point(solver)) spent = kWorkCosts.ik_finish;
     const std::uint32_t reserved = solving_tracking_ && room_for_both ? kWorkCosts.ik_finish : 0;
     spent += solver.run(ik_units_per_cycle_ - spent - reserved);
     end = solver.state();

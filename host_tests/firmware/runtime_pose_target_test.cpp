@@ -23,12 +23,7 @@ using test_support::RuntimeTest;
 // Where the runtime's own model puts the tip for a bent configuration of
 // the test robot (the image's two segments): a pose it can reach.
 model::Pose<double> reachable_pose(const Runtime& runtime, const model::JointVector<double>& joints) {
-  model::RobotGeometry<double> geometry;
-  geometry.segment_count = runtime.geometry().segment_count;
-  for (int s = 0; s < geometry.segment_count; ++s) {
-    const auto& g = runtime.geometry().segments[s];
-    geometry.segments[s] = {double(g.backbone_length_mm), double(g.anchor_radius_mm), double(g.theta_max_rad)};
-  }
+  const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
   model::CableVector<double> cables;
   EXPECT_EQ(model::cables_from_joints(joints, geometry, cables), model::Status::ok);
   PoseEstimate estimate;

@@ -114,12 +114,7 @@ struct Workload {
 
 Workload make_workload(const fw::Runtime& runtime, const Options& options) {
   Workload w;
-  const fw::Geometry& g = runtime.geometry();
-  w.geometry.segment_count = g.segment_count;
-  for (int s = 0; s < g.segment_count; ++s) {
-    w.geometry.segments[s] = {double(g.segments[s].backbone_length_mm), double(g.segments[s].anchor_radius_mm),
-                              double(g.segments[s].theta_max_rad)};
-  }
+  w.geometry = runtime.geometry().cast<double>();
   sim::SimulatorConfig config;
   config.seed = options.seed;
   const sim::SimulatedRobot robot(w.geometry, config);

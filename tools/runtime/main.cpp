@@ -92,13 +92,11 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
   return 0;
 }
 
-void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, std::uint8_t sequence,
-                 bool tracking = false) {
+void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, std::uint8_t sequence) {
   cdcr::hal::CanFrame frame;
   protocol::encode(protocol::TargetPositionXy{target_mm.x(), target_mm.y()}, frame);
   host.send(frame);
-  protocol::encode(protocol::TargetPositionZ{target_mm.z(), protocol::TargetMode::position, tracking, sequence},
-                   frame);
+  protocol::encode(protocol::TargetPositionZ{target_mm.z(), protocol::TargetMode::position, false, sequence}, frame);
   host.send(frame);
 }
 
@@ -137,12 +135,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   if (!image_path.empty()) platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
   fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
   runtime.init();
-  model::RobotGeometry<double> geometry;
-  geometry.segment_count = runtime.geometry().segment_count;
-  for (int s = 0; s < geometry.segment_count; ++s) {
-    const auto& g = runtime.geometry().segments[s];
-    geometry.segments[s] = {double(g.backbone_length_mm), double(g.anchor_radius_mm), double(g.theta_max_rad)};
-  }
+  const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
   const sim::SimulatedRobot robot(geometry, ideal_robot ? sim::SimulatorConfig::nominal_only() : sim::SimulatorConfig{});
   // The bend that puts the nominal tip radius_mm off the axis.
   const auto joints_at = [&](double bend_rad, double direction_rad) {
@@ -249,12 +242,7 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
   fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
   runtime.init();
 
-  model::RobotGeometry<double> geometry;
-  geometry.segment_count = runtime.geometry().segment_count;
-  for (int s = 0; s < geometry.segment_count; ++s) {
-    const auto& g = runtime.geometry().segments[s];
-    geometry.segments[s] = {double(g.backbone_length_mm), double(g.anchor_radius_mm), double(g.theta_max_rad)};
-  }
+  const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
   const sim::SimulatedRobot robot(geometry, ideal_robot ? sim::SimulatorConfig::nominal_only() : sim::SimulatorConfig{});
 
   std::mt19937 rng(7);

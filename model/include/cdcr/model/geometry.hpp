@@ -53,6 +53,18 @@ struct RobotGeometry {
     return uniform(kPrototypeSegmentCount, S(kPrototypeBackboneLengthMm), S(kPrototypeAnchorRadiusMm));
   }
 
+  // The same geometry in another scalar type (a host's double model of the
+  // firmware's float one).
+  template <typename T>
+  RobotGeometry<T, MaxSegments> cast() const {
+    RobotGeometry<T, MaxSegments> g;
+    g.segment_count = segment_count;
+    for (int i = 0; i < MaxSegments; ++i) {
+      g.segments[i] = {T(segments[i].backbone_length_mm), T(segments[i].anchor_radius_mm), T(segments[i].theta_max_rad)};
+    }
+    return g;
+  }
+
   Status validate() const {
     if (segment_count < 1 || segment_count > MaxSegments) return Status::invalid_segment_count;
     for (int i = 0; i < segment_count; ++i) {

@@ -346,28 +346,7 @@ class IkSolver {
       // a fraction of a millimetre on): the setpoints follow the stream
       // every cycle while evaluations and Jacobians go on in the rest.
       track_pending_ = false;
-      // New rows when the slice also holds the step, or when the old ones
-      // have served long enough (that cycle's step then waits a cycle).
-      const bool renew_rows = !rows_current_ && (budget >= costs_.nominal_jacobian + costs_.nominal_step ||
-                                                 stale_row_steps_ >= kMaxStaleRowSteps);
-      if (linearised_ && rows_valid_ && renew_rows && budget >= costs_.nominal_jacobian) {
-        spent += costs_.nominal_jacobian;
-        update_rows();
-      }
-      // An outer step waiting for its turn goes first when the slice cannot
-      // hold both: the stream's steps must not starve the evaluations.
-      const std::uint32_t waiting = phase_ == Phase::outer_step ? costs_.outer_step : 0;
-      if (linearised_ && rows_valid_ && budget - spent >= costs_.nominal_step + waiting) {
-        spent += costs_.nominal_step;
-        if (phase_ == Phase::inner) {
-          inner_iteration();
-        } else {
-          ++iterations_;
-          try_inner_step<6>();
-          tracked_since_outer_ = true;
-        }
-        if (!rows_current_) ++stale_row_steps_;
-      }
+      if (linearised_ && rows_valid_) spent = track_step(budget);
     }
     while (state_ == IkSolveState::running) {
       const std::uint32_t left = budget - spent;
@@ -676,6 +655,33 @@ class IkSolver {
     return theta >= geometry_->segments[segment].theta_max_rad * (S(1) - S(16) * std::numeric_limits<S>::epsilon());
   }
 
+  // A streamed target's step on the linearisation in hand; returns the
+  // units spent. New rows when the slice also holds the step, or when the
+  // old ones have served long enough (that cycle's step then waits a
+  // cycle). An outer step waiting for its turn goes first when the slice
+  // cannot hold both: the stream's steps must not starve the evaluations.
+  std::uint32_t track_step(std::uint32_t budget) {
+    std::uint32_t spent = 0;
+    const bool renew_rows = !rows_current_ && (budget >= costs_.nominal_jacobian + costs_.nominal_step ||
+                                               stale_row_steps_ >= kMaxStaleRowSteps);
+    if (renew_rows && budget >= costs_.nominal_jacobian) {
+      spent += costs_.nominal_jacobian;
+      update_rows();
+    }
+    const std::uint32_t waiting = phase_ == Phase::outer_step ? costs_.outer_step : 0;
+    if (budget - spent < costs_.nominal_step + waiting) return spent;
+    spent += costs_.nominal_step;
+    if (phase_ == Phase::inner) {
+      inner_iteration();
+    } else {
+      ++iterations_;
+      try_inner_step<6>();
+      tracked_since_outer_ = true;
+    }
+    if (!rows_current_) ++stale_row_steps_;
+    return spent;
+  }
+
   // The linearised compensated model: exp(eps_k + E (b - b_k)) T(b).
   Twist<S> linearised_eps(const Joints& bend) const {
     Twist<S> eps = point_eps_;
@@ -731,7 +737,8 @@ class IkSolver {
     }
   }
 
-  // The damped step from inner_bend_ on the current rows, and its test.
+  // One LM iteration of the linearised solve: the damped step, then whether
+  // the solve restarts, goes on, or hands over to the next evaluation.
   template <int Rows>
   void inner_iteration_rows() {
     ++iterations_;

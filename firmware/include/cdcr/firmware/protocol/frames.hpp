@@ -85,11 +85,17 @@ struct Stats {
   std::int64_t stale_events = 0;
 };
 
-// Whether a cable length survives the frame: positive after rounding to the
-// 0.01 mm quantum and short of the "not available" mark (655.34 mm at most).
+// A cable length's raw value, if it survives the frame: positive after
+// rounding to the 0.01 mm quantum and short of the "not available" mark
+// (655.34 mm at most). Scaled once, in single precision where that gives the
+// double result (a core without a double-precision FPU pays for each).
+inline bool cable_length_raw(const SignalSpec& signal, double length_mm, std::int64_t& raw) {
+  return to_raw_checked_single(signal, length_mm, raw) && raw != 0 && raw != kCableNotAvailableRaw;
+}
+
 inline bool cable_length_encodable(double length_mm) {
   std::int64_t raw = 0;
-  return to_raw_checked(cable_lengths::kL1, length_mm, raw) && raw != 0 && raw != kCableNotAvailableRaw;
+  return cable_length_raw(cable_lengths::kL1, length_mm, raw);
 }
 
 // The length a receiver decodes for `length_mm` (which must be encodable).
@@ -101,13 +107,9 @@ inline bool encode(const MessageSpec& message, int segment, const double (&lengt
   if (segment < 0 || segment >= message.id_count) return false;
   std::uint64_t word = 0;
   int k = 0;
-  // One scaling per length: a core without a double-precision FPU pays
-  // for each in software.
   for (const SignalSpec* signal : message.signals) {
     std::int64_t raw = 0;
-    if (!to_raw_checked_single(*signal, lengths_mm[k++], raw) || raw == 0 || raw == kCableNotAvailableRaw) {
-      return false;
-    }
+    if (!cable_length_raw(*signal, lengths_mm[k++], raw)) return false;
     word |= placed(*signal, raw);
   }
   frame = empty_frame(message, segment);
