@@ -10,7 +10,12 @@
 //                   next one as soon as the runtime has answered the last;
 //   IK pose jump    the same with full pose targets.
 // IK runs in bounded slices, so every cycle of a run is timed, whether a
-// request starts, continues or ends in it; the requests' own figures (the
+// request starts, continues or ends in it. Each kind runs twice: back to
+// back, the code's own cost (and how often this machine takes the CPU from
+// a thread that never sleeps), and at the runtime's 1 kHz, each cycle
+// released by the Linux backend's timer as cdcr-runtime releases it (on a
+// virtual machine a thread that sleeps between cycles may wake on a cold
+// cache or a descheduled core); the requests' own figures (the
 // cycles and iterations each took, and whether it converged) come from
 // their IK_REPORT. Targets are poses the simulated robot actually reaches,
 // so the compensated IK can meet them.
@@ -39,6 +44,7 @@
 #include <cdcr/firmware/runtime.hpp>
 
 #include "export/binary_file.hpp"
+#include "linux/posix_time.hpp"
 #include "sim/host_backends.hpp"
 #include "sim/lockstep_timer.hpp"
 #include "sim/simulated_platform.hpp"
@@ -54,7 +60,7 @@ namespace protocol = cdcr::firmware::protocol;
 namespace sim = cdcr::sim;
 using Clock = std::chrono::steady_clock;
 
-constexpr std::int64_t kPeriodNs = 1'000'000;  // 1 kHz; lockstep, so only the release times use it
+constexpr std::int64_t kPeriodNs = 1'000'000;  // 1 kHz: the simulated timer's period, and the paced runs' pace
 constexpr std::size_t kRingSize = 4096;
 // Per-cycle joint step of the tracked trajectory: up to 1 rad/s per joint at
 // 1 kHz, well under a millimetre of tip motion per cycle.
@@ -180,8 +186,10 @@ std::int64_t thread_cpu_ns() {
   return std::int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
 }
 
-// One run of one cycle kind on a freshly booted runtime.
-CycleSamples run_cycles(const std::vector<std::uint8_t>& image, const Workload& w, CycleKind kind, int cycles) {
+// One run of one cycle kind on a freshly booted runtime; paced: one cycle
+// per millisecond of the monotonic clock, else back to back.
+CycleSamples run_cycles(const std::vector<std::uint8_t>& image, const Workload& w, CycleKind kind, int cycles,
+                        bool paced) {
   auto platform = std::make_unique<sim::SimulatedPlatform>();
   platform->storage.assign(image);
   auto runtime = std::make_unique<fw::Runtime>(platform->hal, fw::Geometry::prototype());
@@ -201,6 +209,10 @@ CycleSamples run_cycles(const std::vector<std::uint8_t>& image, const Workload& 
   cdcr::hal::CanFrame drained;
   std::size_t next_target = 0;
   bool awaiting_answer = false;
+  // The Linux backend's timer, as cdcr-runtime paces its cycles.
+  const cdcr::linux_host::PosixMonotonicClock clock;
+  cdcr::linux_host::PosixPeriodicTimer pace(clock);
+  if (paced) pace.start(kPeriodNs);
   for (int k = 0; k < cycles; ++k) {
     const std::size_t i = std::size_t(k) % kRingSize;
     for (const auto& frame : w.feedback[i]) peer.send(frame);
@@ -210,6 +222,7 @@ CycleSamples run_cycles(const std::vector<std::uint8_t>& image, const Workload& 
       awaiting_answer = true;
     }
     const cdcr::hal::TimerTick tick = platform->timer.wait_next();
+    if (paced) pace.wait_next();
     const std::int64_t cpu_begin_ns = thread_cpu_ns();
     const Clock::time_point begin = Clock::now();
     runtime->run_cycle(tick);
@@ -292,7 +305,8 @@ int main(int argc, char** argv) {
   app.add_option("--image", options.image_path, "model image (flash image v1)")->required();
   app.add_option("--forward-cycles", options.forward_cycles, "forward cycles per run")->capture_default_str();
   app.add_option("--ik-cycles", options.ik_cycles, "cycles per run of each IK kind")->capture_default_str();
-  app.add_option("--repetitions", options.repetitions, "runs of every kind; the table shows medians")
+  app.add_option("--repetitions", options.repetitions,
+                 "runs of every kind, each at 1 kHz and back to back; the table shows medians")
       ->capture_default_str();
   app.add_option("--seed", options.seed, "simulated robot (as cdcr simulate --seed)")->capture_default_str();
   CLI11_PARSE(app, argc, argv);
@@ -325,7 +339,7 @@ int main(int argc, char** argv) {
     const fw::Geometry& geometry = probe.geometry();
 
     std::vector<double> fk_ns, gp_ns, evaluation_ns;
-    std::vector<double> p50[kKindCount], p99[kKindCount];
+    std::vector<double> p50[kKindCount], p99[kKindCount], paced_p99[kKindCount];
     std::vector<std::int64_t> all_iterations[kKindCount], all_request_cycles[kKindCount];
     std::int64_t worst_ns[kKindCount] = {}, worst_cpu_ns[kKindCount] = {};
     long converged[kKindCount] = {}, total[kKindCount] = {};
@@ -348,8 +362,9 @@ int main(int argc, char** argv) {
       }));
       for (int k = 0; k < kKindCount; ++k) {
         const CycleKind kind = kKinds[k];
-        const CycleSamples s =
-            run_cycles(image, w, kind, kind == CycleKind::forward ? options.forward_cycles : options.ik_cycles);
+        const int cycles = kind == CycleKind::forward ? options.forward_cycles : options.ik_cycles;
+        const CycleSamples s = run_cycles(image, w, kind, cycles, false);
+        paced_p99[k].push_back(percentile(run_cycles(image, w, kind, cycles, true).ns, 0.99));
         p50[k].push_back(percentile(s.ns, 0.50));
         p99[k].push_back(percentile(s.ns, 0.99));
         worst_ns[k] = std::max(worst_ns[k], *std::max_element(s.ns.begin(), s.ns.end()));
@@ -368,19 +383,22 @@ int main(int argc, char** argv) {
                 "at most %d cycles per request\n",
                 view.training_points, view.input_dims, model::to_string(view.encoding), view.segment_count,
                 probe.ik_units_per_cycle(), fw::kMaxIkCycles);
-    std::printf("%d runs; per run %d forward cycles and %d cycles of each IK kind. p50/p99: median over runs; "
-                "max: worst of all runs.\n\n",
+    std::printf("%d runs; per run %d forward cycles and %d cycles of each IK kind, back to back and then at "
+                "1 kHz. p50/p99: median over runs; max: worst of all runs back to back.\n\n",
                 options.repetitions, options.forward_cycles, options.ik_cycles);
-    std::printf("| cycle | p50 us | p99 us | max us | max us, thread CPU | p50 / FK | p99 / FK | "
-                "requests | cycles per request p50 / p99 / max | iterations p50 / p99 / max | converged |\n");
-    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf("| cycle | p50 us | p99 us | max us | max us, thread CPU | p99 us at 1 kHz | p50 / FK | "
+                "p99 / FK | requests | cycles per request p50 / p99 / max | iterations p50 / p99 / max | "
+                "converged |\n");
+    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     double worst_p99_us = 0;
+    double worst_paced_p99_us = 0;
     for (int k = 0; k < kKindCount; ++k) {
-      const double m50 = median(p50[k]), m99 = median(p99[k]);
+      const double m50 = median(p50[k]), m99 = median(p99[k]), paced99 = median(paced_p99[k]);
       worst_p99_us = std::max(worst_p99_us, m99 * 1e-3);
-      std::printf("| %s | %.2f | %.2f | %.1f | %.1f | %.1f | %.1f |", label(kKinds[k]), m50 * 1e-3, m99 * 1e-3,
-                  double(worst_ns[k]) * 1e-3, double(worst_cpu_ns[k]) * 1e-3, m50 / fk_baseline_ns,
-                  m99 / fk_baseline_ns);
+      worst_paced_p99_us = std::max(worst_paced_p99_us, paced99 * 1e-3);
+      std::printf("| %s | %.2f | %.2f | %.1f | %.1f | %.2f | %.1f | %.1f |", label(kKinds[k]), m50 * 1e-3,
+                  m99 * 1e-3, double(worst_ns[k]) * 1e-3, double(worst_cpu_ns[k]) * 1e-3, paced99 * 1e-3,
+                  m50 / fk_baseline_ns, m99 / fk_baseline_ns);
       if (total[k] == 0) {
         std::printf(" - | - | - | - |\n");
       } else {
@@ -391,14 +409,16 @@ int main(int argc, char** argv) {
                     100.0 * double(converged[k]) / double(total[k]));
       }
     }
-    std::printf("| baseline: nominal FK (`forward_kinematics_bend`, float) | %.3f | | | | 1.0 | | | | | |\n",
+    std::printf("| baseline: nominal FK (`forward_kinematics_bend`, float) | %.3f | | | | | 1.0 | | | | | |\n",
                 fk_baseline_ns * 1e-3);
-    std::printf("| baseline: bare GP predict (%u points) | %.2f | | | | %.1f | | | | | |\n", view.training_points,
+    std::printf("| baseline: bare GP predict (%u points) | %.2f | | | | | %.1f | | | | | |\n", view.training_points,
                 gp_baseline_ns * 1e-3, gp_baseline_ns / fk_baseline_ns);
-    std::printf("| one full model evaluation (FK, Jacobian, GP mean and gradient) | %.2f | | | | %.1f | | | | | |\n",
+    std::printf("| one full model evaluation (FK, Jacobian, GP mean and gradient) | %.2f | | | | | %.1f | | | | | |\n",
                 evaluation_baseline_ns * 1e-3, evaluation_baseline_ns / fk_baseline_ns);
-    std::printf("\nHost goal p99 <= 15 us for every kind of cycle: %s (worst p99 %.2f us)\n",
-                worst_p99_us <= 15.0 ? "met" : "NOT met", worst_p99_us);
+    std::printf("\nHost goal p99 <= 15 us for every kind of cycle: %s (worst p99 %.2f us back to back, %.2f us at "
+                "1 kHz)\n",
+                worst_p99_us <= 15.0 && worst_paced_p99_us <= 15.0 ? "met" : "NOT met", worst_p99_us,
+                worst_paced_p99_us);
     const Interruptions interruptions = measure_interruptions();
     std::printf("This machine interrupts a busy thread %.0f times a second, for %.1f us on average: a %.1f us cycle "
                 "(the IK kinds' p50) is hit %.1f %% of the time.\n",

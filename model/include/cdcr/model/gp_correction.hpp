@@ -28,6 +28,7 @@
 
 #include "cdcr/model/arch/selected.hpp"
 #include "cdcr/model/chain.hpp"
+#include "cdcr/model/compensated_float.hpp"
 #include "cdcr/model/flash_image.hpp"
 #include "cdcr/model/input_encoding.hpp"
 #include "cdcr/model/kernel_exp.hpp"
@@ -35,25 +36,6 @@
 #include "cdcr/model/types.hpp"
 
 namespace cdcr::model {
-
-// Neumaier's compensated sum: a float accumulator that carries its own
-// rounding error.
-struct CompensatedFloat {
-  float sum = 0.0f;
-  float compensation = 0.0f;
-
-  CompensatedFloat& operator+=(float term) {
-    const float t = sum + term;
-    if (std::abs(sum) >= std::abs(term)) {
-      compensation += (sum - t) + term;
-    } else {
-      compensation += (term - t) + sum;
-    }
-    sum = t;
-    return *this;
-  }
-  float value() const { return sum + compensation; }
-};
 
 template <typename S, typename Accumulator = double, int MaxSegments = kMaxSegments, typename Arch = arch::Selected>
 class GpCorrection {

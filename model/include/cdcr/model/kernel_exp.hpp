@@ -15,9 +15,9 @@
 // polynomial fitted for relative error (3e-9 in exact arithmetic), and 2^k
 // put into the exponent bits. Within 1.5 ulp of exp(-y/2) for y <= 40 and 5
 // ulp down to e^-86.5, where k ln 2 carries the float rounding of ln 2
-// (tested against std::exp in host_tests/model/kernel_exp_test.cpp). The Cortex-M7 assembly
-// loop (model/arch/fpv5/.../gp_mean_fpv5.hpp) performs the same operations in the same order and
-// so gives the same bits.
+// (tested against std::exp in host_tests/model/kernel_exp_test.cpp). The boards' assembly
+// loops (model/arch/fpv4/.../gp_point_asm.hpp) perform the same operations in the same order
+// and so give the same bits.
 
 #include <cmath>
 #include <cstdint>

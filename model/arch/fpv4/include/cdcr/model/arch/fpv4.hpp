@@ -1,6 +1,8 @@
 #pragma once
 // GpCorrection's loops on a Cortex-M with a single-precision FPU (FPv4-SP,
-// the Cortex-M4F; FPv5 builds on it): the portable loops, with block loads.
+// the Cortex-M4F; FPv5 builds on it): the portable loops with block loads,
+// and the mean's loop for 8 inputs (4 segments) with compensated float sums
+// in assembly (gp_mean_fpv4.hpp).
 //
 // On such a core GCC issues one VLDR per float; VLDMIA moves a whole training
 // point (or its six alphas) in one instruction, about a fifth of the loop's
@@ -14,7 +16,12 @@
 #error "model/arch/fpv4 needs GCC targeting an Arm core with a single-precision FPU (check CDCR_MODEL_ARCH)"
 #endif
 
+#include <cstdint>
+#include <type_traits>
+
+#include "cdcr/model/arch/gp_mean_fpv4.hpp"
 #include "cdcr/model/arch/portable.hpp"
+#include "cdcr/model/compensated_float.hpp"
 #include "cdcr/model/work_costs.hpp"
 
 namespace cdcr::model::arch {
@@ -23,18 +30,16 @@ struct Fpv4 : Portable {
   static constexpr bool kBlockLoads = true;
 
   // Measured on the Cortex-M4F (qemu.cycle_budget_m4f prints the figures):
-  // a mean point 72 instructions in the forward path and 82 in the IK's
-  // slices, with the gradient 148; the IK Jacobian at most 20,400, the
-  // damped step 20,600, the outer step 7,800 (the IK code is built at -O2,
-  // firmware/CMakeLists.txt); a request's end about 10,000 (the setpoint
-  // frames 7,800, scaled in single precision where that gives the double
-  // result; the report 1,100); the rest of a cycle at most about 15,000
-  // beyond the units spent, with a target's start and a superseded report,
-  // and the IK slices' dearer mean points. The overhead's 325 units leave
-  // the IK 575 a cycle with the demo's 700 points: a Jacobian and a damped
-  // step in one cycle. 1,600 units are 115,200 instructions; the workload's
-  // worst cycle is 119,000, within the board's 120,000.
-  static constexpr WorkCosts kWorkCosts{3, {285, 290, 110}, 150, 325, 1600};
+  // a mean point 54 instructions (the assembly loop), with the gradient 149;
+  // the IK Jacobian at most 20,500, the damped step 20,700, the outer step
+  // 8,100 (the IK code is built at -O2, firmware/CMakeLists.txt); a
+  // request's end about 10,000 (the setpoint frames 7,800, scaled in single
+  // precision where that gives the double result; the report 1,100); the
+  // rest of a cycle at most about 15,000 beyond the units spent, with a
+  // target's start and a superseded report. 2,130 units are 115,000
+  // instructions, within the board's 120,000; at the full 1,024 training
+  // points they leave the IK 806 units a cycle, more than its costliest step.
+  static constexpr WorkCosts kWorkCosts{3, {380, 385, 150}, 185, 300, 2130};
 
 #define CDCR_VLDM_OUT(i) "=t"(r##i)
   template <int Count>
@@ -68,6 +73,18 @@ struct Fpv4 : Portable {
     for (int i = 0; i < Count; ++i) to[i] = loaded[i];
   }
 #undef CDCR_VLDM_OUT
+
+  template <int Dims, typename S, typename Accumulator, std::uint32_t BlockPoints>
+  static constexpr bool has_mean_blocks() {
+    return Dims == 8 && std::is_same_v<S, float> && std::is_same_v<Accumulator, CompensatedFloat> &&
+           BlockPoints == detail::kFpv4BlockPoints;
+  }
+
+  // `blocks` (at least 1) full blocks; advances inputs and alpha past them.
+  static void mean_blocks(const float* query, const float*& inputs, const float*& alpha, std::uint32_t blocks,
+                          CompensatedFloat* sums) {
+    detail::gp_mean_blocks_fpv4(query, inputs, alpha, blocks, sums);
+  }
 };
 
 }  // namespace cdcr::model::arch

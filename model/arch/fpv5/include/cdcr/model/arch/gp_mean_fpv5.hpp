@@ -13,6 +13,7 @@
 
 #include <cstdint>
 
+#include "cdcr/model/arch/gp_point_asm.hpp"
 #include "cdcr/model/kernel_exp.hpp"
 
 #if !(defined(__GNUC__) && !defined(__clang__) && defined(__ARM_ARCH_7EM__) && defined(__ARM_FP) && (__ARM_FP & 0x8))
@@ -23,61 +24,11 @@ namespace cdcr::model::arch::detail {
 
 inline constexpr std::uint32_t kFpv5BlockPoints = 8;
 
-// Distance of the next training point (8 floats at z) from the query, into s16.
-#define CDCR_FPV5_DISTANCE                 \
-  "vldmia %[z]!, {s16-s23}\n\t"            \
-  "vsub.f32 s16, s0, s16\n\t"              \
-  "vsub.f32 s17, s1, s17\n\t"              \
-  "vsub.f32 s18, s2, s18\n\t"              \
-  "vsub.f32 s19, s3, s19\n\t"              \
-  "vsub.f32 s20, s4, s20\n\t"              \
-  "vsub.f32 s21, s5, s21\n\t"              \
-  "vsub.f32 s22, s6, s22\n\t"              \
-  "vsub.f32 s23, s7, s23\n\t"              \
-  "vmul.f32 s16, s16, s16\n\t"             \
-  "vfma.f32 s16, s17, s17\n\t"             \
-  "vfma.f32 s16, s18, s18\n\t"             \
-  "vfma.f32 s16, s19, s19\n\t"             \
-  "vfma.f32 s16, s20, s20\n\t"             \
-  "vfma.f32 s16, s21, s21\n\t"             \
-  "vfma.f32 s16, s22, s22\n\t"             \
-  "vfma.f32 s16, s23, s23\n\t"
-
-// polynomial_gaussian(s16) into s23, step for step.
-#define CDCR_FPV5_GAUSSIAN                 \
-  "vminnm.f32 s16, s16, s24\n\t"           \
-  "vmul.f32 s17, s16, s14\n\t"             \
-  "vcvtr.s32.f32 s17, s17\n\t"             \
-  "vmov %[k], s17\n\t"                     \
-  "vcvt.f32.s32 s17, s17\n\t"              \
-  "vfma.f32 s16, s17, s15\n\t"             \
-  "vmul.f32 s18, s16, s16\n\t"             \
-  "vmov.f32 s19, s25\n\t"                  \
-  "vfma.f32 s19, s16, s26\n\t"             \
-  "vmov.f32 s20, s27\n\t"                  \
-  "vfma.f32 s20, s16, s28\n\t"             \
-  "vfma.f32 s20, s18, s29\n\t"             \
-  "vfma.f32 s19, s18, s20\n\t"             \
-  "vmov.f32 s21, #-0.5\n\t"                \
-  "vfma.f32 s21, s16, s19\n\t"             \
-  "vmov.f32 s22, #1.0\n\t"                 \
-  "vfma.f32 s22, s16, s21\n\t"             \
-  "vmov %[p], s22\n\t"                     \
-  "add %[p], %[p], %[k], lsl #23\n\t"      \
-  "vmov s23, %[p]\n\t"
-
-// The point's six terms: the first point of a block sets the sums, the
-// others add to them.
-#define CDCR_FPV5_TERMS(op)                \
-  "vldmia %[a]!, {s16-s21}\n\t"            \
-  op " s8, s23, s16\n\t"                   \
-  op " s9, s23, s17\n\t"                   \
-  op " s10, s23, s18\n\t"                  \
-  op " s11, s23, s19\n\t"                  \
-  op " s12, s23, s20\n\t"                  \
-  op " s13, s23, s21\n\t"
-
-#define CDCR_FPV5_POINT(op) CDCR_FPV5_DISTANCE CDCR_FPV5_GAUSSIAN CDCR_FPV5_TERMS(op)
+// The kernel's clamp: VMINNM returns the number when the other operand is
+// NaN, so NaN goes to 173 too, as polynomial_gaussian's comparison.
+#define CDCR_FPV5_POINT(op)                                                                        \
+  CDCR_GP_ASM_DISTANCE "vminnm.f32 s16, s16, s24\n\t" CDCR_GP_ASM_GAUSSIAN_OF_CLAMPED \
+      CDCR_GP_ASM_TERMS(op)
 
 // The block's sums into the six doubles at t, two at a time (d8-d11 are
 // s16-s23, free between points).
@@ -99,14 +50,7 @@ inline void gp_mean_blocks_fpv5(const float* query, const float*& inputs, const 
   std::int32_t p_bits;
   asm volatile(
       "vldmia %[q], {s0-s7}\n\t"
-      "vldr s14, [%[c]]\n\t"
-      "vldr s15, [%[c], #4]\n\t"
-      "vldr s24, [%[c], #8]\n\t"
-      "vldr s25, [%[c], #12]\n\t"
-      "vldr s26, [%[c], #16]\n\t"
-      "vldr s27, [%[c], #20]\n\t"
-      "vldr s28, [%[c], #24]\n\t"
-      "vldr s29, [%[c], #28]\n\t"
+      CDCR_GP_ASM_LOAD_CONSTANTS
       "1:\n\t"
       CDCR_FPV5_POINT("vmul.f32")
       CDCR_FPV5_POINT("vfma.f32")
@@ -128,9 +72,10 @@ inline void gp_mean_blocks_fpv5(const float* query, const float*& inputs, const 
         "cc", "memory");
 }
 
-#undef CDCR_FPV5_DISTANCE
-#undef CDCR_FPV5_GAUSSIAN
-#undef CDCR_FPV5_TERMS
+#undef CDCR_GP_ASM_DISTANCE
+#undef CDCR_GP_ASM_GAUSSIAN_OF_CLAMPED
+#undef CDCR_GP_ASM_TERMS
+#undef CDCR_GP_ASM_LOAD_CONSTANTS
 #undef CDCR_FPV5_POINT
 #undef CDCR_FPV5_BLOCK_INTO_DOUBLES
 
