@@ -9,6 +9,7 @@
 #include <sstream>
 #include <string>
 
+#include <Eigen/LU>
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
@@ -104,6 +105,36 @@ TEST(GaussianProcess, MatchesScikitLearnAtFixedHyperparameters) {
     EXPECT_LT(relative_difference(lml.gradient[d], g[d + 1].get<double>()), 1e-6) << "length scale " << d;
   }
   EXPECT_LT(relative_difference(lml.gradient[4], g[4].get<double>()), 1e-6);
+}
+
+// The log marginal likelihood written out as the textbook gives it (Rasmussen
+// and Williams, eq. 2.30), summed over the output columns: the kernel built
+// entry by entry here, its inverse and determinant from a full-pivoting LU
+// rather than the trainer's Cholesky factor.
+TEST(GaussianProcess, LikelihoodMatchesTheDenseFormula) {
+  const Problem p = make_problem();
+  const Eigen::Index n = p.x.rows();
+  Eigen::MatrixXd k(n, n);
+  for (Eigen::Index i = 0; i < n; ++i) {
+    for (Eigen::Index j = 0; j < n; ++j) {
+      double exponent = 0.0;
+      for (Eigen::Index d = 0; d < p.x.cols(); ++d) {
+        const double scaled = (p.x(i, d) - p.x(j, d)) / p.h.length_scales[d];
+        exponent += scaled * scaled;
+      }
+      k(i, j) = p.h.signal_variance * std::exp(-0.5 * exponent) + (i == j ? p.h.noise_variance : 0.0);
+    }
+  }
+  const Eigen::FullPivLU<Eigen::MatrixXd> lu(k);
+  const double log_determinant = std::log(lu.determinant());
+  double expected = 0.0;
+  for (Eigen::Index c = 0; c < p.y.cols(); ++c) {
+    const Eigen::VectorXd y = p.y.col(c);
+    expected += -0.5 * y.dot(lu.solve(y)) - 0.5 * log_determinant - 0.5 * double(n) * std::log(2.0 * M_PI);
+  }
+  const LikelihoodResult lml = log_marginal_likelihood(p.x, p.y, p.h, false);
+  EXPECT_LT(relative_difference(lml.log_marginal_likelihood, expected), 1e-9)
+      << lml.log_marginal_likelihood << " vs " << expected;
 }
 
 TEST(GaussianProcess, LikelihoodGradientMatchesCentralDifferences) {
