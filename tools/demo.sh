@@ -76,10 +76,10 @@ PYTHON
 out=build/demo
 mkdir -p "$out"
 
-heading "4. Simulated robot: 750 random workspace samples (the paper's protocol)"
-run "$cdcr" simulate --samples 750 --seed 1 --out "$out/train.csv"
+heading "4. Simulated robot: 700 random workspace samples (the paper's protocol)"
+run "$cdcr" simulate --samples 700 --seed 1 --out "$out/train.csv"
 
-heading "5. Train on 700 samples, validate on 50 held out, export the float32 image"
+heading "5. Train: hyperparameters on 650 samples, validated on 50 held out; the exported float32 image fitted on all 700"
 run "$cdcr" train --data "$out/train.csv" --out "$out/model.img"
 
 heading "6. Check the image and export it for a board"

@@ -1,8 +1,9 @@
-# cmake -DCDCR= -DMAKE_GOLDEN= -DOUT_DIR= [-DSAMPLES=750] -P make_golden_model.cmake
+# cmake -DCDCR= -DMAKE_GOLDEN= -DOUT_DIR= [-DSAMPLES=700] -P make_golden_model.cmake
 # The model the board programs carry, made the way a user makes one: the
-# simulated robot's default data set (750 samples, 4 segments), trained on
-# 700 of them, then the image and the host's golden results. SAMPLES makes a
-# larger one (1,074 samples give the runtime's capacity, 1,024 points).
+# simulated robot's default data set (700 samples, 4 segments), 50 held out
+# to validate, the exported model fitted on all 700; then the image and the
+# host's golden results. SAMPLES makes a larger one (1,024 samples give the
+# runtime's capacity).
 foreach(variable CDCR MAKE_GOLDEN OUT_DIR)
   if(NOT ${variable})
     message(FATAL_ERROR "make_golden_model.cmake: ${variable} is not set")
@@ -10,7 +11,7 @@ foreach(variable CDCR MAKE_GOLDEN OUT_DIR)
 endforeach()
 file(MAKE_DIRECTORY ${OUT_DIR})
 if(NOT SAMPLES)
-  set(SAMPLES 750)
+  set(SAMPLES 700)
 endif()
 
 function(run)

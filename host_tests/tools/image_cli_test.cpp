@@ -123,6 +123,7 @@ TEST_F(ImageCli, InspectJsonReportsTheModel) {
   EXPECT_EQ(header["crc32_computed"], crc);
 
   EXPECT_EQ(j["dims"], (json{{"training_points", 5}, {"input_dims", 4}, {"output_dims", 6}, {"segments", 2}}));
+  EXPECT_EQ(j["fitted_rows"], 5);
   EXPECT_EQ(j["scalar_type"]["name"], "float32");
   EXPECT_EQ(j["kernel"]["code"], 1);
   EXPECT_EQ(j["input_encoding"]["name"], "bend-vector");
@@ -251,6 +252,7 @@ TEST_F(ImageCli, InspectOfAFileShorterThanAHeader) {
   EXPECT_EQ(j["header"]["magic"], "0x50474443");
   EXPECT_EQ(j["header"]["version_major"], 1);
   EXPECT_TRUE(j["dims"].is_null());
+  EXPECT_TRUE(j["fitted_rows"].is_null());
   EXPECT_EQ(j["checks"]["magic"]["passed"], true);
   EXPECT_TRUE(j["checks"]["header"]["passed"].is_null());
 }

@@ -2,7 +2,8 @@
 # Instruction counts and memory of the runtime on the Cortex-M boards, under
 # QEMU: mps2-an500 (Cortex-M7, fpv5-d16) and mps2-an386 (Cortex-M4F,
 # fpv4-sp-d16). Builds the host tools, trains the 700-point, 8-input model on
-# the simulated robot (750 samples, seed 1, 50 held out), cross-builds the
+# the simulated robot (700 samples, seed 1, 50 held out to validate, the
+# image fitted on all 700), cross-builds the
 # board programs against it (the qemu.golden and qemu.build_* test fixtures),
 # then runs cdcr_qemu_cycle_bench with `-icount shift=10` on each board and
 # prints the size report of the deployable program.

@@ -153,9 +153,15 @@ std::string format_text(const std::string& path, const ImageReport& r) {
     const std::optional<std::string> created = iso8601_utc(m.created_unix_s);
     row("created", fmt::format("{} (unix {})", created.value_or("out of range"), m.created_unix_s));
     row("validation samples", fmt::format("{}", m.validation_samples));
-    row("initial error", fmt::format("{} mm, {} deg (mean over the validation samples)", e.initial_position_mm,
-                                     e.initial_orientation_deg));
-    row("compensated error", fmt::format("{} mm, {} deg", e.compensated_position_mm, e.compensated_orientation_deg));
+    if (m.validation_samples > 0) {
+      row("initial error", fmt::format("{} mm, {} deg (mean over the validation samples)", e.initial_position_mm,
+                                       e.initial_orientation_deg));
+      row("compensated error",
+          fmt::format("{} mm, {} deg", e.compensated_position_mm, e.compensated_orientation_deg));
+    } else {
+      row("initial error", "none held out (trained with --holdout 0)");
+      row("compensated error", "none held out");
+    }
     row("float32 fidelity", fmt::format("max {} mm, {} deg; mean {} mm, {} deg (image path vs double trainer)",
                                         e.float32_max_position_diff_mm, e.float32_max_orientation_diff_deg,
                                         e.float32_mean_position_diff_mm, e.float32_mean_orientation_diff_deg));
@@ -227,11 +233,14 @@ Json format_json(const std::string& path, const ImageReport& r) {
                  {"input_dims", h.input_dims},
                  {"output_dims", h.output_dims},
                  {"segments", h.segment_count}};
+    // An exact GP's image carries the rows it was fitted on.
+    j["fitted_rows"] = h.training_points;
     j["scalar_type"] = kind_json(h.scalar_type, scalar_name(h.scalar_type));
     j["kernel"] = kind_json(h.kernel_kind, kernel_name(h.kernel_kind));
     j["input_encoding"] = kind_json(h.input_encoding, encoding_name(h.input_encoding));
   } else {
     j["dims"] = nullptr;
+    j["fitted_rows"] = nullptr;
     j["scalar_type"] = nullptr;
     j["kernel"] = nullptr;
     j["input_encoding"] = nullptr;

@@ -49,8 +49,14 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     if (!o.validation_path.empty()) {
       train_set = all;
       validation_set = training::make_training_set(load_dataset(o.validation_path, true), geometry, options.encoding);
+    } else if (o.holdout == 0) {
+      train_set = all;
     } else {
-      if (o.holdout < 1) throw InputError("--holdout must be at least 1 (or give --validation FILE)");
+      if (o.holdout < 0) throw InputError(fmt::format("--holdout must not be negative (got {})", o.holdout));
+      if (all.size() - o.holdout < 2) {
+        throw InputError(fmt::format("--holdout {} leaves {} of the {} samples to train on; training needs at least 2",
+                                     o.holdout, std::max(0, all.size() - o.holdout), all.size()));
+      }
       const training::Split split = training::random_split(all.size(), o.holdout, o.training.seed);
       train_set = all.subset(split.train);
       validation_set = all.subset(split.test);
@@ -58,15 +64,24 @@ CommandOutput run_train(const TrainCommandOptions& o) {
   } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
   }
-  if (train_set.size() > static_cast<int>(model::kMaxTrainingPoints)) {
-    throw InputError(fmt::format("{} training samples exceed the image capacity of {}", train_set.size(),
-                                 model::kMaxTrainingPoints));
+  if (train_set.size() < 2) {
+    throw InputError(fmt::format("{}: {} sample{}; training needs at least 2", o.data_path, train_set.size(),
+                                 train_set.size() == 1 ? "" : "s"));
   }
+  const int capacity = static_cast<int>(model::kMaxTrainingPoints);
+  if (train_set.size() > capacity) {
+    throw InputError(
+        fmt::format("{} training samples exceed the image capacity of {}", train_set.size(), capacity));
+  }
+  // The exported model is fitted on every row of --data once the held-out
+  // rows have measured it, unless that many rows exceed the image.
+  const bool fit_all = all.size() <= capacity;
+  const training::TrainingSet& fitted_set = fit_all ? all : train_set;
 
   const auto now = std::chrono::system_clock::now();
   const auto start = std::chrono::steady_clock::now();
   const training::ExportResult r = training::train_and_export(
-      train_set, validation_set, geometry, options, data.content_hash,
+      train_set, validation_set, fitted_set, geometry, options, data.content_hash,
       std::chrono::duration_cast<std::chrono::seconds>(now.time_since_epoch()).count());
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   try {
@@ -81,6 +96,7 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     Json j;
     j["training_samples"] = train_set.size();
     j["validation_samples"] = validation_set.size();
+    j["fitted_rows"] = r.fitted_rows;
     j["encoding"] = model::to_string(m.encoding);
     j["kernel"] = o.training.kernel;
     j["length_scales"] = std::vector<double>(m.length_scales.data(), m.length_scales.data() + m.length_scales.size());
@@ -89,8 +105,13 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     j["log_marginal_likelihood"] = r.report.log_marginal_likelihood;
     j["likelihood_evaluations"] = r.report.likelihood_evaluations;
     j["seconds"] = seconds;
-    j["validation"] = {{"initial", errors_json(r.validation.initial)},
-                       {"compensated", errors_json(r.validation.compensated)}};
+    if (r.validation_samples > 0) {
+      j["validation"] = {{"initial", errors_json(r.validation.initial)},
+                         {"compensated", errors_json(r.validation.compensated)},
+                         {"compensated_float32_image", errors_json(r.firmware.compensated)}};
+    } else {
+      j["validation"] = nullptr;
+    }
     Json fidelity = Json::object();
     for (const auto& [accumulator, f] : r.fidelity_by_accumulator) {
       fidelity[training::to_string(accumulator)] = {{"max_position_mm", f.max_position_mm},
@@ -105,8 +126,12 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     output.text = j.dump() + "\n";
   } else {
     std::string t;
-    t += fmt::format("trained on {} samples, validated on {} held-out samples ({:.1f} s)\n", train_set.size(),
-                     validation_set.size(), seconds);
+    if (validation_set.size() > 0) {
+      t += fmt::format("trained on {} samples, validated on {} held-out samples ({:.1f} s)\n", train_set.size(),
+                       validation_set.size(), seconds);
+    } else {
+      t += fmt::format("trained on {} samples, none held out ({:.1f} s)\n", train_set.size(), seconds);
+    }
     t += fmt::format("  encoding {}, kernel {} squared exponential, hyperparameters shared by the 6 outputs\n",
                      model::to_string(m.encoding), o.training.kernel);
     t += "  length scales (normalised inputs):";
@@ -115,14 +140,25 @@ CommandOutput run_train(const TrainCommandOptions& o) {
                      m.signal_variance[0], m.noise_variance[0]);
     t += fmt::format("  log marginal likelihood {:.6g} after {} evaluations\n", r.report.log_marginal_likelihood,
                      r.report.likelihood_evaluations);
-    t += "held-out mean error          position (mm)   orientation (deg)\n";
-    t += fmt::format("  nominal model              {:13.4f}   {:17.4f}\n", r.validation.initial.position_mm,
-                     r.validation.initial.orientation_deg);
-    t += fmt::format("  compensated (double)       {:13.4f}   {:17.4f}\n", r.validation.compensated.position_mm,
-                     r.validation.compensated.orientation_deg);
-    t += fmt::format("  compensated (float32 image){:13.4f}   {:17.4f}\n", r.firmware.compensated.position_mm,
-                     r.firmware.compensated.orientation_deg);
-    t += "float32 fidelity on the held-out samples (image path vs double trainer; target 0.01 mm, 0.001 deg):\n";
+    if (r.validation_samples > 0) {
+      t += "held-out mean error          position (mm)   orientation (deg)\n";
+      t += fmt::format("  nominal model              {:13.4f}   {:17.4f}\n", r.validation.initial.position_mm,
+                       r.validation.initial.orientation_deg);
+      t += fmt::format("  compensated (double)       {:13.4f}   {:17.4f}\n", r.validation.compensated.position_mm,
+                       r.validation.compensated.orientation_deg);
+      t += fmt::format("  compensated (float32 image){:13.4f}   {:17.4f}\n", r.firmware.compensated.position_mm,
+                       r.firmware.compensated.orientation_deg);
+    } else {
+      t += "no held-out figures (--holdout 0): measure the image with cdcr eval on data collected apart\n";
+    }
+    if (r.fitted_rows == all.size() && validation_set.size() > 0 && o.validation_path.empty()) {
+      t += fmt::format("exported model fitted on all {} rows, the held-out ones included\n", r.fitted_rows);
+    } else if (r.fitted_rows < all.size()) {
+      t += fmt::format("exported model fitted on the {} training rows: all {} exceed the image capacity of {}\n",
+                       r.fitted_rows, all.size(), capacity);
+    }
+    t += fmt::format("float32 fidelity on the {} (image path vs double trainer; target 0.01 mm, 0.001 deg):\n",
+                     validation_set.size() > 0 ? "held-out samples" : "fitted rows");
     for (const auto& [accumulator, f] : r.fidelity_by_accumulator) {
       const bool firmware = accumulator != training::FirmwareAccumulator::float32;
       t += fmt::format("  {:<31} max {:.2e} mm, mean {:.2e} mm, max {:.2e} deg, mean {:.2e} deg: {}\n",
@@ -146,7 +182,9 @@ void register_train_command(CLI::App& app, CommandOutput& output) {
   command->add_option("--validation", o->validation_path,
                       "Held-out dataset CSV for the accuracy and float32 figures (default: hold out --holdout "
                       "samples of --data)");
-  command->add_option("--holdout", o->holdout, "Samples of --data held out when --validation is not given")
+  command->add_option("--holdout", o->holdout,
+                      "Samples of --data held out to validate when --validation is not given (0: none); the exported "
+                      "model is then fitted on every row")
       ->capture_default_str();
   add_geometry_options(*command, o->geometry, "Number of segments (default: from the dataset's cable columns)");
   add_training_flags(*command, o->training);

@@ -45,30 +45,56 @@ model::ImageMetrics metrics_of(const Evaluation& validation, const Fidelity& fid
 
 }  // namespace
 
-ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& validation_set,
-                              const model::RobotGeometry<double>& geometry, const TrainingOptions& options,
-                              std::uint64_t dataset_hash, std::int64_t created_unix_s) {
-  if (validation_set.size() < 1) throw std::invalid_argument("no held-out samples to validate the export on");
-  ExportResult r;
-  r.model = train(train_set, geometry, options, &r.report);
-  r.model.dataset_hash = dataset_hash;
-  r.model.created_unix_s = created_unix_s;
-  r.model.validation_samples = static_cast<std::uint32_t>(validation_set.size());
+namespace {
 
-  const Eigen::MatrixXd predicted = predict_error_twists(r.model, validation_set.bends);
-  r.validation = evaluate(validation_set, predicted);
-  const std::vector<model::Pose<double>> double_poses = compensated_poses(validation_set, predicted);
-
-  // The metrics live inside the image, so measure on a first image and
-  // write the final one with the figures; the payload is identical.
-  std::vector<std::uint8_t> image = exporting::write_image(r.model);
+model::ImageView parsed(const std::vector<std::uint8_t>& image) {
   model::ImageView view{};
   if (const model::ImageStatus s = model::parse_image(image.data(), image.size(), view); s != model::ImageStatus::ok) {
     throw std::runtime_error(std::string("exported image does not parse: ") + model::to_string(s));
   }
+  return view;
+}
+
+bool same_rows(const TrainingSet& a, const TrainingSet& b) {
+  return a.size() == b.size() && a.inputs == b.inputs && a.error_twists == b.error_twists;
+}
+
+}  // namespace
+
+ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& validation_set,
+                              const TrainingSet& fitted_set, const model::RobotGeometry<double>& geometry,
+                              const TrainingOptions& options, std::uint64_t dataset_hash,
+                              std::int64_t created_unix_s) {
+  ExportResult r;
+  const TrainedModel searched = train(train_set, geometry, options, &r.report);
+  r.validation_samples = validation_set.size();
+  if (r.validation_samples > 0) {
+    const Eigen::MatrixXd predicted = predict_error_twists(searched, validation_set.bends);
+    r.validation = evaluate(validation_set, predicted);
+    const std::vector<std::uint8_t> image = exporting::write_image(searched);
+    r.firmware.samples = validation_set.size();
+    r.firmware.initial = r.validation.initial;
+    r.firmware.compensated = mean_errors(
+        validation_set.measured,
+        firmware_poses(parsed(image), validation_set.cables_mm, FirmwareAccumulator::float64));
+  }
+
+  r.model = same_rows(fitted_set, train_set) ? searched : refit(searched, fitted_set);
+  r.fitted_rows = fitted_set.size();
+  r.model.dataset_hash = dataset_hash;
+  r.model.created_unix_s = created_unix_s;
+  r.model.validation_samples = static_cast<std::uint32_t>(r.validation_samples);
+
+  // The metrics live inside the image, so measure on a first image and
+  // write the final one with the figures; the payload is identical.
+  const TrainingSet& fidelity_set = r.validation_samples > 0 ? validation_set : fitted_set;
+  const std::vector<model::Pose<double>> double_poses =
+      compensated_poses(fidelity_set, predict_error_twists(r.model, fidelity_set.bends));
+  const std::vector<std::uint8_t> first_image = exporting::write_image(r.model);
+  const model::ImageView view = parsed(first_image);
   for (const FirmwareAccumulator accumulator :
        {FirmwareAccumulator::float64, FirmwareAccumulator::compensated_float32, FirmwareAccumulator::float32}) {
-    const std::vector<model::Pose<double>> float_poses = firmware_poses(view, validation_set.cables_mm, accumulator);
+    const std::vector<model::Pose<double>> float_poses = firmware_poses(view, fidelity_set.cables_mm, accumulator);
     const Fidelity f = compare_poses(double_poses, float_poses);
     r.fidelity_by_accumulator.emplace_back(accumulator, f);
     if (accumulator == FirmwareAccumulator::float32) continue;  // no firmware build sums this way
@@ -76,11 +102,6 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
     r.fidelity.mean_position_mm = std::max(r.fidelity.mean_position_mm, f.mean_position_mm);
     r.fidelity.max_orientation_deg = std::max(r.fidelity.max_orientation_deg, f.max_orientation_deg);
     r.fidelity.mean_orientation_deg = std::max(r.fidelity.mean_orientation_deg, f.mean_orientation_deg);
-    if (accumulator == FirmwareAccumulator::float64) {
-      r.firmware.samples = validation_set.size();
-      r.firmware.initial = r.validation.initial;
-      r.firmware.compensated = mean_errors(validation_set.measured, float_poses);
-    }
   }
 
   r.model.metrics = metrics_of(r.validation, r.fidelity);

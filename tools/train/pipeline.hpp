@@ -1,7 +1,7 @@
 #pragma once
 // The training PC's job end to end: split, train, evaluate on held-out data,
-// export the image, and measure the float32 firmware path against the
-// double-precision trainer on the same held-out samples.
+// fit the exported model on every row, export the image, and measure the
+// float32 firmware path against the double-precision trainer.
 
 #include <cstdint>
 #include <utility>
@@ -26,11 +26,18 @@ inline constexpr double kFidelityTargetPositionMm = 0.01;
 inline constexpr double kFidelityTargetOrientationDeg = 0.001;
 
 struct ExportResult {
-  TrainedModel model;
+  TrainedModel model;     // the exported one, fitted on `fitted_rows`
   TrainingReport report;
   std::vector<std::uint8_t> image;
-  Evaluation validation;  // double-precision trainer on the held-out samples
-  Evaluation firmware;    // float32 image path (double accumulators) on the same samples
+  int fitted_rows = 0;
+  // The model fitted on the training rows alone, on the held-out samples
+  // (none when validation_samples is 0): the double-precision trainer, and
+  // the float32 image path with double accumulators.
+  int validation_samples = 0;
+  Evaluation validation;
+  Evaluation firmware;
+  // The exported image's float32 path against its double-precision model,
+  // on the held-out samples (on the fitted rows when none are held out).
   // float32 path vs double trainer, one entry per FirmwareAccumulator.
   std::vector<std::pair<FirmwareAccumulator, Fidelity>> fidelity_by_accumulator;
   Fidelity fidelity;      // the worst of the accumulators that firmware builds use
@@ -41,8 +48,13 @@ struct ExportResult {
   bool fidelity_met() const { return meets_target(fidelity); }
 };
 
+// Searches the hyperparameters on train_set, measures that model on
+// validation_set (which may be empty), then fits the exported model on
+// fitted_set with the same hyperparameters (train_set itself when the two
+// have the same rows).
 ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& validation_set,
-                              const model::RobotGeometry<double>& geometry, const TrainingOptions& options,
-                              std::uint64_t dataset_hash, std::int64_t created_unix_s);
+                              const TrainingSet& fitted_set, const model::RobotGeometry<double>& geometry,
+                              const TrainingOptions& options, std::uint64_t dataset_hash,
+                              std::int64_t created_unix_s);
 
 }  // namespace cdcr::training

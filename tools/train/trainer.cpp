@@ -71,6 +71,20 @@ TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& g
   return m;
 }
 
+TrainedModel refit(const TrainedModel& model, const TrainingSet& set) {
+  if (set.size() < 2) throw std::invalid_argument("training needs at least two samples");
+  KernelHyperparameters h;
+  h.length_scales = model.length_scales;
+  h.signal_variance = model.signal_variance[0];
+  h.noise_variance = model.noise_variance[0];
+  const Eigen::MatrixXd x = normalise(set.inputs, model.input_mean, model.input_scale);
+  const Eigen::MatrixXd y = normalise(set.error_twists, model.output_mean, model.output_scale);
+  TrainedModel refitted = model;
+  refitted.inputs = set.inputs;
+  refitted.alpha = GaussianProcess::fit(x, y, h).alpha;
+  return refitted;
+}
+
 Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends) {
   const Eigen::MatrixXd x = normalise(encode_rows(bends, model.encoding), model.input_mean, model.input_scale);
   const Eigen::MatrixXd train_x = normalise(model.inputs, model.input_mean, model.input_scale);

@@ -48,6 +48,12 @@ Eigen::MatrixXd normalise(const Eigen::MatrixXd& m, const Eigen::VectorXd& mean,
 TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
                    const TrainingOptions& options, TrainingReport* report = nullptr);
 
+// The model fitted again on `set`, with the hyperparameters and the
+// normalisation it has (they were found on other rows): a search finds the
+// hyperparameters on the training rows, and once held-out rows have
+// measured the result, the exported model is fitted on every row.
+TrainedModel refit(const TrainedModel& model, const TrainingSet& set);
+
 // Double-precision error twists (rows, (v, omega)) for stacked bend vectors.
 Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends);
 
