@@ -40,16 +40,14 @@ Eigen::MatrixXd kernel_matrix(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b
   return h.signal_variance * (-0.5 * distance_sq.cwiseMax(0.0)).array().exp().matrix();
 }
 
-namespace {
-
-// The Gram matrix of a set with itself: exactly symmetric with the diagonal
-// exactly signal_variance, which the Cholesky factorisation relies on.
 Eigen::MatrixXd gram_matrix(const Eigen::MatrixXd& x, const KernelHyperparameters& h) {
   Eigen::MatrixXd k = kernel_matrix(x, x, h);
   k = 0.5 * (k + k.transpose()).eval();
   k.diagonal().setConstant(h.signal_variance);
   return k;
 }
+
+namespace {
 
 // In-place inverse of a lower-triangular matrix by recursive halving:
 // inv([A 0; B C]) = [inv(A) 0; -inv(C) B inv(A)  inv(C)]. The off-diagonal

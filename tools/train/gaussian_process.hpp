@@ -29,6 +29,10 @@ struct KernelHyperparameters {
 // K_ij = signal_variance * exp(-1/2 sum_d ((a_id - b_jd) / l_d)^2), no noise term.
 Eigen::MatrixXd kernel_matrix(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b, const KernelHyperparameters& h);
 
+// The kernel matrix of a set with itself: exactly symmetric with the
+// diagonal exactly signal_variance, which a Cholesky factorisation relies on.
+Eigen::MatrixXd gram_matrix(const Eigen::MatrixXd& x, const KernelHyperparameters& h);
+
 struct LikelihoodResult {
   double log_marginal_likelihood = 0.0;
   Eigen::VectorXd gradient;  // d LML / d log-parameters, see the order above
