@@ -5,7 +5,11 @@
 // between the measured poses and the image (the error twists, the
 // compensation's exponential, the export) leaves the compensated error at or
 // above the nominal model's.
+#include <cmath>
+#include <fstream>
+#include <sstream>
 #include <string>
+#include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -99,6 +103,77 @@ TEST(TrainEndToEnd, HoldoutsThatLeaveTooLittleAreRefused) {
   run = run_cdcr("train --data " + data + " --out " + image + " --holdout 0");
   EXPECT_EQ(run.exit_code, 1);
   EXPECT_NE(run.err.find("1 sample; training needs at least 2"), std::string::npos) << run.err;
+}
+
+// The data rows of a cdcr simulate CSV, its header first.
+std::vector<std::string> csv_lines(const std::string& path) {
+  std::ifstream in(path);
+  std::vector<std::string> lines;
+  for (std::string line; std::getline(in, line);) {
+    if (!line.empty() && line[0] != '#') lines.push_back(line);
+  }
+  return lines;
+}
+
+void write_lines(const std::string& path, const std::vector<std::string>& lines) {
+  std::ofstream out(path);
+  for (const std::string& line : lines) out << line << '\n';
+}
+
+// An image `cdcr train` wrote: every check of cdcr inspect passes and every
+// hyperparameter is finite.
+void expect_sound_image(const std::string& image) {
+  const CliRun run = run_cdcr("inspect " + image + " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  for (const auto& [name, check] : j.at("checks").items()) {
+    EXPECT_TRUE(check.at("passed").is_null() || check.at("passed").get<bool>()) << name << ": " << check;
+  }
+  for (const auto& group : {"length_scales", "signal_variance", "noise_variance"}) {
+    for (const auto& v : j.at("hyperparameters").at(group)) {
+      EXPECT_TRUE(v.is_number() && std::isfinite(v.get<double>())) << group << ": " << v;
+    }
+  }
+}
+
+// Degenerate training data give a model or a one-line error, never a NaN
+// image or a crash.
+TEST(TrainEndToEnd, DegenerateDatasetsGiveAModelOrAClearError) {
+  const std::string dir = testing::TempDir();
+  ASSERT_EQ(run_cdcr("simulate --samples 20 --seed 4 --out '" + dir + "degenerate_base.csv'").exit_code, 0);
+  const std::vector<std::string> base = csv_lines(dir + "degenerate_base.csv");
+  ASSERT_EQ(base.size(), 21u);
+
+  // Five distinct rows, then the first one 40 times more.
+  std::vector<std::string> duplicates(base.begin(), base.begin() + 6);
+  for (int i = 0; i < 40; ++i) duplicates.push_back(base[1]);
+  write_lines(dir + "duplicates.csv", duplicates);
+  CliRun run = run_cdcr("train --data '" + dir + "duplicates.csv' --out '" + dir + "duplicates.img' --holdout 5");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  expect_sound_image("'" + dir + "duplicates.img'");
+
+  // One row 30 times: nothing varies.
+  std::vector<std::string> same{base[0]};
+  for (int i = 0; i < 30; ++i) same.push_back(base[1]);
+  write_lines(dir + "same.csv", same);
+  run = run_cdcr("train --data '" + dir + "same.csv' --out '" + dir + "same.img' --holdout 5");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  expect_sound_image("'" + dir + "same.img'");
+
+  // A corner of the workspace: every bend within 0.005 rad.
+  ASSERT_EQ(run_cdcr("simulate --samples 40 --seed 4 --workspace-theta-max 0.005 --out '" + dir + "corner.csv'")
+                .exit_code,
+            0);
+  run = run_cdcr("train --data '" + dir + "corner.csv' --out '" + dir + "corner.img' --holdout 5");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  expect_sound_image("'" + dir + "corner.img'");
+
+  // A single row: a one-line error.
+  write_lines(dir + "single.csv", {base[0], base[1]});
+  run = run_cdcr("train --data '" + dir + "single.csv' --out '" + dir + "single.img' --holdout 0");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_EQ(run.err.find('\n'), run.err.size() - 1) << run.err;
+  EXPECT_NE(run.err.find("training needs at least 2"), std::string::npos) << run.err;
 }
 
 }  // namespace
