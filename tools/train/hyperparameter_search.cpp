@@ -5,7 +5,7 @@
 #include <random>
 #include <stdexcept>
 
-#include <LBFGSB.h>
+#include "search_setup.hpp"
 
 namespace cdcr::training {
 
@@ -63,21 +63,12 @@ SearchResult maximise_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd
                                  const KernelHyperparameters& initial, const SearchOptions& options) {
   const ParameterMap map{static_cast<int>(x.cols()), options.isotropic};
   const int d = map.size() - 2;  // length-scale entries in the optimiser's vector
-  const SearchBounds& b = options.bounds;
   Eigen::VectorXd lower(d + 2);
   Eigen::VectorXd upper(d + 2);
-  lower.head(d).setConstant(std::log(b.length_scale_min));
-  upper.head(d).setConstant(std::log(b.length_scale_max));
-  lower[d] = std::log(b.signal_variance_min);
-  upper[d] = std::log(b.signal_variance_max);
-  lower[d + 1] = std::log(b.noise_variance_min);
-  upper[d + 1] = std::log(b.noise_variance_max);
-
-  LBFGSpp::LBFGSBParam<double> param;
-  param.epsilon = options.gradient_tolerance;
-  param.max_iterations = options.max_iterations;
-  param.max_linesearch = 40;
-  LBFGSpp::LBFGSBSolver<double> solver(param);
+  detail::set_hyperparameter_box(options.bounds, d, lower, upper);
+  // The solver keeps a reference to its settings: they must outlive it.
+  const LBFGSpp::LBFGSBParam<double> settings = detail::lbfgsb_parameters(options);
+  LBFGSpp::LBFGSBSolver<double> solver(settings);
 
   // Restarts are drawn log-uniformly from a box of plausible values for
   // normalised data rather than from the whole search bounds, most of which

@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include <Eigen/Cholesky>
-#include <LBFGSB.h>
+#include "search_setup.hpp"
 
 namespace cdcr::training {
 
@@ -194,25 +194,16 @@ Eigen::MatrixXd initial_inducing_inputs(const Eigen::MatrixXd& x, int m, std::ui
 SparseSearchResult maximise_sparse_bound(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
                                          const SparseParameters& initial, const SearchOptions& options) {
   const int d = static_cast<int>(x.cols());
-  const SearchBounds& b = options.bounds;
   Eigen::VectorXd v = initial.to_vector();
   // The inducing inputs may go beyond the data, but not without bound.
   const double reach = 10.0 * std::max(1.0, x.cwiseAbs().maxCoeff());
   Eigen::VectorXd lower = Eigen::VectorXd::Constant(v.size(), -reach);
   Eigen::VectorXd upper = Eigen::VectorXd::Constant(v.size(), reach);
-  lower.head(d).setConstant(std::log(b.length_scale_min));
-  upper.head(d).setConstant(std::log(b.length_scale_max));
-  lower[d] = std::log(b.signal_variance_min);
-  upper[d] = std::log(b.signal_variance_max);
-  lower[d + 1] = std::log(b.noise_variance_min);
-  upper[d + 1] = std::log(b.noise_variance_max);
+  detail::set_hyperparameter_box(options.bounds, d, lower, upper);
   v = v.cwiseMax(lower).cwiseMin(upper);
-
-  LBFGSpp::LBFGSBParam<double> param;
-  param.epsilon = options.gradient_tolerance;
-  param.max_iterations = options.max_iterations;
-  param.max_linesearch = 40;
-  LBFGSpp::LBFGSBSolver<double> solver(param);
+  // The solver keeps a reference to its settings: they must outlive it.
+  const LBFGSpp::LBFGSBParam<double> settings = detail::lbfgsb_parameters(options);
+  LBFGSpp::LBFGSBSolver<double> solver(settings);
   SparseSearchResult result;
   const auto objective = [&](const Eigen::VectorXd& w, Eigen::VectorXd& gradient) {
     ++result.bound_evaluations;

@@ -48,6 +48,9 @@ inline constexpr float kB3 = -0.0208331496f;
 inline constexpr float kB4 = 0.00260427454f;
 inline constexpr float kB5 = -0.000261524139f;
 inline constexpr float kB6 = 2.1585045e-05f;
+// In the order the boards' assembly loops load them (CDCR_GP_ASM_LOAD_CONSTANTS
+// in model/arch/fpv4/.../gp_point_asm.hpp).
+inline constexpr float kAssemblyOrder[8] = {kMinusHalfLog2e, kTwoLn2, kClamp, kB2, kB3, kB4, kB5, kB6};
 }  // namespace gaussian_constants
 
 // Fused multiply-adds throughout (std::fma is one VFMA on the boards), so

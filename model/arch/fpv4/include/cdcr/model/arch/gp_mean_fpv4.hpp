@@ -68,8 +68,6 @@ inline constexpr std::uint32_t kFpv4BlockPoints = 8;
 // each; advances inputs and alpha past them.
 inline void gp_mean_blocks_fpv4(const float* query, const float*& inputs, const float*& alpha,
                                 std::uint32_t blocks, CompensatedFloat* sums) {
-  using namespace gaussian_constants;
-  static constexpr float kConstants[8] = {kMinusHalfLog2e, kTwoLn2, kClamp, kB2, kB3, kB4, kB5, kB6};
   float* sums_data = &sums[0].sum;
   std::int32_t k_bits;
   std::int32_t p_bits;
@@ -93,7 +91,7 @@ inline void gp_mean_blocks_fpv4(const float* query, const float*& inputs, const 
       "bne 1b\n\t"
       : [z] "+r"(inputs), [a] "+r"(alpha), [n] "+r"(blocks), [t] "+r"(sums_data), [k] "=&r"(k_bits),
         [p] "=&r"(p_bits)
-      : [q] "r"(query), [c] "r"(kConstants)
+      : [q] "r"(query), [c] "r"(gaussian_constants::kAssemblyOrder)
       : "s0", "s1", "s2", "s3", "s4", "s5", "s6", "s7", "s8", "s9", "s10", "s11", "s12", "s13", "s14", "s15",
         "s16", "s17", "s18", "s19", "s20", "s21", "s22", "s23", "s24", "s25", "s26", "s27", "s28", "s29", "cc",
         "memory");

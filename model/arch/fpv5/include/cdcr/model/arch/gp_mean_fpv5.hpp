@@ -44,8 +44,6 @@ inline constexpr std::uint32_t kFpv5BlockPoints = 8;
 // each; advances inputs and alpha past them.
 inline void gp_mean_blocks_fpv5(const float* query, const float*& inputs, const float*& alpha,
                                 std::uint32_t blocks, double* sums) {
-  using namespace gaussian_constants;
-  static constexpr float kConstants[8] = {kMinusHalfLog2e, kTwoLn2, kClamp, kB2, kB3, kB4, kB5, kB6};
   std::int32_t k_bits;
   std::int32_t p_bits;
   asm volatile(
@@ -67,7 +65,7 @@ inline void gp_mean_blocks_fpv5(const float* query, const float*& inputs, const 
       "subs %[n], %[n], #1\n\t"
       "bne 1b\n\t"
       : [z] "+r"(inputs), [a] "+r"(alpha), [n] "+r"(blocks), [t] "+r"(sums), [k] "=&r"(k_bits), [p] "=&r"(p_bits)
-      : [q] "r"(query), [c] "r"(kConstants)
+      : [q] "r"(query), [c] "r"(gaussian_constants::kAssemblyOrder)
       : "d0", "d1", "d2", "d3", "d4", "d5", "d6", "d7", "d8", "d9", "d10", "d11", "d12", "d13", "d14", "d15",
         "cc", "memory");
 }
