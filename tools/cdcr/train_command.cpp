@@ -105,7 +105,7 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     j["log_marginal_likelihood"] = r.report.log_marginal_likelihood;
     j["likelihood_evaluations"] = r.report.likelihood_evaluations;
     j["seconds"] = seconds;
-    if (r.validation_samples > 0) {
+    if (r.validation.samples > 0) {
       j["validation"] = {{"initial", errors_json(r.validation.initial)},
                          {"compensated", errors_json(r.validation.compensated)},
                          {"compensated_float32_image", errors_json(r.firmware.compensated)}};
@@ -140,7 +140,7 @@ CommandOutput run_train(const TrainCommandOptions& o) {
                      m.signal_variance[0], m.noise_variance[0]);
     t += fmt::format("  log marginal likelihood {:.6g} after {} evaluations\n", r.report.log_marginal_likelihood,
                      r.report.likelihood_evaluations);
-    if (r.validation_samples > 0) {
+    if (r.validation.samples > 0) {
       t += "held-out mean error          position (mm)   orientation (deg)\n";
       t += fmt::format("  nominal model              {:13.4f}   {:17.4f}\n", r.validation.initial.position_mm,
                        r.validation.initial.orientation_deg);

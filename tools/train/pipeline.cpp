@@ -43,10 +43,6 @@ model::ImageMetrics metrics_of(const Evaluation& validation, const Fidelity& fid
   return m;
 }
 
-}  // namespace
-
-namespace {
-
 model::ImageView parsed(const std::vector<std::uint8_t>& image) {
   model::ImageView view{};
   if (const model::ImageStatus s = model::parse_image(image.data(), image.size(), view); s != model::ImageStatus::ok) {
@@ -67,8 +63,7 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
                               std::int64_t created_unix_s) {
   ExportResult r;
   const TrainedModel searched = train(train_set, geometry, options, &r.report);
-  r.validation_samples = validation_set.size();
-  if (r.validation_samples > 0) {
+  if (validation_set.size() > 0) {
     const Eigen::MatrixXd predicted = predict_error_twists(searched, validation_set.bends);
     r.validation = evaluate(validation_set, predicted);
     const std::vector<std::uint8_t> image = exporting::write_image(searched);
@@ -83,11 +78,11 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   r.fitted_rows = fitted_set.size();
   r.model.dataset_hash = dataset_hash;
   r.model.created_unix_s = created_unix_s;
-  r.model.validation_samples = static_cast<std::uint32_t>(r.validation_samples);
+  r.model.validation_samples = static_cast<std::uint32_t>(r.validation.samples);
 
   // The metrics live inside the image, so measure on a first image and
   // write the final one with the figures; the payload is identical.
-  const TrainingSet& fidelity_set = r.validation_samples > 0 ? validation_set : fitted_set;
+  const TrainingSet& fidelity_set = r.validation.samples > 0 ? validation_set : fitted_set;
   const std::vector<model::Pose<double>> double_poses =
       compensated_poses(fidelity_set, predict_error_twists(r.model, fidelity_set.bends));
   const std::vector<std::uint8_t> first_image = exporting::write_image(r.model);

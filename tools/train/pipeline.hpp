@@ -31,9 +31,8 @@ struct ExportResult {
   std::vector<std::uint8_t> image;
   int fitted_rows = 0;
   // The model fitted on the training rows alone, on the held-out samples
-  // (none when validation_samples is 0): the double-precision trainer, and
+  // (none when validation.samples is 0): the double-precision trainer, and
   // the float32 image path with double accumulators.
-  int validation_samples = 0;
   Evaluation validation;
   Evaluation firmware;
   // The exported image's float32 path against its double-precision model,
