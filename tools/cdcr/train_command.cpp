@@ -1,6 +1,8 @@
 #include "train_command.hpp"
 
 #include <chrono>
+#include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 
@@ -22,6 +24,9 @@ struct TrainCommandOptions {
   std::string validation_path;
   std::string out_path;
   int holdout = 50;
+  std::string model = "auto";
+  int inducing = 0;
+  std::uint64_t flash_budget = 96 * 1024;
   GeometryOptions geometry;
   TrainingFlags training;
   bool json = false;
@@ -37,7 +42,19 @@ Json errors_json(const training::MeanErrors& e) {
 }
 
 CommandOutput run_train(const TrainCommandOptions& o) {
-  const training::TrainingOptions options = make_training_options(o.training);
+  training::TrainingOptions options = make_training_options(o.training);
+  options.model = o.model == "exact"    ? training::ModelChoice::exact
+                  : o.model == "sparse" ? training::ModelChoice::sparse
+                                        : training::ModelChoice::automatic;
+  if (o.inducing < 0) throw InputError(fmt::format("--inducing must not be negative (got {})", o.inducing));
+  if (o.inducing > 0 && options.model == training::ModelChoice::exact) {
+    throw InputError("--inducing applies to a sparse model, not to --model exact");
+  }
+  options.inducing_points = o.inducing;
+  if (o.flash_budget > std::numeric_limits<std::uint32_t>::max()) {
+    throw InputError(fmt::format("--flash-budget {} is beyond a 32-bit image size", o.flash_budget));
+  }
+  options.board.flash_budget_bytes = static_cast<std::uint32_t>(o.flash_budget);
   const dataset::Dataset data = load_dataset(o.data_path, true);
   const model::RobotGeometry<double> geometry = geometry_for(data, o.geometry);
 
@@ -68,15 +85,15 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     throw InputError(fmt::format("{}: {} sample{}; training needs at least 2", o.data_path, train_set.size(),
                                  train_set.size() == 1 ? "" : "s"));
   }
-  const int capacity = static_cast<int>(model::kMaxTrainingPoints);
-  if (train_set.size() > capacity) {
-    throw InputError(
-        fmt::format("{} training samples exceed the image capacity of {}", train_set.size(), capacity));
-  }
   // The exported model is fitted on every row of --data once the held-out
-  // rows have measured it, unless that many rows exceed the image.
-  const bool fit_all = all.size() <= capacity;
-  const training::TrainingSet& fitted_set = fit_all ? all : train_set;
+  // rows have measured it; a model too large for the board is sparse.
+  const training::TrainingSet& fitted_set = all;
+  try {
+    static_cast<void>(training::select_model(all.size(), static_cast<int>(all.inputs.cols()), geometry.segment_count,
+                                             options.model, options.inducing_points, options.board));
+  } catch (const std::invalid_argument& e) {
+    throw InputError(e.what());
+  }
 
   const auto now = std::chrono::system_clock::now();
   const auto start = std::chrono::steady_clock::now();
@@ -97,6 +114,14 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     j["training_samples"] = train_set.size();
     j["validation_samples"] = validation_set.size();
     j["fitted_rows"] = r.fitted_rows;
+    const training::ModelSelection& selection = r.report.selection;
+    j["model"] = {{"kind", training::to_string(selection.kind)},
+                  {"points", selection.points},
+                  {"largest_points", selection.largest_points},
+                  {"image_bytes", selection.image_bytes},
+                  {"forward_cycle_instructions_m7", selection.forward_cycle_instructions},
+                  {"reason", selection.reason}};
+    j["search_rows"] = r.report.search_rows;
     j["encoding"] = model::to_string(m.encoding);
     j["kernel"] = o.training.kernel;
     j["length_scales"] = std::vector<double>(m.length_scales.data(), m.length_scales.data() + m.length_scales.size());
@@ -132,6 +157,14 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     } else {
       t += fmt::format("trained on {} samples, none held out ({:.1f} s)\n", train_set.size(), seconds);
     }
+    const training::ModelSelection& selection = r.report.selection;
+    t += fmt::format("  model: {}\n", selection.reason);
+    t += fmt::format("  image {} bytes (budget {}), Cortex-M7 forward cycle about {} instructions (budget {})\n",
+                     selection.image_bytes, options.board.flash_budget_bytes, selection.forward_cycle_instructions,
+                     options.board.forward_cycle_instructions);
+    if (r.report.search_rows < train_set.size()) {
+      t += fmt::format("  hyperparameters searched on {} of the {} rows\n", r.report.search_rows, train_set.size());
+    }
     t += fmt::format("  encoding {}, kernel {} squared exponential, hyperparameters shared by the 6 outputs\n",
                      model::to_string(m.encoding), o.training.kernel);
     t += "  length scales (normalised inputs):";
@@ -151,11 +184,8 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     } else {
       t += "no held-out figures (--holdout 0): measure the image with cdcr eval on data collected apart\n";
     }
-    if (r.fitted_rows == all.size() && validation_set.size() > 0 && o.validation_path.empty()) {
+    if (validation_set.size() > 0 && o.validation_path.empty()) {
       t += fmt::format("exported model fitted on all {} rows, the held-out ones included\n", r.fitted_rows);
-    } else if (r.fitted_rows < all.size()) {
-      t += fmt::format("exported model fitted on the {} training rows: all {} exceed the image capacity of {}\n",
-                       r.fitted_rows, all.size(), capacity);
     }
     t += fmt::format("float32 fidelity on the {} (image path vs double trainer; target 0.01 mm, 0.001 deg):\n",
                      validation_set.size() > 0 ? "held-out samples" : "fitted rows");
@@ -186,6 +216,16 @@ void register_train_command(CLI::App& app, CommandOutput& output) {
                       "Samples of --data held out to validate when --validation is not given (0: none); the exported "
                       "model is then fitted on every row")
       ->capture_default_str();
+  command->add_option("--model", o->model,
+                      "exact: one point per row; sparse: M inducing points; auto: exact while its points fit the "
+                      "board (capacity, --flash-budget, the Cortex-M7 forward cycle), else sparse")
+      ->check(CLI::IsMember({"auto", "exact", "sparse"}))
+      ->capture_default_str();
+  command->add_option("--inducing", o->inducing, "Inducing points M of a sparse model (0: the most that fit the board)")
+      ->capture_default_str();
+  command->add_option("--flash-budget", o->flash_budget, "Largest image, in bytes (suffixes K, KiB, M accepted)")
+      ->transform(CLI::AsSizeValue(false))
+      ->default_str("96KiB");
   add_geometry_options(*command, o->geometry, "Number of segments (default: from the dataset's cable columns)");
   add_training_flags(*command, o->training);
   command->add_flag("--json", o->json, "Print one JSON object");

@@ -62,7 +62,16 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
                               const TrainingOptions& options, std::uint64_t dataset_hash,
                               std::int64_t created_unix_s) {
   ExportResult r;
-  const TrainedModel searched = train(train_set, geometry, options, &r.report);
+  // The shipped model's kind and size are those for the rows it is fitted
+  // on; the search's model on fewer rows is of the same kind.
+  const ModelSelection shipped =
+      select_model(fitted_set.size(), static_cast<int>(fitted_set.inputs.cols()), geometry.segment_count,
+                   options.model, options.inducing_points, options.board);
+  TrainingOptions search_options = options;
+  search_options.model = shipped.kind == ModelKind::exact ? ModelChoice::exact : ModelChoice::sparse;
+  search_options.inducing_points = shipped.kind == ModelKind::exact ? 0 : std::min(shipped.points, train_set.size());
+  const TrainedModel searched = train(train_set, geometry, search_options, &r.report);
+  r.report.selection = shipped;
   if (validation_set.size() > 0) {
     const Eigen::MatrixXd predicted = predict_error_twists(searched, validation_set.bends);
     r.validation = evaluate(validation_set, predicted);
@@ -74,7 +83,7 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
         firmware_poses(parsed(image), validation_set.cables_mm, FirmwareAccumulator::float64));
   }
 
-  r.model = same_rows(fitted_set, train_set) ? searched : refit(searched, fitted_set);
+  r.model = same_rows(fitted_set, train_set) ? searched : refit(searched, shipped.kind, fitted_set);
   r.fitted_rows = fitted_set.size();
   r.model.dataset_hash = dataset_hash;
   r.model.created_unix_s = created_unix_s;

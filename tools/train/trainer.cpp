@@ -1,6 +1,11 @@
 #include "trainer.hpp"
 
+#include <algorithm>
+#include <numeric>
+#include <random>
 #include <stdexcept>
+
+#include "sparse_gp.hpp"
 
 namespace cdcr::training {
 
@@ -45,43 +50,120 @@ Eigen::MatrixXd normalise(const Eigen::MatrixXd& m, const Eigen::VectorXd& mean,
   return (m.rowwise() - mean.transpose()).array().rowwise() / scale.transpose().array();
 }
 
+namespace {
+
+KernelHyperparameters shared_hyperparameters(const TrainedModel& model) {
+  KernelHyperparameters h;
+  h.length_scales = model.length_scales;
+  h.signal_variance = model.signal_variance[0];
+  h.noise_variance = model.noise_variance[0];
+  return h;
+}
+
+// Normalised rows back to the model's input units, the way the image
+// stores its points.
+Eigen::MatrixXd denormalised(const Eigen::MatrixXd& m, const Eigen::VectorXd& mean, const Eigen::VectorXd& scale) {
+  return (m.array().rowwise() * scale.transpose().array()).rowwise() + mean.transpose().array();
+}
+
+// At most `count` rows of x and y, drawn at random without repetition.
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> random_rows(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
+                                                        int count, std::uint64_t seed) {
+  if (count >= x.rows()) return {x, y};
+  std::vector<int> order(static_cast<std::size_t>(x.rows()));
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 rng(seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  order.resize(static_cast<std::size_t>(count));
+  std::sort(order.begin(), order.end());
+  return {x(order, Eigen::all), y(order, Eigen::all)};
+}
+
+}  // namespace
+
+Eigen::MatrixXd inducing_inputs(const Eigen::MatrixXd& x, int m, int iterations, std::uint64_t seed) {
+  Eigen::MatrixXd z = initial_inducing_inputs(x, m, seed);
+  for (int iteration = 0; iteration < iterations; ++iteration) {
+    // Squared distances less each row's own |x|^2, which does not change
+    // which centre is nearest.
+    Eigen::MatrixXd distance = -2.0 * x * z.transpose();
+    distance.rowwise() += z.rowwise().squaredNorm().transpose();
+    Eigen::MatrixXd sums = Eigen::MatrixXd::Zero(m, x.cols());
+    Eigen::VectorXi counts = Eigen::VectorXi::Zero(m);
+    for (Eigen::Index i = 0; i < x.rows(); ++i) {
+      Eigen::Index nearest = 0;
+      distance.row(i).minCoeff(&nearest);
+      sums.row(nearest) += x.row(i);
+      ++counts[nearest];
+    }
+    for (int k = 0; k < m; ++k) {
+      if (counts[k] > 0) z.row(k) = sums.row(k) / counts[k];
+    }
+  }
+  return z;
+}
+
 TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
                    const TrainingOptions& options, TrainingReport* report) {
   if (options.sharing != HyperparameterSharing::shared) {
     throw std::invalid_argument("only shared hyperparameters can be exported to a flash image");
   }
   const Normalisation n = normalisation_of(set);
+  const ModelSelection selection =
+      select_model(set.size(), static_cast<int>(set.inputs.cols()), geometry.segment_count, options.model,
+                   options.inducing_points, options.board);
   const Eigen::MatrixXd x = normalise(set.inputs, n.input_mean, n.input_scale);
   const Eigen::MatrixXd y = normalise(set.error_twists, n.output_mean, n.output_scale);
-  const SearchResult search =
-      maximise_likelihood(x, y, default_initial_hyperparameters(static_cast<int>(x.cols())), options.search);
-  const GaussianProcess gp = GaussianProcess::fit(x, y, search.hyperparameters);
+  const int search_rows = selection.kind == ModelKind::exact
+                              ? set.size()
+                              : std::min(set.size(), std::max(2, options.sparse_search_rows));
+  const auto [search_x, search_y] = random_rows(x, y, search_rows, options.search.seed);
+  const SearchResult search = maximise_likelihood(
+      search_x, search_y, default_initial_hyperparameters(static_cast<int>(x.cols())), options.search);
 
   TrainedModel m = packaged(set, geometry, options, n);
   m.length_scales = search.hyperparameters.length_scales;
   m.signal_variance.setConstant(search.hyperparameters.signal_variance);
   m.noise_variance.setConstant(search.hyperparameters.noise_variance);
-  m.alpha = gp.alpha;
+  double jitter = 0.0;
+  if (selection.kind == ModelKind::exact) {
+    const GaussianProcess gp = GaussianProcess::fit(x, y, search.hyperparameters);
+    m.alpha = gp.alpha;
+    jitter = gp.jitter;
+  } else {
+    SparseParameters p;
+    p.hyperparameters = search.hyperparameters;
+    p.inducing = inducing_inputs(x, selection.points, options.inducing_iterations, options.search.seed);
+    const SparseGaussianProcess gp = SparseGaussianProcess::fit(x, y, p);
+    m.inputs = denormalised(p.inducing, n.input_mean, n.input_scale);
+    m.alpha = gp.beta;
+  }
   if (report != nullptr) {
+    report->selection = selection;
     report->log_marginal_likelihood = search.log_marginal_likelihood;
     report->likelihood_evaluations = search.likelihood_evaluations;
     report->optimisations_completed = search.optimisations_completed;
-    report->jitter = gp.jitter;
+    report->search_rows = search_rows;
+    report->jitter = jitter;
   }
   return m;
 }
 
-TrainedModel refit(const TrainedModel& model, const TrainingSet& set) {
+TrainedModel refit(const TrainedModel& model, ModelKind kind, const TrainingSet& set) {
   if (set.size() < 2) throw std::invalid_argument("training needs at least two samples");
-  KernelHyperparameters h;
-  h.length_scales = model.length_scales;
-  h.signal_variance = model.signal_variance[0];
-  h.noise_variance = model.noise_variance[0];
+  const KernelHyperparameters h = shared_hyperparameters(model);
   const Eigen::MatrixXd x = normalise(set.inputs, model.input_mean, model.input_scale);
   const Eigen::MatrixXd y = normalise(set.error_twists, model.output_mean, model.output_scale);
   TrainedModel refitted = model;
-  refitted.inputs = set.inputs;
-  refitted.alpha = GaussianProcess::fit(x, y, h).alpha;
+  if (kind == ModelKind::exact) {
+    refitted.inputs = set.inputs;
+    refitted.alpha = GaussianProcess::fit(x, y, h).alpha;
+  } else {
+    SparseParameters p;
+    p.hyperparameters = h;
+    p.inducing = normalise(model.inputs, model.input_mean, model.input_scale);
+    refitted.alpha = SparseGaussianProcess::fit(x, y, p).beta;
+  }
   return refitted;
 }
 

@@ -10,6 +10,7 @@
 #include "cdcr/model/input_encoding.hpp"
 #include "gaussian_process.hpp"
 #include "hyperparameter_search.hpp"
+#include "model_selection.hpp"
 #include "trained_model.hpp"
 #include "training_set.hpp"
 
@@ -26,12 +27,25 @@ struct TrainingOptions {
   model::InputEncoding encoding = model::InputEncoding::bend_vector;
   HyperparameterSharing sharing = HyperparameterSharing::shared;
   SearchOptions search;
+  // Exact or sparse, and M: see select_model().
+  ModelChoice model = ModelChoice::automatic;
+  int inducing_points = 0;
+  BoardLimits board;
+  // A sparse model's hyperparameters are those of the exact GP on at most
+  // this many of its rows, drawn at random: the exact search costs O(N^3)
+  // per evaluation, and a thousand rows pin the kernel's shape down.
+  int sparse_search_rows = 1000;
+  // Lloyd iterations that move the inducing inputs from their k-means++
+  // seeds to the centres of the rows nearest each.
+  int inducing_iterations = 10;
 };
 
 struct TrainingReport {
-  double log_marginal_likelihood = 0.0;  // summed over outputs, normalised units
+  ModelSelection selection;
+  double log_marginal_likelihood = 0.0;  // summed over outputs, normalised units; the search's rows
   int likelihood_evaluations = 0;
   int optimisations_completed = 0;
+  int search_rows = 0;                   // rows the hyperparameter search saw
   double jitter = 0.0;
 };
 
@@ -44,15 +58,22 @@ struct Normalisation {
 Normalisation normalisation_of(const TrainingSet& set);
 Eigen::MatrixXd normalise(const Eigen::MatrixXd& m, const Eigen::VectorXd& mean, const Eigen::VectorXd& scale);
 
-// Shared hyperparameters only (throws std::invalid_argument otherwise).
+// Shared hyperparameters only (throws std::invalid_argument otherwise). The
+// model's kind and points follow select_model() for the rows of `set`.
 TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
                    const TrainingOptions& options, TrainingReport* report = nullptr);
 
 // The model fitted again on `set`, with the hyperparameters and the
 // normalisation it has (they were found on other rows): a search finds the
 // hyperparameters on the training rows, and once held-out rows have
-// measured the result, the exported model is fitted on every row.
-TrainedModel refit(const TrainedModel& model, const TrainingSet& set);
+// measured the result, the exported model is fitted on every row. An exact
+// model gets one point per row of `set`; a sparse one keeps its inducing
+// inputs and gets new weights.
+TrainedModel refit(const TrainedModel& model, ModelKind kind, const TrainingSet& set);
+
+// M inducing inputs for normalised rows x: k-means++ seeds, then
+// `iterations` of Lloyd's algorithm (a centre with no rows stays put).
+Eigen::MatrixXd inducing_inputs(const Eigen::MatrixXd& x, int m, int iterations, std::uint64_t seed);
 
 // Double-precision error twists (rows, (v, omega)) for stacked bend vectors.
 Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends);

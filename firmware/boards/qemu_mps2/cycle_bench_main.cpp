@@ -21,6 +21,7 @@
 #include <cdcr/cortexm/semihosting.hpp>
 #include <cdcr/cortexm/stack_watermark.hpp>
 #include <cdcr/firmware/runtime.hpp>
+#include <cdcr/model/work_costs.hpp>
 
 #include "board.hpp"
 #include "golden_check.hpp"
@@ -32,6 +33,11 @@ namespace console = cdcr::cortexm;
 namespace model = cdcr::model;
 
 constexpr int kIcountShift = 10;
+#if defined(__ARM_FP) && !(__ARM_FP & 0x8)
+constexpr model::ForwardCycleInstructions kForwardCycle = model::kCortexM4fForwardCycle;
+#else
+constexpr model::ForwardCycleInstructions kForwardCycle = model::kCortexM7ForwardCycle;
+#endif
 // A period far longer than anything measured keeps SysTick exceptions (and
 // their instructions) out of the counts.
 constexpr std::int64_t kCountingPeriodNs = 600'000'000;
@@ -259,6 +265,17 @@ int main() {
     console::console_write(" mm\n");
   }
   report("forward_cycle", forward_cycle, kCases);
+  // The figure the trainer sizes models by must hold on the board.
+  const std::uint32_t forward_limit = kForwardCycle.for_points(image.training_points);
+  const std::uint32_t forward_worst = *std::max_element(forward_cycle, forward_cycle + kCases);
+  if (forward_worst > forward_limit) {
+    console::console_write("FAIL: a forward cycle took ");
+    console::console_write_int(static_cast<std::int32_t>(forward_worst));
+    console::console_write(" instructions, above the ");
+    console::console_write_int(static_cast<std::int32_t>(forward_limit));
+    console::console_write(" that model::ForwardCycleInstructions predicts for this model\n");
+    ok = false;
+  }
   report("compensated_forward", compensated, kCases);
   report("gp_predict", gp, kCases);
   report("nominal_forward", nominal, kCases);

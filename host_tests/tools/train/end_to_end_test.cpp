@@ -5,6 +5,7 @@
 // between the measured poses and the image (the error twists, the
 // compensation's exponential, the export) leaves the compensated error at or
 // above the nominal model's.
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <sstream>
@@ -177,3 +178,76 @@ TEST(TrainEndToEnd, DegenerateDatasetsGiveAModelOrAClearError) {
 }
 
 }  // namespace
+
+namespace {
+
+struct Compensated {
+  double position_mm;
+  double orientation_deg;
+  double initial_mm;
+};
+
+Compensated evaluate_image(const std::string& image, const std::string& data) {
+  const CliRun run = run_cdcr("eval --model " + image + " --data " + data + " --json");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  return {j.at("compensated").at("position_mm").get<double>(), j.at("compensated").at("orientation_deg").get<double>(),
+          j.at("initial").at("position_mm").get<double>()};
+}
+
+}  // namespace
+
+// Under a flash budget too small for one point per row, `cdcr train` ships a
+// sparse GP with the most inducing points that fit, and it compensates on
+// an independent test set nearly as well as the exact GP on every row.
+TEST(TrainEndToEnd, TooManyRowsForTheBoardGiveASparseModel) {
+  const std::string dir = testing::TempDir();
+  const std::string data = "'" + dir + "sparse_train.csv'";
+  const std::string test = "'" + dir + "sparse_test.csv'";
+  const std::string sparse_image = "'" + dir + "sparse.img'";
+  const std::string exact_image = "'" + dir + "sparse_exact.img'";
+  ASSERT_EQ(run_cdcr("simulate --samples 600 --seed 5 --out " + data).exit_code, 0);
+  ASSERT_EQ(run_cdcr("simulate --samples 200 --seed 5 --session 2 --out " + test).exit_code, 0);
+
+  CliRun run = run_cdcr("train --data " + data + " --out " + sparse_image +
+                        " --holdout 0 --restarts 0 --flash-budget 12KiB --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json trained = nlohmann::json::parse(run.out);
+  const nlohmann::json& chosen = trained.at("model");
+  EXPECT_EQ(chosen.at("kind").get<std::string>(), "sparse") << run.out;
+  const int points = chosen.at("points").get<int>();
+  EXPECT_GT(points, 100);
+  EXPECT_LT(points, 300);
+  EXPECT_LE(chosen.at("image_bytes").get<int>(), 12 * 1024);
+  EXPECT_EQ(trained.at("fitted_rows").get<int>(), 600);
+  EXPECT_LE(trained.at("image").at("bytes").get<int>(), 12 * 1024);
+  run = run_cdcr("inspect " + sparse_image + " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(nlohmann::json::parse(run.out).at("dims").at("training_points").get<int>(), points) << run.out;
+
+  run = run_cdcr("train --data " + data + " --out " + exact_image + " --holdout 0 --restarts 0 --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(nlohmann::json::parse(run.out).at("model").at("kind").get<std::string>(), "exact");
+
+  const Compensated sparse = evaluate_image(sparse_image, test);
+  const Compensated exact = evaluate_image(exact_image, test);
+  EXPECT_LT(sparse.position_mm, 0.25 * sparse.initial_mm);
+  EXPECT_LT(sparse.position_mm, 1.3 * exact.position_mm) << "sparse " << sparse.position_mm << " mm, exact "
+                                                          << exact.position_mm << " mm";
+  EXPECT_LT(sparse.orientation_deg, 1.3 * exact.orientation_deg);
+}
+
+TEST(TrainEndToEnd, ModelOptionsOutsideTheBoardAreOneLineErrors) {
+  const std::string dir = testing::TempDir();
+  const std::string data = "'" + dir + "model_options.csv'";
+  const std::string image = "'" + dir + "model_options.img'";
+  ASSERT_EQ(run_cdcr("simulate --samples 40 --seed 3 --out " + data).exit_code, 0);
+  for (const std::string& options : {std::string("--model exact --flash-budget 1KiB"),
+                                     std::string("--model sparse --inducing 41"), std::string("--inducing -1"),
+                                     std::string("--model exact --inducing 5"), std::string("--flash-budget lots"),
+                                     std::string("--model approximate")}) {
+    const CliRun run = run_cdcr("train --data " + data + " --out " + image + " --restarts 0 " + options);
+    EXPECT_NE(run.exit_code, 0) << options;
+    EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << options << ": " << run.err;
+  }
+}

@@ -35,4 +35,25 @@ struct WorkCosts {
   std::uint32_t cycle = 2000;
 };
 
+// A forward cycle's instructions on a board as a function of the model's
+// points: the GP mean's loop per point, and the rest of the cycle (cable
+// frames, joints, nominal kinematics, the exponential, the pose frames).
+// qemu.cycle_bench_<board> fails when a measured forward cycle exceeds it;
+// the trainer sizes models with it.
+struct ForwardCycleInstructions {
+  std::uint32_t fixed;
+  std::uint32_t per_point;
+
+  constexpr std::uint32_t for_points(std::uint32_t points) const { return fixed + per_point * points; }
+  // The most points whose forward cycle fits `budget` (0 if none does).
+  constexpr std::uint32_t points_within(std::uint32_t budget) const {
+    return budget > fixed ? (budget - fixed) / per_point : 0;
+  }
+};
+
+// Measured: 37,729 instructions with the 700-point demo model on the M7,
+// 50,460 on the M4F; the fixed parts are rounded up.
+inline constexpr ForwardCycleInstructions kCortexM7ForwardCycle{5'000, 47};
+inline constexpr ForwardCycleInstructions kCortexM4fForwardCycle{12'800, 54};
+
 }  // namespace cdcr::model
