@@ -68,6 +68,12 @@ sim::SimulatorConfig make_config(const SimulateCommandOptions& options, const mo
   config.gravity.enabled = !options.no_gravity;
   config.repeatability.enabled = !options.no_repeatability;
   config.mocap_noise.enabled = !options.no_mocap_noise;
+  if (!std::isfinite(options.noise_scale) || options.noise_scale < 0.0) {
+    throw InputError(fmt::format("--noise-scale must be a finite number, zero or more (got {})", options.noise_scale));
+  }
+  config.repeatability.bend_sigma_rad *= options.noise_scale;
+  config.mocap_noise.position_sigma_mm *= options.noise_scale;
+  config.mocap_noise.rotation_sigma_rad *= options.noise_scale;
   return config;
 }
 
@@ -127,6 +133,9 @@ void register_simulate_command(CLI::App& app, CommandOutput& output) {
   command->add_flag("--no-gravity", options->no_gravity, "Without gravity sag");
   command->add_flag("--no-repeatability", options->no_repeatability, "Without repeatability noise");
   command->add_flag("--no-mocap-noise", options->no_mocap_noise, "Without motion-capture noise");
+  command->add_option("--noise-scale", options->noise_scale,
+                      "Scale of the per-sample noise (repeatability and motion capture); 0.25 is a low-noise robot")
+      ->capture_default_str();
   command->add_flag("--json", options->json, "Print one JSON object instead of the summary");
   command->callback([options, &output] { output = run_simulate(*options); });
 }

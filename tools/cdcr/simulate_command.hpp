@@ -35,6 +35,7 @@ struct SimulateCommandOptions {
   bool no_gravity = false;
   bool no_repeatability = false;
   bool no_mocap_noise = false;
+  double noise_scale = 1.0;
   bool json = false;
 };
 

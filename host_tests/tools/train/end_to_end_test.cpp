@@ -251,3 +251,25 @@ TEST(TrainEndToEnd, ModelOptionsOutsideTheBoardAreOneLineErrors) {
     EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << options << ": " << run.err;
   }
 }
+
+// --noise-scale scales the per-sample noise and nothing else: the same robot
+// and samples with a quarter of the noise have a quarter of the floor and
+// the same initial error to within that noise.
+TEST(TrainEndToEnd, TheNoiseScaleScalesTheFloor) {
+  const auto simulate = [](const std::string& scale) {
+    const CliRun run = run_cdcr("simulate --samples 300 --seed 4 --json --noise-scale " + scale);
+    EXPECT_EQ(run.exit_code, 0) << run.err;
+    return nlohmann::json::parse(run.out);
+  };
+  const nlohmann::json full = simulate("1");
+  const nlohmann::json quarter = simulate("0.25");
+  const nlohmann::json none = simulate("0");
+  const double floor = full.at("noise_floor").at("position_mm").get<double>();
+  EXPECT_GT(floor, 1.0);
+  EXPECT_NEAR(quarter.at("noise_floor").at("position_mm").get<double>(), 0.25 * floor, 0.02 * floor);
+  EXPECT_NEAR(quarter.at("noise_floor").at("orientation_deg").get<double>(),
+              0.25 * full.at("noise_floor").at("orientation_deg").get<double>(), 0.01);
+  EXPECT_EQ(none.at("noise_floor").at("position_mm").get<double>(), 0.0);
+  EXPECT_NEAR(quarter.at("initial").at("position_mm").get<double>(), full.at("initial").at("position_mm").get<double>(),
+              floor);
+}
