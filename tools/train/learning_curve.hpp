@@ -14,6 +14,7 @@ namespace cdcr::training {
 
 struct LearningCurvePoint {
   int training_samples = 0;
+  int model_points = 0;  // N for the exact GP, M for the sparse one
   MeanErrors compensated;
   double seconds = 0.0;
 };
@@ -28,6 +29,18 @@ struct LearningCurve {
 // larger N only ever adds samples.
 LearningCurve learning_curve(const TrainingSet& all, const std::vector<int>& sizes, int test_count,
                              std::uint64_t seed, const TrainingOptions& options,
+                             const model::RobotGeometry<double>& geometry);
+
+// The same on a test set collected apart: every row of `pool` may train. A
+// sparse model (options.model) gets min(options.inducing_points, N) points.
+LearningCurve learning_curve(const TrainingSet& pool, const TrainingSet& test, const std::vector<int>& sizes,
+                             std::uint64_t seed, const TrainingOptions& options,
+                             const model::RobotGeometry<double>& geometry);
+
+// A sparse GP on the first `samples` of the shuffled pool with each of
+// `inducing_sizes` inducing points: the error against M at a fixed N.
+LearningCurve inducing_curve(const TrainingSet& pool, const TrainingSet& test, int samples,
+                             const std::vector<int>& inducing_sizes, std::uint64_t seed, TrainingOptions options,
                              const model::RobotGeometry<double>& geometry);
 
 }  // namespace cdcr::training

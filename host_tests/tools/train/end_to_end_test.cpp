@@ -273,3 +273,42 @@ TEST(TrainEndToEnd, TheNoiseScaleScalesTheFloor) {
   EXPECT_NEAR(quarter.at("initial").at("position_mm").get<double>(), full.at("initial").at("position_mm").get<double>(),
               floor);
 }
+
+// The learning curve against N for the exact and the sparse GP, and against
+// M at a fixed N, on a test set collected apart. With as many inducing
+// points as rows the sparse GP's centres are the rows themselves and it
+// must reproduce the exact GP.
+TEST(TrainEndToEnd, LearningCurvesAgainstRowsAndInducingPoints) {
+  const std::string dir = testing::TempDir();
+  const std::string data = "'" + dir + "curve_train.csv'";
+  const std::string test = "'" + dir + "curve_test.csv'";
+  const std::string prefix = dir + "curve";
+  ASSERT_EQ(run_cdcr("simulate --samples 120 --seed 6 --out " + data).exit_code, 0);
+  ASSERT_EQ(run_cdcr("simulate --samples 100 --seed 6 --session 3 --out " + test).exit_code, 0);
+  const CliRun run = run_cdcr("learning-curve --data " + data + " --test-data " + test +
+                              " --sizes 40,120 --encodings bend-vector --models exact,sparse --inducing 40"
+                              " --inducing-sizes 5,40 --restarts 0 --json --plot-prefix '" + prefix + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json j = nlohmann::json::parse(run.out);
+  EXPECT_EQ(j.at("test_samples").get<int>(), 100);
+  const nlohmann::json& exact = j.at("curves").at("exact");
+  const nlohmann::json& sparse = j.at("curves").at("sparse, M = 40");
+  ASSERT_EQ(exact.size(), 2u);
+  ASSERT_EQ(sparse.size(), 2u);
+  EXPECT_EQ(exact[1].at("model_points").get<int>(), 120);
+  EXPECT_EQ(sparse[0].at("model_points").get<int>(), 40);
+  EXPECT_EQ(sparse[1].at("model_points").get<int>(), 40);
+  // N = 40 = M: the same model.
+  EXPECT_NEAR(sparse[0].at("position_mm").get<double>(), exact[0].at("position_mm").get<double>(), 1e-3);
+  EXPECT_NEAR(sparse[0].at("orientation_deg").get<double>(), exact[0].at("orientation_deg").get<double>(), 1e-4);
+  // Fewer inducing points than rows lose accuracy; more rows gain it.
+  const nlohmann::json& against_m = j.at("inducing_curves").at("sparse, N = 120");
+  ASSERT_EQ(against_m.size(), 2u);
+  EXPECT_EQ(against_m[0].at("model_points").get<int>(), 5);
+  EXPECT_GT(against_m[0].at("position_mm").get<double>(), against_m[1].at("position_mm").get<double>());
+  EXPECT_LT(exact[1].at("position_mm").get<double>(), exact[0].at("position_mm").get<double>());
+  for (const char* plot : {"-position.svg", "-orientation.svg", "-time.svg", "-inducing-position.svg"}) {
+    std::ifstream file(prefix + plot);
+    EXPECT_TRUE(file.good()) << plot;
+  }
+}
