@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -13,6 +14,7 @@
 #include "dataset_input.hpp"
 #include "export/binary_file.hpp"
 #include "json_output.hpp"
+#include "train/calibration.hpp"
 #include "train/pipeline.hpp"
 #include "training_options.hpp"
 
@@ -29,6 +31,7 @@ struct TrainCommandOptions {
   std::uint64_t flash_budget = 96 * 1024;
   GeometryOptions geometry;
   TrainingFlags training;
+  bool calibrate = false;
   bool json = false;
 };
 
@@ -56,31 +59,52 @@ CommandOutput run_train(const TrainCommandOptions& o) {
   }
   options.board.flash_budget_bytes = static_cast<std::uint32_t>(o.flash_budget);
   const dataset::Dataset data = load_dataset(o.data_path, true);
-  const model::RobotGeometry<double> geometry = geometry_for(data, o.geometry);
+  const model::RobotGeometry<double> design = geometry_for(data, o.geometry);
 
-  training::TrainingSet all;
-  training::TrainingSet train_set;
-  training::TrainingSet validation_set;
-  try {
-    all = training::make_training_set(data, geometry, options.encoding);
-    if (!o.validation_path.empty()) {
-      train_set = all;
-      validation_set = training::make_training_set(load_dataset(o.validation_path, true), geometry, options.encoding);
-    } else if (o.holdout == 0) {
-      train_set = all;
-    } else {
-      if (o.holdout < 0) throw InputError(fmt::format("--holdout must not be negative (got {})", o.holdout));
-      if (all.size() - o.holdout < 2) {
-        throw InputError(fmt::format("--holdout {} leaves {} of the {} samples to train on; training needs at least 2",
-                                     o.holdout, std::max(0, all.size() - o.holdout), all.size()));
+  // The rows, split for validation, with a given geometry: the design's,
+  // then the calibrated one's (the split depends only on the row count).
+  struct Sets {
+    training::TrainingSet all, train, validation;
+  };
+  const auto build_sets = [&](const model::RobotGeometry<double>& g) {
+    Sets sets;
+    try {
+      sets.all = training::make_training_set(data, g, options.encoding);
+      if (!o.validation_path.empty()) {
+        sets.train = sets.all;
+        sets.validation = training::make_training_set(load_dataset(o.validation_path, true), g, options.encoding);
+      } else if (o.holdout == 0) {
+        sets.train = sets.all;
+      } else {
+        if (o.holdout < 0) throw InputError(fmt::format("--holdout must not be negative (got {})", o.holdout));
+        if (sets.all.size() - o.holdout < 2) {
+          throw InputError(fmt::format("--holdout {} leaves {} of the {} samples to train on; training needs at least 2",
+                                       o.holdout, std::max(0, sets.all.size() - o.holdout), sets.all.size()));
+        }
+        const training::Split split = training::random_split(sets.all.size(), o.holdout, o.training.seed);
+        sets.train = sets.all.subset(split.train);
+        sets.validation = sets.all.subset(split.test);
       }
-      const training::Split split = training::random_split(all.size(), o.holdout, o.training.seed);
-      train_set = all.subset(split.train);
-      validation_set = all.subset(split.test);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
     }
-  } catch (const std::invalid_argument& e) {
-    throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
+    return sets;
+  };
+  Sets sets = build_sets(design);
+  std::optional<training::Calibration> calibration;
+  model::RobotGeometry<double> geometry = design;
+  if (o.calibrate && sets.train.size() >= 2) {
+    try {
+      calibration = training::calibrate_geometry(sets.train, design);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
+    }
+    geometry = calibration->geometry;
+    sets = build_sets(geometry);
   }
+  const training::TrainingSet& all = sets.all;
+  const training::TrainingSet& train_set = sets.train;
+  const training::TrainingSet& validation_set = sets.validation;
   if (train_set.size() < 2) {
     throw InputError(fmt::format("{}: {} sample{}; training needs at least 2", o.data_path, train_set.size(),
                                  train_set.size() == 1 ? "" : "s"));
@@ -122,6 +146,19 @@ CommandOutput run_train(const TrainCommandOptions& o) {
                   {"forward_cycle_instructions_m7", selection.forward_cycle_instructions},
                   {"reason", selection.reason}};
     j["search_rows"] = r.report.search_rows;
+    if (calibration) {
+      Json segments = Json::array();
+      for (int i = 0; i < geometry.segment_count; ++i) {
+        segments.push_back({{"backbone_length_mm", geometry.segments[i].backbone_length_mm},
+                            {"anchor_radius_mm", geometry.segments[i].anchor_radius_mm}});
+      }
+      j["calibration"] = {{"segments", segments},
+                          {"nominal_before", errors_json(calibration->before)},
+                          {"nominal_after", errors_json(calibration->after)},
+                          {"evaluations", calibration->evaluations}};
+    } else {
+      j["calibration"] = nullptr;
+    }
     j["encoding"] = model::to_string(m.encoding);
     j["kernel"] = o.training.kernel;
     j["length_scales"] = std::vector<double>(m.length_scales.data(), m.length_scales.data() + m.length_scales.size());
@@ -164,6 +201,17 @@ CommandOutput run_train(const TrainCommandOptions& o) {
                      options.board.forward_cycle_instructions);
     if (r.report.search_rows < train_set.size()) {
       t += fmt::format("  hyperparameters searched on {} of the {} rows\n", r.report.search_rows, train_set.size());
+    }
+    if (calibration) {
+      t += fmt::format("  geometry calibrated on the {} training rows: nominal model {:.3f} mm, {:.3f} deg -> {:.3f} mm, "
+                       "{:.3f} deg\n    (L, r) per segment in mm:",
+                       train_set.size(), calibration->before.position_mm, calibration->before.orientation_deg,
+                       calibration->after.position_mm, calibration->after.orientation_deg);
+      for (int i = 0; i < geometry.segment_count; ++i) {
+        t += fmt::format(" ({:.2f}, {:.2f})", geometry.segments[i].backbone_length_mm,
+                         geometry.segments[i].anchor_radius_mm);
+      }
+      t += "\n";
     }
     t += fmt::format("  encoding {}, kernel {} squared exponential, hyperparameters shared by the 6 outputs\n",
                      model::to_string(m.encoding), o.training.kernel);
@@ -226,6 +274,9 @@ void register_train_command(CLI::App& app, CommandOutput& output) {
   command->add_option("--flash-budget", o->flash_budget, "Largest image, in bytes (suffixes K, KiB, M accepted)")
       ->transform(CLI::AsSizeValue(false))
       ->default_str("96KiB");
+  command->add_flag("--calibrate", o->calibrate,
+                    "Identify each segment's backbone length and anchor radius (its bending gain) from the data "
+                    "before the GP; the image carries the calibrated geometry");
   add_geometry_options(*command, o->geometry, "Number of segments (default: from the dataset's cable columns)");
   add_training_flags(*command, o->training);
   command->add_flag("--json", o->json, "Print one JSON object");

@@ -312,3 +312,30 @@ TEST(TrainEndToEnd, LearningCurvesAgainstRowsAndInducingPoints) {
     EXPECT_TRUE(file.good()) << plot;
   }
 }
+
+// --calibrate: the image carries the identified geometry, which explains
+// more of the measured error than the design's.
+TEST(TrainEndToEnd, TheCalibratedGeometryGoesIntoTheImage) {
+  const std::string dir = testing::TempDir();
+  const std::string data = "'" + dir + "calibrate.csv'";
+  const std::string image = "'" + dir + "calibrate.img'";
+  ASSERT_EQ(run_cdcr("simulate --samples 150 --seed 8 --out " + data).exit_code, 0);
+  CliRun run = run_cdcr("train --data " + data + " --out " + image + " --calibrate --restarts 0 --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json trained = nlohmann::json::parse(run.out);
+  const nlohmann::json& calibration = trained.at("calibration");
+  ASSERT_FALSE(calibration.is_null());
+  EXPECT_LT(calibration.at("nominal_after").at("position_mm").get<double>(),
+            calibration.at("nominal_before").at("position_mm").get<double>());
+  run = run_cdcr("inspect " + image + " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json geometry = nlohmann::json::parse(run.out).at("geometry");
+  const nlohmann::json& segments = calibration.at("segments");
+  ASSERT_EQ(geometry.size(), segments.size());
+  for (std::size_t s = 0; s < segments.size(); ++s) {
+    EXPECT_NEAR(geometry[s].at("backbone_length_mm").get<double>(),
+                segments[s].at("backbone_length_mm").get<double>(), 1e-3);
+    EXPECT_NEAR(geometry[s].at("anchor_radius_mm").get<double>(), segments[s].at("anchor_radius_mm").get<double>(),
+                1e-3);
+  }
+}
