@@ -5,6 +5,10 @@
 #   paper      the default workspace (bends up to 0.2 rad), 700 rows, 400 test rows;
 #   low-noise  the same with the per-sample noise at a quarter (--noise-scale 0.25);
 #   wide       bends up to 0.7 rad, 4,000 rows, 200 test rows.
+# Each with the design geometry and with --calibrate.
+# "float32 max" is the largest difference between the image's float32 path
+# (double accumulators, as on the M7 and the host) and the double-precision
+# trainer on the held-out rows.
 # The floor is the test set's measured pose against its noise-free pose
 # (`cdcr simulate` reports it). On the wide data, scikit-learn's exact GP on
 # the first 1,000 and 2,000 rows is timed in the same run, with the same
@@ -32,20 +36,29 @@ cmake --build "$build_dir" -j"$(nproc)" --target cdcr cdcr-bench-training >/dev/
 mkdir -p "$work_dir"
 cdcr=$build_dir/bin/cdcr
 
-run_case() {  # name, training rows, test rows, simulate options...
+simulate_case() {  # name, training rows, test rows, simulate options...
   local name=$1 rows=$2 test_rows=$3
   shift 3
   "$cdcr" simulate --samples "$rows" --seed 1 "$@" --out "$work_dir/$name-train.csv" --json >"$work_dir/$name-simulate.json"
   "$cdcr" simulate --samples "$test_rows" --seed 1 --session 1 "$@" --out "$work_dir/$name-test.csv" --json \
     >"$work_dir/$name-test-simulate.json"
-  echo "$name: training on $rows rows..." >&2
-  "$cdcr" train --data "$work_dir/$name-train.csv" --out "$work_dir/$name.img" --json >"$work_dir/$name-train.json"
-  "$cdcr" eval --model "$work_dir/$name.img" --data "$work_dir/$name-test.csv" --json >"$work_dir/$name-eval.json"
 }
 
-run_case paper 700 400
-run_case low-noise 700 400 --noise-scale 0.25
-run_case wide 4000 200 --workspace-theta-max 0.7
+train_case() {  # data name, result name, cdcr train options...
+  local name=$1 result=$2
+  shift 2
+  echo "$result: training..." >&2
+  "$cdcr" train --data "$work_dir/$name-train.csv" --out "$work_dir/$result.img" --json "$@" >"$work_dir/$result-train.json"
+  "$cdcr" eval --model "$work_dir/$result.img" --data "$work_dir/$name-test.csv" --json >"$work_dir/$result-eval.json"
+}
+
+simulate_case paper 700 400
+simulate_case low-noise 700 400 --noise-scale 0.25
+simulate_case wide 4000 200 --workspace-theta-max 0.7
+for name in paper low-noise wide; do
+  train_case "$name" "$name"
+  train_case "$name" "$name-calibrated" --calibrate
+done
 
 if [[ $skip_sklearn == 0 ]]; then
   for rows in 1000 2000; do
@@ -72,20 +85,22 @@ def load(name):
         return json.load(f)
 
 
-print("| data | rows | model | image bytes | M7 forward cycle | train s | test position mm (floor, ratio) "
-      "| test orientation deg (floor, ratio) |")
-print("|---|---:|---|---:|---:|---:|---:|---:|")
+print("| data | rows | geometry | model | image bytes | M7 forward cycle | train s "
+      "| test position mm (floor, ratio) | test orientation deg (floor, ratio) | float32 max mm |")
+print("|---|---:|---|---|---:|---:|---:|---:|---:|---:|")
 for name in ("paper", "low-noise", "wide"):
-    trained = load(f"{name}-train.json")
-    evaluated = load(f"{name}-eval.json")
     floor = load(f"{name}-test-simulate.json")["noise_floor"]
-    model = trained["model"]
-    position = evaluated["compensated"]["position_mm"]
-    orientation = evaluated["compensated"]["orientation_deg"]
-    print(f"| {name} | {trained['fitted_rows']} | {model['kind']}, {model['points']} points | {trained['image']['bytes']} "
-          f"| {model['forward_cycle_instructions_m7']} | {trained['seconds']:.1f} "
-          f"| {position:.3f} ({floor['position_mm']:.3f}, {position / floor['position_mm']:.3f}x) "
-          f"| {orientation:.4f} ({floor['orientation_deg']:.4f}, {orientation / floor['orientation_deg']:.3f}x) |")
+    for result, geometry in ((name, "design"), (f"{name}-calibrated", "calibrated")):
+        trained = load(f"{result}-train.json")
+        evaluated = load(f"{result}-eval.json")
+        model = trained["model"]
+        position = evaluated["compensated"]["position_mm"]
+        orientation = evaluated["compensated"]["orientation_deg"]
+        print(f"| {name} | {trained['fitted_rows']} | {geometry} | {model['kind']}, {model['points']} points "
+              f"| {trained['image']['bytes']} | {model['forward_cycle_instructions_m7']} | {trained['seconds']:.1f} "
+              f"| {position:.3f} ({floor['position_mm']:.3f}, {position / floor['position_mm']:.3f}x) "
+              f"| {orientation:.4f} ({floor['orientation_deg']:.4f}, {orientation / floor['orientation_deg']:.3f}x) "
+              f"| {trained['float32_fidelity']['double accumulators']['max_position_mm']:.4f} |")
 
 if not skip_sklearn:
     wide_seconds = load("wide-train.json")["seconds"]
