@@ -34,7 +34,7 @@ cmake --build "$build_dir" -j"$(nproc)" --target cdcr cdcr-bench-training
 mkdir -p "$work_dir"
 
 "$build_dir/bin/cdcr" simulate --samples 700 --seed 11 --out "$work_dir/data.csv" >/dev/null
-echo "cdcr (C++, Eigen + LBFGSpp): fitting..."
+echo "cdcr (C++, Eigen + OpenBLAS + LBFGSpp): fitting..."
 "$build_dir/bin/cdcr-bench-training" --data "$work_dir/data.csv" --samples 700 --restarts "$restarts" \
   --repetitions "$repetitions" --export "$work_dir/xy.json" >"$work_dir/cdcr.json"
 echo "scikit-learn: fitting..."
@@ -62,5 +62,5 @@ print(f"\nspeed-up: {ratio:.1f}x overall, {per_ratio:.1f}x per evaluation; LML d
       f"{ours['log_marginal_likelihood'] - theirs['log_marginal_likelihood']:+.3f}")
 print(f"floor of cdcr's search: {ours['likelihood_evaluations']} evaluations x "
       f"{ours['flops_per_evaluation'] / 1e6:.0f} Mflop at {ours['achieved_gflops']:.1f} GFLOP/s "
-      f"(an N x N product on this machine) = {ours['floor_seconds']:.2f} s; measured {ours['median_seconds']:.2f} s")
+      f"(an N x N BLAS product on this machine) = {ours['floor_seconds']:.2f} s; measured {ours['median_seconds']:.2f} s")
 PYTHON

@@ -52,11 +52,11 @@ namespace {
 // The lower triangle of the kernel matrix of the scaled inputs a (N x D)
 // with themselves, straight from the differences (no cancellation, never
 // below zero); the diagonal is exactly the signal variance. The strict
-// upper triangle is left unset: every user reads the lower one only.
-Eigen::MatrixXd lower_gram(const Eigen::MatrixXd& a, double signal_variance) {
+// upper triangle is left alone: every user reads the lower one only.
+void lower_gram(const Eigen::MatrixXd& a, double signal_variance, Eigen::MatrixXd& k) {
   const Eigen::Index n = a.rows();
   const Eigen::Index d = a.cols();
-  Eigen::MatrixXd k(n, n);
+  k.resize(n, n);
   for (Eigen::Index j = 0; j < n; ++j) {
     const Eigen::Index below = n - j - 1;
     auto column = k.col(j).tail(below);
@@ -67,55 +67,60 @@ Eigen::MatrixXd lower_gram(const Eigen::MatrixXd& a, double signal_variance) {
     column = signal_variance * (-0.5 * column.array()).exp();
     k(j, j) = signal_variance;
   }
-  return k;
 }
 
-// The lower Cholesky factor of K_signal + noise I (lower triangles), with
-// jitter growing by decades from 1e-10 of the signal variance until the
-// factorisation succeeds.
-struct Factorisation {
-  Eigen::MatrixXd l;  // lower triangle; the strict upper one is unspecified
-  double jitter = 0.0;
-};
-
-Factorisation factorise(const Eigen::MatrixXd& k_signal, double noise_variance, double signal_variance) {
-  Factorisation f;
-  f.l.resize(k_signal.rows(), k_signal.cols());
-  f.l.triangularView<Eigen::Lower>() = k_signal;
-  f.l.diagonal().array() += noise_variance;
+// The lower Cholesky factor of K_signal + noise I (lower triangles) into l,
+// with jitter growing by decades from 1e-10 of the signal variance until
+// the factorisation succeeds; returns the jitter.
+double factorise(const Eigen::MatrixXd& k_signal, double noise_variance, double signal_variance,
+                 Eigen::MatrixXd& l) {
+  l.resize(k_signal.rows(), k_signal.cols());
+  l.triangularView<Eigen::Lower>() = k_signal;
+  l.diagonal().array() += noise_variance;
   double jitter = 1e-10 * signal_variance;
-  while (lapack::cholesky_lower(f.l) != 0) {
+  double added = 0.0;
+  while (lapack::cholesky_lower(l) != 0) {
     if (jitter > 1e-2 * signal_variance) {
       throw std::runtime_error("kernel matrix is not positive definite even with jitter");
     }
-    f.l.triangularView<Eigen::Lower>() = k_signal;
-    f.l.diagonal().array() += noise_variance + jitter;
-    f.jitter = jitter;
+    l.triangularView<Eigen::Lower>() = k_signal;
+    l.diagonal().array() += noise_variance + jitter;
+    added = jitter;
     jitter *= 10.0;
   }
-  return f;
+  return added;
 }
 
-Eigen::MatrixXd scaled_inputs(const Eigen::MatrixXd& x, const KernelHyperparameters& h) {
-  return x.array().rowwise() * h.length_scales.cwiseInverse().transpose().array();
+void scale_inputs(const Eigen::MatrixXd& x, const KernelHyperparameters& h, Eigen::MatrixXd& a) {
+  a = x.array().rowwise() * h.length_scales.cwiseInverse().transpose().array();
 }
 
 }  // namespace
 
 LikelihoodResult log_marginal_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
                                          const KernelHyperparameters& h, bool with_gradient) {
+  LikelihoodWorkspace workspace;
+  return log_marginal_likelihood(x, y, h, with_gradient, workspace);
+}
+
+LikelihoodResult log_marginal_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
+                                         const KernelHyperparameters& h, bool with_gradient,
+                                         LikelihoodWorkspace& workspace) {
   const Eigen::Index n = x.rows();
   const Eigen::Index d = x.cols();
   const double outputs = static_cast<double>(y.cols());
-  const Eigen::MatrixXd a = scaled_inputs(x, h);
-  const Eigen::MatrixXd k_signal = lower_gram(a, h.signal_variance);
-  Factorisation f = factorise(k_signal, h.noise_variance, h.signal_variance);
-  Eigen::MatrixXd alpha = y;
-  lapack::cholesky_solve_lower(f.l, alpha);
-
+  Eigen::MatrixXd& a = workspace.scaled_inputs;
+  Eigen::MatrixXd& k_signal = workspace.k_signal;
+  Eigen::MatrixXd& factor = workspace.factor;
+  Eigen::MatrixXd& alpha = workspace.alpha;
+  scale_inputs(x, h, a);
+  lower_gram(a, h.signal_variance, k_signal);
   LikelihoodResult result;
-  result.jitter = f.jitter;
-  const double log_det = 2.0 * f.l.diagonal().array().log().sum();
+  result.jitter = factorise(k_signal, h.noise_variance, h.signal_variance, factor);
+  alpha = y;
+  lapack::cholesky_solve_lower(factor, alpha);
+
+  const double log_det = 2.0 * factor.diagonal().array().log().sum();
   result.log_marginal_likelihood = -0.5 * (y.array() * alpha.array()).sum() - 0.5 * outputs * log_det -
                                    0.5 * outputs * static_cast<double>(n) * std::log(2.0 * kPi);
   if (!with_gradient) return result;
@@ -123,7 +128,7 @@ LikelihoodResult log_marginal_likelihood(const Eigen::MatrixXd& x, const Eigen::
   // dLML/dp = 1/2 tr(W dK/dp), W = alpha alpha^T - m K^-1 (symmetric).
   // K^-1 from the factor (potri: triangular inverse, then the lower
   // triangle of L^-T L^-1; 2n^3/3 flops, the dominant cost).
-  Eigen::MatrixXd& k_inverse = f.l;
+  Eigen::MatrixXd& k_inverse = factor;
   if (lapack::inverse_from_cholesky_lower(k_inverse) != 0) {
     throw std::runtime_error("kernel matrix inverse failed");
   }
@@ -134,13 +139,13 @@ LikelihoodResult log_marginal_likelihood(const Eigen::MatrixXd& x, const Eigen::
   //   scale d: 1/2 sum_ij M_ij (a_id - a_jd)^2   = sum_{i>j} M_ij (a_id - a_jd)^2
   //   noise:   1/2 noise tr(W)
   // The diagonal of M is (|alpha_i|^2 - m K^-1_ii) signal_variance.
-  const Eigen::VectorXd w_diagonal = alpha.rowwise().squaredNorm() - outputs * k_inverse.diagonal();
+  const double w_trace = alpha.squaredNorm() - outputs * k_inverse.diagonal().sum();
   double signal_sum = 0.0;
   Eigen::VectorXd scale_sums = Eigen::VectorXd::Zero(d);
-  Eigen::VectorXd m_column(n);
+  workspace.column.resize(n);
   for (Eigen::Index j = 0; j + 1 < n; ++j) {
     const Eigen::Index below = n - j - 1;
-    auto m = m_column.head(below);
+    auto m = workspace.column.head(below);
     m.noalias() = alpha.bottomRows(below) * alpha.row(j).transpose();
     m = (m - outputs * k_inverse.col(j).tail(below)).cwiseProduct(k_signal.col(j).tail(below));
     signal_sum += m.sum();
@@ -150,21 +155,24 @@ LikelihoodResult log_marginal_likelihood(const Eigen::MatrixXd& x, const Eigen::
   }
   result.gradient.resize(d + 2);
   result.gradient.head(d) = scale_sums;
-  result.gradient[d] = signal_sum + 0.5 * h.signal_variance * w_diagonal.sum();
-  result.gradient[d + 1] = 0.5 * h.noise_variance * w_diagonal.sum();
+  result.gradient[d] = signal_sum + 0.5 * h.signal_variance * w_trace;
+  result.gradient[d + 1] = 0.5 * h.noise_variance * w_trace;
   return result;
 }
 
 GaussianProcess GaussianProcess::fit(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
                                      const KernelHyperparameters& h) {
-  const Factorisation f =
-      factorise(lower_gram(scaled_inputs(x, h), h.signal_variance), h.noise_variance, h.signal_variance);
+  Eigen::MatrixXd a;
+  Eigen::MatrixXd k_signal;
+  Eigen::MatrixXd factor;
+  scale_inputs(x, h, a);
+  lower_gram(a, h.signal_variance, k_signal);
   GaussianProcess gp;
   gp.hyperparameters = h;
   gp.inputs = x;
+  gp.jitter = factorise(k_signal, h.noise_variance, h.signal_variance, factor);
   gp.alpha = y;
-  lapack::cholesky_solve_lower(f.l, gp.alpha);
-  gp.jitter = f.jitter;
+  lapack::cholesky_solve_lower(factor, gp.alpha);
   return gp;
 }
 

@@ -48,10 +48,12 @@ struct NegativeLikelihood {
   const Eigen::MatrixXd& y;
   ParameterMap map;
   int evaluations = 0;
+  LikelihoodWorkspace workspace;
 
   double operator()(const Eigen::VectorXd& p, Eigen::VectorXd& gradient) {
     ++evaluations;
-    const LikelihoodResult r = log_marginal_likelihood(x, y, KernelHyperparameters::from_log(map.expand(p)));
+    const LikelihoodResult r =
+        log_marginal_likelihood(x, y, KernelHyperparameters::from_log(map.expand(p)), true, workspace);
     gradient = -map.reduce_gradient(r.gradient);
     return -r.log_marginal_likelihood;
   }
@@ -80,7 +82,7 @@ SearchResult maximise_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd
 
   SearchResult best;
   best.log_marginal_likelihood = -std::numeric_limits<double>::infinity();
-  NegativeLikelihood objective{x, y, map};
+  NegativeLikelihood objective{x, y, map, 0, {}};
   for (int start = 0; start <= options.restarts; ++start) {
     Eigen::VectorXd p(d + 2);
     if (start == 0) {
@@ -106,7 +108,7 @@ SearchResult maximise_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd
     }
     double lml = 0.0;
     try {
-      lml = log_marginal_likelihood(x, y, KernelHyperparameters::from_log(map.expand(p)), false)
+      lml = log_marginal_likelihood(x, y, KernelHyperparameters::from_log(map.expand(p)), false, objective.workspace)
                 .log_marginal_likelihood;
     } catch (const std::exception&) {
       continue;
