@@ -58,6 +58,7 @@ for name, r in (("cdcr train (C++)", ours), ("scikit-learn", theirs)):
           f"{r['likelihood_evaluations']} | {per:.1f} |")
 per_ratio = (theirs["median_seconds"] / theirs["likelihood_evaluations"]) / (
     ours["median_seconds"] / ours["likelihood_evaluations"])
+print(f"\nscikit-learn's numpy/scipy BLAS: {theirs['blas']}")
 print(f"\nspeed-up: {ratio:.1f}x overall, {per_ratio:.1f}x per evaluation; LML difference (cdcr - scikit-learn): "
       f"{ours['log_marginal_likelihood'] - theirs['log_marginal_likelihood']:+.3f}")
 print(f"floor of cdcr's search: {ours['likelihood_evaluations']} evaluations x "
