@@ -33,6 +33,11 @@ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCDCR_BUILD_TOOLS=ON -DCD
 cmake --build "$build_dir" -j"$(nproc)" --target cdcr cdcr-bench-training
 mkdir -p "$work_dir"
 
+# Both sides' BLAS on one thread per call: the trainer's default (its
+# search uses the cores by running starts side by side), and scikit-learn's
+# faster setting on a busy machine (numpy's OpenBLAS waits in every call
+# for a second thread that other processes may hold).
+export OPENBLAS_NUM_THREADS=1
 "$build_dir/bin/cdcr" simulate --samples 700 --seed 11 --out "$work_dir/data.csv" >/dev/null
 echo "cdcr (C++, Eigen + OpenBLAS + LBFGSpp): fitting..."
 "$build_dir/bin/cdcr-bench-training" --data "$work_dir/data.csv" --samples 700 --restarts "$restarts" \

@@ -19,6 +19,9 @@ void dpotrs_(const char* uplo, const int* n, const int* nrhs, const double* a, c
 void dgemm_(const char* transa, const char* transb, const int* m, const int* n, const int* k, const double* alpha,
             const double* a, const int* lda, const double* b, const int* ldb, const double* beta, double* c,
             const int* ldc, std::size_t transa_len, std::size_t transb_len);
+// OpenBLAS's own: the threads its calls use, for the whole process.
+int openblas_get_num_threads();
+void openblas_set_num_threads(int threads);
 }
 
 namespace cdcr::training::lapack {
@@ -69,3 +72,20 @@ inline void multiply(const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen::Re
 }
 
 }  // namespace cdcr::training::lapack
+
+namespace cdcr::training::blas_threads {
+
+// The BLAS on one thread per call while it lives (callers run their own
+// threads side by side), the previous setting restored after.
+class SingleThreaded {
+ public:
+  SingleThreaded() : previous_(openblas_get_num_threads()) { openblas_set_num_threads(1); }
+  ~SingleThreaded() { openblas_set_num_threads(previous_); }
+  SingleThreaded(const SingleThreaded&) = delete;
+  SingleThreaded& operator=(const SingleThreaded&) = delete;
+
+ private:
+  int previous_;
+};
+
+}  // namespace cdcr::training::blas_threads
