@@ -92,8 +92,9 @@ int main(int argc, char** argv) {
     }
     std::sort(seconds.begin(), seconds.end());
     // What this machine reaches on an N x N dense product (2 N^3 flops)
-    // through the BLAS the trainer uses (OpenBLAS, all its threads), the
-    // best of five.
+    // through the BLAS the trainer uses, on the threads its calls get
+    // (OPENBLAS_NUM_THREADS; one under run_training_bench.sh), the best of
+    // five.
     const Eigen::Index nn = x.rows();
     const Eigen::MatrixXd a = Eigen::MatrixXd::Random(nn, nn), b = Eigen::MatrixXd::Random(nn, nn);
     Eigen::MatrixXd c(nn, nn);
