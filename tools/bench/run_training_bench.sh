@@ -33,8 +33,13 @@ cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCDCR_BUILD_TOOLS=ON -DCD
 cmake --build "$build_dir" -j"$(nproc)" --target cdcr cdcr-bench-training
 mkdir -p "$work_dir"
 
+# Both sides' BLAS on one thread per call: the trainer's default (its
+# search uses the cores by running starts side by side), and scikit-learn's
+# faster setting on a busy machine (numpy's OpenBLAS waits in every call
+# for a second thread that other processes may hold).
+export OPENBLAS_NUM_THREADS=1
 "$build_dir/bin/cdcr" simulate --samples 700 --seed 11 --out "$work_dir/data.csv" >/dev/null
-echo "cdcr (C++, Eigen + LBFGSpp): fitting..."
+echo "cdcr (C++, Eigen + OpenBLAS + LBFGSpp): fitting..."
 "$build_dir/bin/cdcr-bench-training" --data "$work_dir/data.csv" --samples 700 --restarts "$restarts" \
   --repetitions "$repetitions" --export "$work_dir/xy.json" >"$work_dir/cdcr.json"
 echo "scikit-learn: fitting..."
@@ -58,9 +63,10 @@ for name, r in (("cdcr train (C++)", ours), ("scikit-learn", theirs)):
           f"{r['likelihood_evaluations']} | {per:.1f} |")
 per_ratio = (theirs["median_seconds"] / theirs["likelihood_evaluations"]) / (
     ours["median_seconds"] / ours["likelihood_evaluations"])
+print(f"\nscikit-learn's numpy/scipy BLAS: {theirs['blas']}")
 print(f"\nspeed-up: {ratio:.1f}x overall, {per_ratio:.1f}x per evaluation; LML difference (cdcr - scikit-learn): "
       f"{ours['log_marginal_likelihood'] - theirs['log_marginal_likelihood']:+.3f}")
 print(f"floor of cdcr's search: {ours['likelihood_evaluations']} evaluations x "
       f"{ours['flops_per_evaluation'] / 1e6:.0f} Mflop at {ours['achieved_gflops']:.1f} GFLOP/s "
-      f"(an N x N product on this machine) = {ours['floor_seconds']:.2f} s; measured {ours['median_seconds']:.2f} s")
+      f"(an N x N BLAS product on this machine) = {ours['floor_seconds']:.2f} s; measured {ours['median_seconds']:.2f} s")
 PYTHON

@@ -13,6 +13,7 @@ import warnings
 
 import numpy as np
 import scipy.optimize
+import threadpoolctl
 from sklearn.exceptions import ConvergenceWarning
 from sklearn.gaussian_process import GaussianProcessRegressor
 from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
@@ -56,6 +57,12 @@ for repetition in range(args.repetitions):
     seconds.append(time.perf_counter() - start)
     evaluations_per_run.append(evaluations)
 
+# The BLAS/LAPACK numpy and scipy run on (Debian's alternatives pick it:
+# OpenBLAS once libopenblas0 is installed, else the reference BLAS, which
+# threadpoolctl does not list).
+blas = [f"{p['internal_api']} {p['version']} ({p['num_threads']} threads)" for p in threadpoolctl.threadpool_info()
+        if p["user_api"] == "blas"]
+
 print(
     json.dumps(
         {
@@ -68,6 +75,7 @@ print(
             "log_marginal_likelihood": float(gp.log_marginal_likelihood_value_),
             "likelihood_evaluations": evaluations_per_run[-1],
             "kernel": str(gp.kernel_),
+            "blas": ", ".join(blas) or "reference BLAS (single-threaded)",
         }
     )
 )

@@ -3,7 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include <Eigen/Cholesky>
+#include "lapack.hpp"
 
 namespace cdcr::training {
 
@@ -49,123 +49,130 @@ Eigen::MatrixXd gram_matrix(const Eigen::MatrixXd& x, const KernelHyperparameter
 
 namespace {
 
-// In-place inverse of a lower-triangular matrix by recursive halving:
-// inv([A 0; B C]) = [inv(A) 0; -inv(C) B inv(A)  inv(C)]. The off-diagonal
-// block is two triangular products, so the whole costs n^3/3 flops where a
-// triangular solve against the identity costs n^3.
-void invert_lower_triangular(Eigen::Ref<Eigen::MatrixXd> l) {
-  const Eigen::Index n = l.rows();
-  constexpr Eigen::Index kDirect = 64;
-  if (n <= kDirect) {
-    Eigen::MatrixXd identity = Eigen::MatrixXd::Identity(n, n);
-    l.triangularView<Eigen::Lower>().solveInPlace(identity);
-    l = identity;
-    return;
+// The lower triangle of the kernel matrix of the scaled inputs a (N x D)
+// with themselves, straight from the differences (no cancellation, never
+// below zero); the diagonal is exactly the signal variance. The strict
+// upper triangle is left alone: every user reads the lower one only.
+void lower_gram(const Eigen::MatrixXd& a, double signal_variance, Eigen::MatrixXd& k) {
+  const Eigen::Index n = a.rows();
+  const Eigen::Index d = a.cols();
+  k.resize(n, n);
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const Eigen::Index below = n - j - 1;
+    auto column = k.col(j).tail(below);
+    column.setZero();
+    for (Eigen::Index c = 0; c < d; ++c) {
+      column.array() += (a.col(c).tail(below).array() - a(j, c)).square();
+    }
+    column = signal_variance * (-0.5 * column.array()).exp();
+    k(j, j) = signal_variance;
   }
-  const Eigen::Index n1 = n / 2;
-  const Eigen::Index n2 = n - n1;
-  invert_lower_triangular(l.topLeftCorner(n1, n1));
-  invert_lower_triangular(l.bottomRightCorner(n2, n2));
-  Eigen::MatrixXd b = l.bottomLeftCorner(n2, n1) * l.topLeftCorner(n1, n1).triangularView<Eigen::Lower>();
-  l.bottomLeftCorner(n2, n1).noalias() = -(l.bottomRightCorner(n2, n2).triangularView<Eigen::Lower>() * b);
 }
 
-// The lower triangle of M^T M for lower-triangular M, in place (LAPACK's
-// lauum): with M = [P 0; Q R], M^T M = [P^T P + Q^T Q, .; R^T Q, R^T R].
-// n^3/3 flops instead of the n^3 of a general symmetric product.
-void lower_gram_in_place(Eigen::Ref<Eigen::MatrixXd> m) {
-  const Eigen::Index n = m.rows();
-  constexpr Eigen::Index kDirect = 64;
-  if (n <= kDirect) {
-    const Eigen::MatrixXd lower = m.triangularView<Eigen::Lower>();
-    m.triangularView<Eigen::Lower>() = lower.transpose() * lower;
-    return;
-  }
-  const Eigen::Index n1 = n / 2;
-  const Eigen::Index n2 = n - n1;
-  lower_gram_in_place(m.topLeftCorner(n1, n1));
-  m.topLeftCorner(n1, n1).selfadjointView<Eigen::Lower>().rankUpdate(m.bottomLeftCorner(n2, n1).transpose());
-  m.bottomLeftCorner(n2, n1) =
-      m.bottomRightCorner(n2, n2).triangularView<Eigen::Lower>().transpose() * m.bottomLeftCorner(n2, n1);
-  lower_gram_in_place(m.bottomRightCorner(n2, n2));
-}
-
-struct Factorisation {
-  Eigen::LLT<Eigen::MatrixXd> llt;
-  double jitter = 0.0;
-};
-
-// Adds the noise, then jitter growing by decades from 1e-10 of the signal
-// variance until the Cholesky factorisation succeeds.
-Factorisation factorise(Eigen::MatrixXd k, double noise_variance, double signal_variance) {
-  k.diagonal().array() += noise_variance;
-  Factorisation f;
-  f.llt.compute(k);
+// The lower Cholesky factor of K_signal + noise I (lower triangles) into l,
+// with jitter growing by decades from 1e-10 of the signal variance until
+// the factorisation succeeds; returns the jitter.
+double factorise(const Eigen::MatrixXd& k_signal, double noise_variance, double signal_variance,
+                 Eigen::MatrixXd& l) {
+  l.resize(k_signal.rows(), k_signal.cols());
+  l.triangularView<Eigen::Lower>() = k_signal;
+  l.diagonal().array() += noise_variance;
   double jitter = 1e-10 * signal_variance;
-  while (f.llt.info() != Eigen::Success) {
+  double added = 0.0;
+  while (lapack::cholesky_lower(l) != 0) {
     if (jitter > 1e-2 * signal_variance) {
       throw std::runtime_error("kernel matrix is not positive definite even with jitter");
     }
-    k.diagonal().array() += jitter - f.jitter;
-    f.jitter = jitter;
-    f.llt.compute(k);
+    l.triangularView<Eigen::Lower>() = k_signal;
+    l.diagonal().array() += noise_variance + jitter;
+    added = jitter;
     jitter *= 10.0;
   }
-  return f;
+  return added;
+}
+
+void scale_inputs(const Eigen::MatrixXd& x, const KernelHyperparameters& h, Eigen::MatrixXd& a) {
+  a = x.array().rowwise() * h.length_scales.cwiseInverse().transpose().array();
 }
 
 }  // namespace
 
 LikelihoodResult log_marginal_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
                                          const KernelHyperparameters& h, bool with_gradient) {
+  LikelihoodWorkspace workspace;
+  return log_marginal_likelihood(x, y, h, with_gradient, workspace);
+}
+
+LikelihoodResult log_marginal_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
+                                         const KernelHyperparameters& h, bool with_gradient,
+                                         LikelihoodWorkspace& workspace) {
   const Eigen::Index n = x.rows();
   const Eigen::Index d = x.cols();
   const double outputs = static_cast<double>(y.cols());
-  const Eigen::MatrixXd k_signal = gram_matrix(x, h);
-  const Factorisation f = factorise(k_signal, h.noise_variance, h.signal_variance);
-  const Eigen::MatrixXd alpha = f.llt.solve(y);
-  const Eigen::MatrixXd& l = f.llt.matrixLLT();
-
+  Eigen::MatrixXd& a = workspace.scaled_inputs;
+  Eigen::MatrixXd& k_signal = workspace.k_signal;
+  Eigen::MatrixXd& factor = workspace.factor;
+  Eigen::MatrixXd& alpha = workspace.alpha;
+  scale_inputs(x, h, a);
+  lower_gram(a, h.signal_variance, k_signal);
   LikelihoodResult result;
-  result.jitter = f.jitter;
-  const double log_det = 2.0 * l.diagonal().array().log().sum();
+  result.jitter = factorise(k_signal, h.noise_variance, h.signal_variance, factor);
+  alpha = y;
+  lapack::cholesky_solve_lower(factor, alpha);
+
+  const double log_det = 2.0 * factor.diagonal().array().log().sum();
   result.log_marginal_likelihood = -0.5 * (y.array() * alpha.array()).sum() - 0.5 * outputs * log_det -
                                    0.5 * outputs * static_cast<double>(n) * std::log(2.0 * kPi);
   if (!with_gradient) return result;
 
-  // dLML/dp = 1/2 tr(W dK/dp), W = alpha alpha^T - m K^-1.
-  // K^-1 = L^-T L^-1, as LAPACK's potri does it: invert L, then form the
-  // lower triangle of the product; together n^3 * 2/3 flops, the dominant
-  // cost of an evaluation.
-  Eigen::MatrixXd k_inverse = l.triangularView<Eigen::Lower>();
-  invert_lower_triangular(k_inverse);
-  lower_gram_in_place(k_inverse);
-  Eigen::MatrixXd w = -outputs * k_inverse.selfadjointView<Eigen::Lower>().toDenseMatrix();
-  w.noalias() += alpha * alpha.transpose();
+  // dLML/dp = 1/2 tr(W dK/dp), W = alpha alpha^T - m K^-1 (symmetric).
+  // K^-1 from the factor (potri: triangular inverse, then the lower
+  // triangle of L^-T L^-1; 2n^3/3 flops, the dominant cost).
+  Eigen::MatrixXd& k_inverse = factor;
+  if (lapack::inverse_from_cholesky_lower(k_inverse) != 0) {
+    throw std::runtime_error("kernel matrix inverse failed");
+  }
 
-  result.gradient = Eigen::VectorXd::Zero(d + 2);
-  // With a = scaled inputs and M = W .* K_signal (symmetric):
-  //   1/2 sum_ij M_ij (a_id - a_jd)^2 = sum_i a_id^2 (M 1)_i - (a^T M a)_dd,
-  // two matrix products instead of a loop over pairs.
-  const Eigen::MatrixXd a = x.array().rowwise() * h.length_scales.cwiseInverse().transpose().array();
-  const Eigen::MatrixXd m = w.cwiseProduct(k_signal);
-  const Eigen::VectorXd row_sums = m.rowwise().sum();
-  const Eigen::MatrixXd ma = m * a;
-  result.gradient.head(d) = (a.array().square().matrix().transpose() * row_sums) -
-                            a.cwiseProduct(ma).colwise().sum().transpose();
-  result.gradient[d] = 0.5 * (w.array() * k_signal.array()).sum();
-  result.gradient[d + 1] = 0.5 * h.noise_variance * w.trace();
+  // One pass over the strict lower triangle, column by column, with
+  // M = W .* K_signal:
+  //   signal:  1/2 sum_ij M_ij                    = 1/2 diag + sum_{i>j} M_ij
+  //   scale d: 1/2 sum_ij M_ij (a_id - a_jd)^2   = sum_{i>j} M_ij (a_id - a_jd)^2
+  //   noise:   1/2 noise tr(W)
+  // The diagonal of M is (|alpha_i|^2 - m K^-1_ii) signal_variance.
+  const double w_trace = alpha.squaredNorm() - outputs * k_inverse.diagonal().sum();
+  double signal_sum = 0.0;
+  Eigen::VectorXd scale_sums = Eigen::VectorXd::Zero(d);
+  workspace.column.resize(n);
+  for (Eigen::Index j = 0; j + 1 < n; ++j) {
+    const Eigen::Index below = n - j - 1;
+    auto m = workspace.column.head(below);
+    m.noalias() = alpha.bottomRows(below) * alpha.row(j).transpose();
+    m = (m - outputs * k_inverse.col(j).tail(below)).cwiseProduct(k_signal.col(j).tail(below));
+    signal_sum += m.sum();
+    for (Eigen::Index c = 0; c < d; ++c) {
+      scale_sums[c] += (m.array() * (a.col(c).tail(below).array() - a(j, c)).square()).sum();
+    }
+  }
+  result.gradient.resize(d + 2);
+  result.gradient.head(d) = scale_sums;
+  result.gradient[d] = signal_sum + 0.5 * h.signal_variance * w_trace;
+  result.gradient[d + 1] = 0.5 * h.noise_variance * w_trace;
   return result;
 }
 
 GaussianProcess GaussianProcess::fit(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
                                      const KernelHyperparameters& h) {
-  const Factorisation f = factorise(gram_matrix(x, h), h.noise_variance, h.signal_variance);
+  Eigen::MatrixXd a;
+  Eigen::MatrixXd k_signal;
+  Eigen::MatrixXd factor;
+  scale_inputs(x, h, a);
+  lower_gram(a, h.signal_variance, k_signal);
   GaussianProcess gp;
   gp.hyperparameters = h;
   gp.inputs = x;
-  gp.alpha = f.llt.solve(y);
-  gp.jitter = f.jitter;
+  gp.jitter = factorise(k_signal, h.noise_variance, h.signal_variance, factor);
+  gp.alpha = y;
+  lapack::cholesky_solve_lower(factor, gp.alpha);
   return gp;
 }
 

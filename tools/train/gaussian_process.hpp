@@ -39,10 +39,24 @@ struct LikelihoodResult {
   double jitter = 0.0;       // diagonal added beyond the noise to make K positive definite
 };
 
+// The N x N buffers of an evaluation, kept by a search from one evaluation
+// to the next: allocating (and first touching) them anew costs as much as
+// the arithmetic on some machines.
+struct LikelihoodWorkspace {
+  Eigen::MatrixXd scaled_inputs;  // N x D
+  Eigen::MatrixXd k_signal;       // N x N, lower triangle
+  Eigen::MatrixXd factor;         // N x N: the Cholesky factor, then K^-1 (lower triangles)
+  Eigen::MatrixXd alpha;          // N x m
+  Eigen::VectorXd column;         // N
+};
+
 // X: N x D inputs, Y: N x m outputs (already normalised). Throws
 // std::runtime_error if K cannot be factorised even with jitter.
 LikelihoodResult log_marginal_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
                                          const KernelHyperparameters& h, bool with_gradient = true);
+LikelihoodResult log_marginal_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
+                                         const KernelHyperparameters& h, bool with_gradient,
+                                         LikelihoodWorkspace& workspace);
 
 // A fitted GP: the training inputs, alpha = (K + noise I)^-1 Y, and the kernel.
 struct GaussianProcess {

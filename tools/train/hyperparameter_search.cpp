@@ -1,10 +1,17 @@
 #include "hyperparameter_search.hpp"
 
+#include <algorithm>
+#include <atomic>
 #include <cmath>
+#include <cstdlib>
 #include <limits>
+#include <optional>
 #include <random>
 #include <stdexcept>
+#include <thread>
+#include <vector>
 
+#include "lapack.hpp"
 #include "search_setup.hpp"
 
 namespace cdcr::training {
@@ -48,10 +55,12 @@ struct NegativeLikelihood {
   const Eigen::MatrixXd& y;
   ParameterMap map;
   int evaluations = 0;
+  LikelihoodWorkspace workspace;
 
   double operator()(const Eigen::VectorXd& p, Eigen::VectorXd& gradient) {
     ++evaluations;
-    const LikelihoodResult r = log_marginal_likelihood(x, y, KernelHyperparameters::from_log(map.expand(p)));
+    const LikelihoodResult r =
+        log_marginal_likelihood(x, y, KernelHyperparameters::from_log(map.expand(p)), true, workspace);
     gradient = -map.reduce_gradient(r.gradient);
     return -r.log_marginal_likelihood;
   }
@@ -66,22 +75,21 @@ SearchResult maximise_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd
   Eigen::VectorXd lower(d + 2);
   Eigen::VectorXd upper(d + 2);
   detail::set_hyperparameter_box(options.bounds, d, lower, upper);
-  // The solver keeps a reference to its settings: they must outlive it.
+  // Each solver keeps a reference to its settings: they must outlive it.
   const LBFGSpp::LBFGSBParam<double> settings = detail::lbfgsb_parameters(options);
-  LBFGSpp::LBFGSBSolver<double> solver(settings);
 
   // Restarts are drawn log-uniformly from a box of plausible values for
   // normalised data rather than from the whole search bounds, most of which
   // are degenerate (every point its own cluster, or one flat function).
+  // All starting points are drawn up front, so they do not depend on how
+  // the starts are spread over threads.
   std::mt19937_64 rng(options.seed);
   std::uniform_real_distribution<double> length_draw(std::log(0.1), std::log(10.0));
   std::uniform_real_distribution<double> signal_draw(std::log(0.1), std::log(10.0));
   std::uniform_real_distribution<double> noise_draw(std::log(1e-4), std::log(1.0));
-
-  SearchResult best;
-  best.log_marginal_likelihood = -std::numeric_limits<double>::infinity();
-  NegativeLikelihood objective{x, y, map};
-  for (int start = 0; start <= options.restarts; ++start) {
+  const int starts = options.restarts + 1;
+  std::vector<Eigen::VectorXd> start_points(static_cast<std::size_t>(starts));
+  for (int start = 0; start < starts; ++start) {
     Eigen::VectorXd p(d + 2);
     if (start == 0) {
       const Eigen::VectorXd full = initial.to_log();
@@ -95,29 +103,72 @@ SearchResult maximise_likelihood(const Eigen::MatrixXd& x, const Eigen::MatrixXd
       p[d] = signal_draw(rng);
       p[d + 1] = noise_draw(rng);
     }
-    p = p.cwiseMax(lower).cwiseMin(upper);
+    start_points[static_cast<std::size_t>(start)] = p.cwiseMax(lower).cwiseMin(upper);
+  }
+
+  struct StartOutcome {
+    Eigen::VectorXd p;
+    double lml = 0.0;
+    bool completed = false;
+    int evaluations = 0;
+  };
+  std::vector<StartOutcome> outcomes(static_cast<std::size_t>(starts));
+  auto run_start = [&](int start) {
+    StartOutcome& outcome = outcomes[static_cast<std::size_t>(start)];
+    NegativeLikelihood objective{x, y, map, 0, {}};
+    LBFGSpp::LBFGSBSolver<double> solver(settings);
+    outcome.p = start_points[static_cast<std::size_t>(start)];
     double negative_lml = 0.0;
     try {
-      solver.minimize(objective, p, negative_lml, lower, upper);
+      solver.minimize(objective, outcome.p, negative_lml, lower, upper);
     } catch (const std::exception&) {
       // A line search that cannot progress leaves p at its last accepted
       // point, which is still a valid candidate; a factorisation failure is
       // re-raised below by the evaluation.
     }
-    double lml = 0.0;
+    outcome.evaluations = objective.evaluations;
     try {
-      lml = log_marginal_likelihood(x, y, KernelHyperparameters::from_log(map.expand(p)), false)
-                .log_marginal_likelihood;
+      outcome.lml = log_marginal_likelihood(x, y, KernelHyperparameters::from_log(map.expand(outcome.p)), false,
+                                            objective.workspace)
+                        .log_marginal_likelihood;
+      outcome.completed = true;
     } catch (const std::exception&) {
-      continue;
     }
+  };
+
+  // The BLAS runs each call on the calling thread (unless
+  // OPENBLAS_NUM_THREADS asks otherwise): on a shared machine, waiting in
+  // every call for a second BLAS thread that another process holds costs
+  // far more than the thread gains (13x slower per evaluation, measured on
+  // the 2-core development machine under load). The cores are used by
+  // running the independent starts side by side, one per core.
+  std::optional<blas_threads::SingleThreaded> single_threaded_blas;
+  if (std::getenv("OPENBLAS_NUM_THREADS") == nullptr) single_threaded_blas.emplace();
+  const int workers = std::min(starts, static_cast<int>(std::max(1u, std::thread::hardware_concurrency())));
+  if (workers > 1) {
+    std::atomic<int> next{0};
+    std::vector<std::thread> threads;
+    for (int w = 0; w < workers; ++w) {
+      threads.emplace_back([&] {
+        for (int start = next++; start < starts; start = next++) run_start(start);
+      });
+    }
+    for (std::thread& t : threads) t.join();
+  } else {
+    run_start(0);
+  }
+
+  SearchResult best;
+  best.log_marginal_likelihood = -std::numeric_limits<double>::infinity();
+  for (const StartOutcome& outcome : outcomes) {
+    best.likelihood_evaluations += outcome.evaluations;
+    if (!outcome.completed) continue;
     ++best.optimisations_completed;
-    if (lml > best.log_marginal_likelihood) {
-      best.log_marginal_likelihood = lml;
-      best.hyperparameters = KernelHyperparameters::from_log(map.expand(p));
+    if (outcome.lml > best.log_marginal_likelihood) {
+      best.log_marginal_likelihood = outcome.lml;
+      best.hyperparameters = KernelHyperparameters::from_log(map.expand(outcome.p));
     }
   }
-  best.likelihood_evaluations = objective.evaluations;
   if (best.optimisations_completed == 0) {
     throw std::runtime_error("hyperparameter search failed from every start");
   }
