@@ -26,6 +26,7 @@ TrainedModel packaged(const TrainingSet& set, const model::RobotGeometry<double>
   m.output_mean = n.output_mean;
   m.output_scale = n.output_scale;
   m.inputs = set.inputs;
+  m.set_input_range(set.inputs);
   return m;
 }
 
@@ -81,6 +82,7 @@ TrainedModel refit(const TrainedModel& model, const TrainingSet& set) {
   const Eigen::MatrixXd y = normalise(set.error_twists, model.output_mean, model.output_scale);
   TrainedModel refitted = model;
   refitted.inputs = set.inputs;
+  refitted.set_input_range(set.inputs);
   refitted.alpha = GaussianProcess::fit(x, y, h).alpha;
   return refitted;
 }
