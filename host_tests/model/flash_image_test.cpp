@@ -76,7 +76,8 @@ class Findings : public ImageCheckSink {
     return nullptr;
   }
   bool failed(ImageCheckId check) const {
-    return std::any_of(all.begin(), all.end(), [check](const ImageFinding& f) { return f.check == check && !f.passed; });
+    return std::any_of(all.begin(), all.end(),
+                       [check](const ImageFinding& f) { return f.check == check && !f.passed; });
   }
   const ImageFinding* failure_of(const char* field) const {
     for (const ImageFinding& f : all) {

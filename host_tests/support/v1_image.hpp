@@ -55,7 +55,9 @@ inline std::vector<std::uint8_t> v1_image(const training::TrainedModel& m) {
   const auto s = static_cast<std::uint32_t>(m.geometry.segment_count);
   const V1Layout l = v1_layout(n, d, s);
   std::vector<std::uint8_t> image(l.total, 0);
-  const auto put = [&image](std::size_t offset, auto value) { std::memcpy(image.data() + offset, &value, sizeof value); };
+  const auto put = [&image](std::size_t offset, auto value) {
+    std::memcpy(image.data() + offset, &value, sizeof value);
+  };
   const auto put_f32 = [&put](std::size_t offset, double value) { put(offset, static_cast<float>(value)); };
 
   std::memcpy(image.data(), "CDGP", 4);

@@ -314,7 +314,9 @@ class ImageReportDamage : public ImageCli, public ::testing::WithParamInterface<
     const std::uint32_t input_min = layout.parameters_offset + 4 * (3 * 4 + 4 * 6);
     if (name == "range_nan") put<float>(bad, input_min + 4 * 5, std::numeric_limits<float>::quiet_NaN());
     if (name == "inverted_range") put<float>(bad, input_min + 4, get<float>(bad, input_min + 4 * 5) + 1.0f);
-    if (name == "fitted_rows") put<std::uint32_t>(bad, layout.metadata_offset + model::image_metadata_field::fitted_rows, 0);
+    if (name == "fitted_rows") {
+      put<std::uint32_t>(bad, layout.metadata_offset + model::image_metadata_field::fitted_rows, 0);
+    }
     if (name == "v1_reserved") {
       bad = test_support::v1_image(model);
       bad[model_kind] = 2;  // a v2 field in a v1 image: reserved there

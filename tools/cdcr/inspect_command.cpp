@@ -111,7 +111,9 @@ std::string format_text(const std::string& path, const ImageReport& r) {
     // The points are the training inputs of an exact model, the inducing
     // inputs of a sparse one.
     row(is_sparse(h) ? "inducing points" : "training points", fmt::format("{}", h.training_points));
-    if (r.fitted_rows) row("fitted rows", fmt::format("{}{}", *r.fitted_rows, is_v1(h) ? " (v1: the training points)" : ""));
+    if (r.fitted_rows) {
+      row("fitted rows", fmt::format("{}{}", *r.fitted_rows, is_v1(h) ? " (v1: the training points)" : ""));
+    }
     row("input dims", fmt::format("{}", h.input_dims));
     if (!is_v1(h)) row("extra inputs", fmt::format("{}", h.extra_inputs));
     row("output dims", fmt::format("{}", h.output_dims));

@@ -377,7 +377,8 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   std::uint16_t major = kImageVersionMajor;
   if (bytes != nullptr && size >= version_major + 2) {
     major = read_u16(bytes + version_major);
-    if (!run.expect(major == 1 || major == 2, Check::version, Status::unsupported_version, "version_major", -1, major,
+    const bool readable = major >= kImageOldestVersionMajor && major <= kImageVersionMajor;
+    if (!run.expect(readable, Check::version, Status::unsupported_version, "version_major", -1, major,
                     kImageVersionMajor, Expect::known)) {
       return run.status;
     }
@@ -559,7 +560,9 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   }
 
   // The parameter arrays, back to back; none where the block is not readable.
-  const auto parameter = [parameters](std::uint32_t first) { return parameters != nullptr ? parameters + first : nullptr; };
+  const auto parameter = [parameters](std::uint32_t first) {
+    return parameters != nullptr ? parameters + first : nullptr;
+  };
   const float* input_scale = parameter(d);
   const float* length_scale = parameter(2 * d);
   const float* output_mean = parameter(3 * d);
@@ -595,7 +598,9 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
         return run.status;
       }
     }
-    if (all_ordered) run.expect(true, Check::ranges, Status::invalid_parameters, "input_min", -1, 0, 0, Expect::at_most, d);
+    if (all_ordered) {
+      run.expect(true, Check::ranges, Status::invalid_parameters, "input_min", -1, 0, 0, Expect::at_most, d);
+    }
   }
 
   std::uint32_t fitted = n;  // a v1 image was fitted on exactly the rows it carries
