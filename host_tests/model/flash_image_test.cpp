@@ -880,6 +880,37 @@ TEST_F(FlashImage, WriterRefusesWhatTheParserWouldRefuse) {
   EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
 }
 
+// The trainer records the range of every row a model is fitted on: the
+// search's rows, then all rows when the exported model is refitted on them.
+TEST(TrainerInputRange, IsTheRangeOfTheRowsTheModelIsFittedOn) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 0.3);
+  training::TrainingSet all;
+  all.inputs = Eigen::MatrixXd::NullaryExpr(12, 4, [&] { return normal(rng); });
+  all.error_twists = Eigen::MatrixXd::NullaryExpr(12, 6, [&] { return normal(rng); });
+  all.inputs.row(11) << 2.0, -2.0, 2.5, -2.5;  // extremes only in the rows the search does not see
+  training::TrainingSet searched;
+  searched.inputs = all.inputs.topRows(8);
+  searched.error_twists = all.error_twists.topRows(8);
+
+  training::TrainingOptions options;
+  options.search.restarts = 0;
+  const auto geometry = RobotGeometry<double>::uniform(2, 120.0, 67.0);
+  const training::TrainedModel trained = training::train(searched, geometry, options);
+  EXPECT_EQ(trained.input_min, Eigen::VectorXd(searched.inputs.colwise().minCoeff().transpose()));
+  EXPECT_EQ(trained.input_max, Eigen::VectorXd(searched.inputs.colwise().maxCoeff().transpose()));
+
+  const training::TrainedModel refitted = training::refit(trained, all);
+  EXPECT_EQ(refitted.input_min, Eigen::VectorXd(all.inputs.colwise().minCoeff().transpose()));
+  EXPECT_EQ(refitted.input_max, Eigen::VectorXd(all.inputs.colwise().maxCoeff().transpose()));
+  const Bytes image = exporting::write_image(refitted);
+  ImageView view{};
+  ASSERT_EQ(parse_image(image.data(), image.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.fitted_rows, 12u);
+  EXPECT_EQ(view.input_max[0], 2.0f);
+  EXPECT_EQ(view.input_min[3], -2.5f);
+}
+
 // --- the float32 run time against the double-precision trainer ----------------
 
 template <typename Accumulator>
