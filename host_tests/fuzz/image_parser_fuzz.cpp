@@ -2,7 +2,9 @@
 // contents. Besides "never reads out of bounds" (ASan) and "no undefined
 // behaviour" (UBSan), an accepted image must keep every promise of the view:
 // each array lies inside the image, every float is finite, and the GP can be
-// bound and evaluated from it.
+// bound and evaluated from it. The mode that reports every check to a sink
+// must reach the same verdict on every input, its first failed finding must
+// be the one that decided it, and it must stay inside the buffer as well.
 
 #include <cstddef>
 #include <cstdint>
@@ -36,13 +38,25 @@ void check_accepted(const std::uint8_t* bytes, std::size_t size, const ImageView
   require(view.segment_count >= 1 && static_cast<std::uint32_t>(view.segment_count) <= capacity.max_segments);
   require(view.input_dims == 2 * view.segment_count);
   require(is_known(view.encoding));
+  require(view.version_major == 1 || view.version_major == 2);
+  require(is_known(view.model_kind));
+  require(view.fitted_rows >= 1);
+  if (view.model_kind == ImageModelKind::exact_gp) require(view.fitted_rows == view.training_points);
   const std::size_t n = view.training_points;
   const std::size_t d = static_cast<std::size_t>(view.input_dims);
   const std::size_t image_size = view.total_size;
   check_floats(view.geometry, 3 * static_cast<std::size_t>(view.segment_count), bytes, image_size);
   // The parameter block: means, scales, length scales, then four 6-vectors.
-  check_floats(view.input_mean, image_parameter_floats(static_cast<std::uint32_t>(d)), bytes, image_size);
-  require(view.noise_variance + kImageOutputs == view.input_mean + image_parameter_floats(static_cast<std::uint32_t>(d)));
+  const std::uint32_t parameter_floats = image_parameter_floats(static_cast<std::uint32_t>(d), view.version_major);
+  check_floats(view.input_mean, parameter_floats, bytes, image_size);
+  if (view.version_major == 1) {
+    require(view.input_min == nullptr && view.input_max == nullptr);
+    require(view.noise_variance + kImageOutputs == view.input_mean + parameter_floats);
+  } else {
+    require(view.input_min == view.noise_variance + kImageOutputs);
+    require(view.input_max + d == view.input_mean + parameter_floats);
+    for (std::size_t i = 0; i < d; ++i) require(view.input_min[i] <= view.input_max[i]);
+  }
   check_floats(view.inputs, n * d, bytes, image_size);
   check_floats(view.alpha, n * kImageOutputs, bytes, image_size);
   require(inside(view.trainer, 32, bytes, image_size));
@@ -57,13 +71,45 @@ void check_accepted(const std::uint8_t* bytes, std::size_t size, const ImageView
   }
 }
 
+// Remembers the first failed finding and counts the rest.
+class FirstFailure final : public ImageCheckSink {
+ public:
+  void on_finding(const ImageFinding& finding) override {
+    require(finding.field != nullptr);
+    require(static_cast<int>(finding.check) < kImageCheckCount);
+    if (!finding.passed && first_status_ == ImageStatus::ok) first_status_ = finding.status;
+    if (!finding.passed) require(finding.status != ImageStatus::ok);
+  }
+  ImageStatus first_status() const { return first_status_; }
+
+ private:
+  ImageStatus first_status_ = ImageStatus::ok;
+};
+
+ImageStatus parse_both_ways(const std::uint8_t* bytes, std::size_t size, ImageView& view,
+                            const ImageCapacity& capacity) {
+  const ImageStatus status = parse_image(bytes, size, view, capacity);
+  FirstFailure findings;
+  ImageView reported_view{};
+  require(parse_image(bytes, size, reported_view, capacity, &findings) == status);
+  require(findings.first_status() == status);
+  if (status == ImageStatus::ok) {
+    require(reported_view.total_size == view.total_size && reported_view.training_points == view.training_points &&
+            reported_view.fitted_rows == view.fitted_rows && reported_view.model_kind == view.model_kind &&
+            reported_view.geometry == view.geometry && reported_view.input_mean == view.input_mean &&
+            reported_view.input_min == view.input_min && reported_view.inputs == view.inputs &&
+            reported_view.alpha == view.alpha && reported_view.trainer == view.trainer);
+  }
+  return status;
+}
+
 void parse_and_check(const std::uint8_t* bytes, std::size_t size) {
   const ImageCapacity firmware{};
   // The host tools validate what they write with no capacity limit at all.
   const ImageCapacity unlimited{std::numeric_limits<std::uint32_t>::max(), std::numeric_limits<std::uint16_t>::max()};
   for (const ImageCapacity& capacity : {firmware, unlimited}) {
     ImageView view{};
-    if (parse_image(bytes, size, view, capacity) == ImageStatus::ok) check_accepted(bytes, size, view, capacity);
+    if (parse_both_ways(bytes, size, view, capacity) == ImageStatus::ok) check_accepted(bytes, size, view, capacity);
   }
 }
 
@@ -90,6 +136,6 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   std::vector<std::uint8_t> shifted(size + 1);
   if (size > 0) std::memcpy(shifted.data() + 1, image.data(), size);
   ImageView view{};
-  require(parse_image(shifted.data() + 1, size, view) != ImageStatus::ok);
+  require(parse_both_ways(shifted.data() + 1, size, view, ImageCapacity{}) != ImageStatus::ok);
   return 0;
 }

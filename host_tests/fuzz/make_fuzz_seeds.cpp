@@ -16,6 +16,8 @@
 #include "export/image_writer.hpp"
 #include "train/trained_model.hpp"
 
+#include "../support/v1_image.hpp"
+
 namespace {
 
 using cdcr::training::TrainedModel;
@@ -113,6 +115,13 @@ int main(int argc, char** argv) {
         cdcr::exporting::write_image(small_model(1, 3, InputEncoding::bend_vector)));
   write(root / "image" / "two_segments_joint_angles.bin",
         cdcr::exporting::write_image(small_model(2, 4, InputEncoding::joint_angles)));
+  TrainedModel sparse = small_model(2, 3, InputEncoding::bend_vector);
+  sparse.kind = cdcr::model::ImageModelKind::sparse_gp;
+  sparse.fitted_rows = 40;
+  write(root / "image" / "two_segments_sparse.bin", cdcr::exporting::write_image(sparse));
+  // Format v1, which boards in the field still carry.
+  write(root / "image" / "one_segment_v1.bin",
+        cdcr::test_support::v1_image(small_model(1, 3, InputEncoding::bend_vector)));
 
   write(root / "csv" / "cables.csv", cdcr::dataset::format_dataset_csv(small_dataset(2, 3, false)));
   write(root / "csv" / "poses.csv", cdcr::dataset::format_dataset_csv(small_dataset(1, 2, true), "measured"));

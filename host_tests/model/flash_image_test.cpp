@@ -1,9 +1,11 @@
-// Flash image format v1 (model/flash-image-v1.md): an image written by the
-// exporter parses into a zero-copy view holding the model's values, and every
+// Flash image format v2 (model/flash-image-v2.md): an image written by the
+// exporter parses into a zero-copy view holding the model's values, a v1
+// image built by hand from model/flash-image-v1.md still parses, and every
 // way an image can be wrong is refused with its own status, in the order the
 // specification's validation table gives. Damaged images are made by editing
 // a valid one; where a check sits behind the CRC, the CRC is recomputed so the
-// edit reaches that check.
+// edit reaches that check. Every parse also runs in the mode that reports
+// every check to a sink, which must reach the same verdict.
 
 #include <algorithm>
 #include <cmath>
@@ -26,6 +28,7 @@
 #include "train/trainer.hpp"
 
 #include "../support/synthetic_trained_model.hpp"
+#include "../support/v1_image.hpp"
 
 namespace cdcr::model {
 namespace {
@@ -61,9 +64,62 @@ void reseal(Bytes& image) {
   put<std::uint32_t>(image, total - kImageTrailerSize, reference_crc32(image.data(), total - kImageTrailerSize));
 }
 
+// Every finding of a reporting parse.
+class Findings : public ImageCheckSink {
+ public:
+  void on_finding(const ImageFinding& finding) override { all.push_back(finding); }
+
+  const ImageFinding* first_failure() const {
+    for (const ImageFinding& f : all) {
+      if (!f.passed) return &f;
+    }
+    return nullptr;
+  }
+  bool failed(ImageCheckId check) const {
+    return std::any_of(all.begin(), all.end(),
+                       [check](const ImageFinding& f) { return f.check == check && !f.passed; });
+  }
+  const ImageFinding* failure_of(const char* field) const {
+    for (const ImageFinding& f : all) {
+      if (!f.passed && std::string(f.field) == field) return &f;
+    }
+    return nullptr;
+  }
+
+  std::vector<ImageFinding> all;
+};
+
+// The reporting parse of the same bytes.
+ImageStatus parse_reporting(const Bytes& image, Findings& findings, const ImageCapacity& capacity = {}) {
+  ImageView view{};
+  return parse_image(image.data(), image.size(), view, capacity, &findings);
+}
+
+// The plain verdict, after checking that the reporting mode reaches the same
+// one, and that its first failed finding is the one that decided it.
 ImageStatus parse(const Bytes& image, const ImageCapacity& capacity = {}) {
   ImageView view{};
-  return parse_image(image.data(), image.size(), view, capacity);
+  const ImageStatus status = parse_image(image.data(), image.size(), view, capacity);
+  Findings findings;
+  EXPECT_EQ(parse_reporting(image, findings, capacity), status) << "the reporting parse disagrees";
+  const ImageFinding* first = findings.first_failure();
+  if (status == ImageStatus::ok) {
+    EXPECT_EQ(first, nullptr) << "a valid image with a failed finding: " << (first ? first->field : "");
+  } else if (first == nullptr) {
+    ADD_FAILURE() << "rejected, but no finding failed";
+  } else {
+    EXPECT_EQ(first->status, status) << "first failed finding: " << to_string(first->check) << " " << first->field;
+  }
+  return status;
+}
+
+// The verdict and, in the reporting mode, that `check` is among the failures.
+ImageStatus parse_failing(const Bytes& image, ImageCheckId check, const ImageCapacity& capacity = {}) {
+  const ImageStatus status = parse(image, capacity);
+  Findings findings;
+  parse_reporting(image, findings, capacity);
+  EXPECT_TRUE(findings.failed(check)) << "check " << to_string(check) << " did not fail";
+  return status;
 }
 
 class FlashImage : public ::testing::Test {
@@ -105,7 +161,10 @@ TEST_F(FlashImage, LayoutIsTheOneTheDimsImply) {
 TEST_F(FlashImage, ParsesIntoAZeroCopyViewOfTheModel) {
   ImageView view{};
   ASSERT_EQ(parse_image(image.data(), image.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.version_major, 2);
   EXPECT_EQ(view.version_minor, kImageVersionMinor);
+  EXPECT_EQ(view.model_kind, ImageModelKind::exact_gp);
+  EXPECT_EQ(view.fitted_rows, 5u);
   EXPECT_EQ(view.total_size, image.size());
   EXPECT_EQ(view.training_points, 5u);
   EXPECT_EQ(view.input_dims, 4);
@@ -123,6 +182,13 @@ TEST_F(FlashImage, ParsesIntoAZeroCopyViewOfTheModel) {
     EXPECT_EQ(view.geometry[3 * s + 0], static_cast<float>(model.geometry.segments[s].backbone_length_mm));
     EXPECT_EQ(view.geometry[3 * s + 1], static_cast<float>(model.geometry.segments[s].anchor_radius_mm));
     EXPECT_EQ(view.geometry[3 * s + 2], static_cast<float>(model.geometry.segments[s].theta_max_rad));
+  }
+  // The range of the rows the model was fitted on, after the v1 parameters.
+  EXPECT_EQ(view.input_min, view.noise_variance + kImageOutputs);
+  EXPECT_EQ(view.input_max, view.input_min + 4);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(view.input_min[k], static_cast<float>(model.inputs.col(k).minCoeff()));
+    EXPECT_EQ(view.input_max[k], static_cast<float>(model.inputs.col(k).maxCoeff()));
   }
   for (int k = 0; k < 4; ++k) {
     EXPECT_EQ(view.input_mean[k], static_cast<float>(model.input_mean[k]));
@@ -188,6 +254,220 @@ TEST_F(FlashImage, TrailingBytesInTheRegionAreIgnored) {
   EXPECT_EQ(view.total_size, image.size());
 }
 
+TEST_F(FlashImage, GivenInputRangeIsCarried) {
+  // A model fitted on more rows than it carries (a refit, a sparse model)
+  // gives the range of all of them.
+  model.input_min = Eigen::VectorXd::LinSpaced(4, -2.0, -0.5);
+  model.input_max = Eigen::VectorXd::LinSpaced(4, 0.5, 2.0);
+  const Bytes ranged = exporting::write_image(model);
+  ImageView view{};
+  ASSERT_EQ(parse_image(ranged.data(), ranged.size(), view), ImageStatus::ok);
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(view.input_min[k], static_cast<float>(model.input_min[k]));
+    EXPECT_EQ(view.input_max[k], static_cast<float>(model.input_max[k]));
+  }
+}
+
+// A sparse model: the points are inducing inputs, the weights beta, and the
+// board's sum is the same; only the kind and the rows behind it differ.
+TEST_F(FlashImage, SparseModelRoundTrip) {
+  training::TrainedModel sparse = model;
+  sparse.kind = ImageModelKind::sparse_gp;
+  sparse.fitted_rows = 1200;
+  sparse.input_min = Eigen::VectorXd::Constant(4, -1.5);
+  sparse.input_max = Eigen::VectorXd::Constant(4, 1.5);
+  const Bytes sparse_image = exporting::write_image(sparse);
+  ASSERT_EQ(sparse_image.size(), image.size());
+  EXPECT_EQ(sparse_image[image_field::model_kind], 2);
+  EXPECT_EQ(get<std::uint32_t>(sparse_image, layout.metadata_offset + image_metadata_field::fitted_rows), 1200u);
+
+  ImageView view{};
+  ASSERT_EQ(parse(sparse_image), ImageStatus::ok);
+  ASSERT_EQ(parse_image(sparse_image.data(), sparse_image.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.version_major, 2);
+  EXPECT_EQ(view.model_kind, ImageModelKind::sparse_gp);
+  EXPECT_EQ(view.training_points, 5u);
+  EXPECT_EQ(view.fitted_rows, 1200u);
+  EXPECT_EQ(view.input_min[0], -1.5f);
+  EXPECT_EQ(view.input_max[3], 1.5f);
+
+  ImageView exact_view{};
+  ASSERT_EQ(parse_image(image.data(), image.size(), exact_view), ImageStatus::ok);
+  GpCorrection<float, double> sparse_correction;
+  GpCorrection<float, double> exact_correction;
+  ASSERT_EQ(sparse_correction.bind(view), Status::ok);
+  ASSERT_EQ(exact_correction.bind(exact_view), Status::ok);
+  const JointVector<float> bend = (JointVector<float>(4) << 0.3f, -0.2f, 0.1f, 0.6f).finished();
+  EXPECT_EQ(sparse_correction.predict(bend), exact_correction.predict(bend));
+}
+
+// --- version 1 ------------------------------------------------------------------
+
+// Built byte by byte from the v1 specification, not by the exporter.
+class FlashImageV1 : public FlashImage {
+ protected:
+  Bytes v1 = test_support::v1_image(model);
+  test_support::V1Layout v1_layout = test_support::v1_layout(5, 4, 2);
+};
+
+TEST_F(FlashImageV1, LoadsWithTheSameModel) {
+  ASSERT_EQ(v1.size(), image_layout(5, 4, 2, 1).total_size);
+  ASSERT_EQ(v1.size() + 4 * 2 * 4, image.size()) << "v2 adds input_min and input_max, D floats each";
+  ImageView view{};
+  ASSERT_EQ(parse(v1), ImageStatus::ok);
+  ASSERT_EQ(parse_image(v1.data(), v1.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.version_major, 1);
+  EXPECT_EQ(view.version_minor, 0);
+  EXPECT_EQ(view.model_kind, ImageModelKind::exact_gp);
+  EXPECT_EQ(view.training_points, 5u);
+  EXPECT_EQ(view.fitted_rows, 5u);  // v1 images were fitted on the rows they carry
+  EXPECT_EQ(view.input_min, nullptr);
+  EXPECT_EQ(view.input_max, nullptr);
+  EXPECT_EQ(view.inputs, reinterpret_cast<const float*>(v1.data() + v1_layout.inputs));
+  EXPECT_EQ(view.alpha, reinterpret_cast<const float*>(v1.data() + v1_layout.alpha));
+  EXPECT_EQ(view.validation_samples, model.validation_samples);
+  EXPECT_EQ(std::string(view.trainer, strnlen(view.trainer, 32)), model.trainer);
+
+  // The same float32 model as the v2 image of it, value for value.
+  ImageView v2{};
+  ASSERT_EQ(parse_image(image.data(), image.size(), v2), ImageStatus::ok);
+  EXPECT_EQ(std::memcmp(view.geometry, v2.geometry, 4 * geometry_floats()), 0);
+  EXPECT_EQ(std::memcmp(view.input_mean, v2.input_mean, 4 * image_parameter_floats(4, 1)), 0);
+  EXPECT_EQ(std::memcmp(view.inputs, v2.inputs, 4 * input_floats()), 0);
+  EXPECT_EQ(std::memcmp(view.alpha, v2.alpha, 4 * alpha_floats()), 0);
+  GpCorrection<float, double> from_v1;
+  GpCorrection<float, double> from_v2;
+  ASSERT_EQ(from_v1.bind(view), Status::ok);
+  ASSERT_EQ(from_v2.bind(v2), Status::ok);
+  const JointVector<float> bend = (JointVector<float>(4) << -0.4f, 0.25f, 0.7f, 0.05f).finished();
+  EXPECT_EQ(from_v1.predict(bend), from_v2.predict(bend));
+}
+
+TEST_F(FlashImageV1, KeepsItsOwnReservedBytes) {
+  // In v1 the bytes v2 gives a meaning are reserved, so a v1 image with a
+  // model kind is a bad header, not a sparse model.
+  for (std::size_t offset : {29u, 30u, 31u, 56u, 57u, 60u, 61u, 62u, 63u}) {
+    Bytes bad = v1;
+    bad[offset] = 1;
+    test_support::reseal_v1_image(bad);
+    EXPECT_EQ(parse_failing(bad, ImageCheckId::header), ImageStatus::bad_header) << offset;
+  }
+  // Its metadata word at 20 is not looked at.
+  Bytes word = v1;
+  put<std::uint32_t>(word, v1_layout.metadata + 20, 7);
+  test_support::reseal_v1_image(word);
+  ImageView view{};
+  ASSERT_EQ(parse_image(word.data(), word.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.fitted_rows, 5u);
+}
+
+TEST_F(FlashImageV1, IsLaidOutByItsOwnVersion) {
+  // v1 bytes labelled v2 lack the input ranges; a v2 image labelled v1 has
+  // 32 bytes too many.
+  Bytes relabelled = v1;
+  put<std::uint16_t>(relabelled, image_field::version_major, 2);
+  test_support::reseal_v1_image(relabelled);
+  EXPECT_EQ(parse(relabelled), ImageStatus::unsupported_kind) << "v2 reads model_kind 0 first";
+  relabelled[image_field::model_kind] = 1;
+  test_support::reseal_v1_image(relabelled);
+  EXPECT_EQ(parse_failing(relabelled, ImageCheckId::layout), ImageStatus::size_mismatch);
+
+  Bytes v2_as_v1 = image;
+  put<std::uint16_t>(v2_as_v1, image_field::version_major, 1);
+  v2_as_v1[image_field::model_kind] = 0;
+  reseal(v2_as_v1);
+  EXPECT_EQ(parse_failing(v2_as_v1, ImageCheckId::layout), ImageStatus::size_mismatch);
+}
+
+TEST_F(FlashImageV1, EveryDamagedByteIsRejected) {
+  for (std::size_t i = 0; i < v1.size(); ++i) {
+    Bytes bad = v1;
+    bad[i] ^= 0x01;
+    const ImageStatus status = parse(bad);
+    ASSERT_NE(status, ImageStatus::ok) << "byte " << i;
+    if (i >= 16) {
+      ASSERT_EQ(status, ImageStatus::checksum_mismatch) << "byte " << i;
+    }
+  }
+}
+
+// --- every check ------------------------------------------------------------------
+
+// Two independent faults behind a valid CRC: the plain parse stops at the
+// first, the reporting parse names both and returns the same status.
+TEST_F(FlashImage, ReportingModeFindsEveryIndependentFault) {
+  Bytes bad = image;
+  bad[image_field::model_kind] = 3;
+  put<float>(bad, layout.alpha_offset + 4 * 7, std::numeric_limits<float>::quiet_NaN());
+  put<float>(bad, layout.parameters_offset + 4 * (12 + 6 + 1), -1.0f);  // output_scale[1]
+  reseal(bad);
+  EXPECT_EQ(parse(bad), ImageStatus::unsupported_kind);
+
+  Findings findings;
+  ASSERT_EQ(parse_reporting(bad, findings), ImageStatus::unsupported_kind);
+  EXPECT_TRUE(findings.failed(ImageCheckId::kind));
+  EXPECT_TRUE(findings.failed(ImageCheckId::finite));
+  EXPECT_TRUE(findings.failed(ImageCheckId::positive));
+  const ImageFinding* nan = findings.failure_of("alpha");
+  ASSERT_NE(nan, nullptr);
+  EXPECT_EQ(nan->index, 7);
+  EXPECT_TRUE(std::isnan(nan->value));
+  EXPECT_EQ(nan->status, ImageStatus::non_finite_payload);
+  const ImageFinding* scale = findings.failure_of("output_scale");
+  ASSERT_NE(scale, nullptr);
+  EXPECT_EQ(scale->index, 1);
+  EXPECT_EQ(scale->value, -1.0);
+  // Nothing else is wrong.
+  for (const ImageFinding& f : findings.all) {
+    if (f.passed) continue;
+    EXPECT_TRUE(f.check == ImageCheckId::kind || f.check == ImageCheckId::finite || f.check == ImageCheckId::positive)
+        << to_string(f.check) << " " << f.field;
+  }
+}
+
+TEST_F(FlashImage, ReportingModeOnAValidImageCoversEveryCheck) {
+  Findings findings;
+  ASSERT_EQ(parse_reporting(image, findings), ImageStatus::ok);
+  for (int c = 0; c < kImageCheckCount; ++c) {
+    const auto check = static_cast<ImageCheckId>(c);
+    EXPECT_TRUE(std::any_of(findings.all.begin(), findings.all.end(),
+                            [check](const ImageFinding& f) { return f.check == check && f.passed; }))
+        << to_string(check);
+  }
+  // Findings arrive in the order of the checks' first evaluation.
+  int last = -1;
+  std::set<int> seen;
+  for (const ImageFinding& f : findings.all) {
+    const int c = static_cast<int>(f.check);
+    if (seen.insert(c).second) {
+      EXPECT_GT(c, last) << to_string(f.check);
+      last = c;
+    }
+  }
+}
+
+TEST_F(FlashImage, ReportingModeStaysInsideAShortBuffer) {
+  // A header that places the blocks far beyond the buffer: the payload checks
+  // are not evaluated rather than read out of bounds (ASan builds see it).
+  const Bytes header_only(image.begin(), image.begin() + kImageHeaderSize);
+  Findings findings;
+  EXPECT_EQ(parse_reporting(header_only, findings), ImageStatus::truncated);
+  for (const ImageFinding& f : findings.all) {
+    EXPECT_NE(f.check, ImageCheckId::finite);
+    EXPECT_NE(f.check, ImageCheckId::checksum);
+  }
+  EXPECT_TRUE(findings.failed(ImageCheckId::size));
+  EXPECT_FALSE(findings.failed(ImageCheckId::layout));
+
+  // A short file still has its magic and version judged.
+  Findings short_findings;
+  EXPECT_EQ(parse_reporting(Bytes(image.begin(), image.begin() + 6), short_findings), ImageStatus::truncated);
+  ASSERT_EQ(short_findings.all.size(), 3u);
+  EXPECT_EQ(short_findings.all[1].check, ImageCheckId::magic);
+  EXPECT_TRUE(short_findings.all[1].passed);
+  EXPECT_EQ(short_findings.all[2].check, ImageCheckId::version);
+}
+
 TEST(FlashImageStatus, EveryStatusHasItsOwnMessage) {
   std::set<std::string> messages;
   for (int s = 0; s <= static_cast<int>(ImageStatus::invalid_parameters); ++s) {
@@ -219,7 +499,7 @@ TEST_F(FlashImage, BadMagic) {
 }
 
 TEST_F(FlashImage, UnknownMajorVersion) {
-  for (std::uint16_t major : {0, 2, 0xFFFF}) {
+  for (std::uint16_t major : {0, 3, 0xFFFF}) {
     Bytes bad = image;
     put<std::uint16_t>(bad, image_field::version_major, major);
     reseal(bad);
@@ -287,16 +567,65 @@ TEST_F(FlashImage, EveryDamagedByteIsRejected) {
 }
 
 TEST_F(FlashImage, ReservedHeaderBytesMustBeZero) {
-  std::vector<std::size_t> reserved;
-  for (std::size_t i = 0; i < 3; ++i) reserved.push_back(image_field::reserved_a + i);
-  for (std::size_t i = 0; i < 8; ++i) reserved.push_back(image_field::reserved_b + i);
-  for (std::size_t offset : reserved) {
+  for (std::size_t offset : {image_field::reserved_a, image_field::reserved_b, image_field::reserved_b + 1}) {
     Bytes bad = image;
     bad[offset] = 1;
     EXPECT_EQ(parse(bad), ImageStatus::checksum_mismatch) << offset;
     reseal(bad);
-    EXPECT_EQ(parse(bad), ImageStatus::bad_header) << offset;
+    EXPECT_EQ(parse_failing(bad, ImageCheckId::header), ImageStatus::bad_header) << offset;
+    Findings findings;
+    parse_reporting(bad, findings);
+    ASSERT_NE(findings.failure_of("reserved"), nullptr);
+    EXPECT_EQ(findings.failure_of("reserved")->index, static_cast<std::int32_t>(offset));
   }
+}
+
+// Room for a predictive-variance factor that v2.0 does not define: an image
+// carrying one is refused, not half-read.
+TEST_F(FlashImage, VarianceFactorFieldsMustBeZero) {
+  for (std::size_t byte = 0; byte < 6; ++byte) {
+    Bytes bad = image;
+    bad[image_field::variance_offset + byte] = 8;
+    reseal(bad);
+    EXPECT_EQ(parse_failing(bad, ImageCheckId::header), ImageStatus::bad_header) << "byte " << byte;
+    Findings findings;
+    parse_reporting(bad, findings);
+    const ImageFinding* failure = findings.failure_of(byte < 4 ? "variance_offset" : "variance_rank");
+    ASSERT_NE(failure, nullptr) << byte;
+    EXPECT_EQ(failure->value, 8.0 * (1u << (8 * (byte % 4)))) << byte;
+    EXPECT_EQ(failure->expected, 0.0);
+    EXPECT_EQ(failure->status, ImageStatus::bad_header);
+  }
+}
+
+TEST_F(FlashImage, UnknownModelKindOrExtraInputs) {
+  const std::pair<std::size_t, std::uint8_t> cases[] = {{image_field::model_kind, 0},
+                                                        {image_field::model_kind, 3},
+                                                        {image_field::model_kind, 0xFF},
+                                                        {image_field::extra_inputs, 1},
+                                                        {image_field::extra_inputs, 0xFF}};
+  for (const auto& [offset, value] : cases) {
+    Bytes bad = image;
+    bad[offset] = value;
+    reseal(bad);
+    EXPECT_EQ(parse_failing(bad, ImageCheckId::kind), ImageStatus::unsupported_kind) << offset << " = " << int(value);
+    Findings findings;
+    parse_reporting(bad, findings);
+    const ImageFinding* failure =
+        findings.failure_of(offset == image_field::model_kind ? "model_kind" : "extra_inputs");
+    ASSERT_NE(failure, nullptr);
+    EXPECT_EQ(failure->value, value);
+  }
+}
+
+// extra_inputs widens D; a parser that accepted it would have to supply the
+// extra input. Both the kind and the header see the damage.
+TEST_F(FlashImage, ExtraInputsWithAWiderInputIsStillUnsupported) {
+  Bytes bad = image;
+  bad[image_field::extra_inputs] = 1;
+  put<std::uint16_t>(bad, image_field::input_dims, 5);
+  reseal(bad);
+  EXPECT_EQ(parse_failing(bad, ImageCheckId::kind), ImageStatus::unsupported_kind);
 }
 
 TEST_F(FlashImage, UnsupportedScalarKernelOrEncoding) {
@@ -420,6 +749,67 @@ TEST_F(FlashImage, NonFinitePayload) {
   }
 }
 
+TEST_F(FlashImage, NonFiniteInputRangeIsNonFinitePayload) {
+  const std::uint32_t ranges = layout.parameters_offset + 4 * (3 * 4 + 4 * kImageOutputs);
+  for (std::uint32_t i = 0; i < 2 * 4; ++i) {
+    for (float poison : {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+      Bytes bad = image;
+      put<float>(bad, ranges + 4 * i, poison);
+      reseal(bad);
+      EXPECT_EQ(parse_failing(bad, ImageCheckId::finite), ImageStatus::non_finite_payload) << i << " = " << poison;
+    }
+  }
+}
+
+TEST_F(FlashImage, InvertedInputRange) {
+  const std::uint32_t input_min = layout.parameters_offset + 4 * (3 * 4 + 4 * kImageOutputs);
+  const std::uint32_t input_max = input_min + 4 * 4;
+  for (std::uint32_t k = 0; k < 4; ++k) {
+    Bytes bad = image;
+    const float low = get<float>(bad, input_min + 4 * k);
+    const float high = get<float>(bad, input_max + 4 * k);
+    put<float>(bad, input_min + 4 * k, high);
+    put<float>(bad, input_max + 4 * k, low);
+    reseal(bad);
+    EXPECT_EQ(parse_failing(bad, ImageCheckId::ranges), ImageStatus::invalid_parameters) << k;
+    Findings findings;
+    parse_reporting(bad, findings);
+    const ImageFinding* failure = findings.failure_of("input_min");
+    ASSERT_NE(failure, nullptr);
+    EXPECT_EQ(failure->index, static_cast<std::int32_t>(k));
+    EXPECT_EQ(failure->value, high);
+    EXPECT_EQ(failure->expected, low);
+  }
+  // An empty range, every row alike in one input, is a range.
+  Bytes point = image;
+  put<float>(point, input_max, get<float>(point, input_min));
+  reseal(point);
+  EXPECT_EQ(parse(point), ImageStatus::ok);
+}
+
+TEST_F(FlashImage, FittedRows) {
+  const std::size_t fitted_rows = layout.metadata_offset + image_metadata_field::fitted_rows;
+  for (std::uint32_t rows : {0u, 4u, 6u, 1000u}) {
+    Bytes bad = image;
+    put<std::uint32_t>(bad, fitted_rows, rows);
+    reseal(bad);
+    // An exact model's rows are its points.
+    EXPECT_EQ(parse_failing(bad, ImageCheckId::fitted_rows), ImageStatus::invalid_parameters) << rows;
+  }
+  Bytes sparse = image;
+  sparse[image_field::model_kind] = static_cast<std::uint8_t>(ImageModelKind::sparse_gp);
+  for (std::uint32_t rows : {1u, 4u, 6u, 1000u}) {
+    put<std::uint32_t>(sparse, fitted_rows, rows);
+    reseal(sparse);
+    ImageView view{};
+    ASSERT_EQ(parse_image(sparse.data(), sparse.size(), view), ImageStatus::ok) << rows;
+    EXPECT_EQ(view.fitted_rows, rows);
+  }
+  put<std::uint32_t>(sparse, fitted_rows, 0);
+  reseal(sparse);
+  EXPECT_EQ(parse_failing(sparse, ImageCheckId::fitted_rows), ImageStatus::invalid_parameters);
+}
+
 TEST_F(FlashImage, MetadataMetricsAreNotPayload) {
   Bytes informational = image;
   put<float>(informational, layout.metadata_offset + image_metadata_field::metrics,
@@ -474,6 +864,51 @@ TEST_F(FlashImage, WriterRefusesWhatTheParserWouldRefuse) {
   bad = model;
   bad.geometry.segment_count = 1;
   EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
+  bad = model;
+  bad.set_input_range(bad.inputs);
+  std::swap(bad.input_min[2], bad.input_max[2]);
+  EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
+  bad = model;
+  bad.input_min = Eigen::VectorXd::Zero(3);
+  bad.input_max = Eigen::VectorXd::Ones(3);
+  EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
+  bad = model;
+  bad.fitted_rows = 6;  // an exact model of 5 points
+  EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
+  bad = model;
+  bad.kind = ImageModelKind::sparse_gp;  // without the rows behind it
+  EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
+}
+
+// The trainer records the range of every row a model is fitted on: the
+// search's rows, then all rows when the exported model is refitted on them.
+TEST(TrainerInputRange, IsTheRangeOfTheRowsTheModelIsFittedOn) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> normal(0.0, 0.3);
+  training::TrainingSet all;
+  all.inputs = Eigen::MatrixXd::NullaryExpr(12, 4, [&] { return normal(rng); });
+  all.error_twists = Eigen::MatrixXd::NullaryExpr(12, 6, [&] { return normal(rng); });
+  all.inputs.row(11) << 2.0, -2.0, 2.5, -2.5;  // extremes only in the rows the search does not see
+  training::TrainingSet searched;
+  searched.inputs = all.inputs.topRows(8);
+  searched.error_twists = all.error_twists.topRows(8);
+
+  training::TrainingOptions options;
+  options.search.restarts = 0;
+  const auto geometry = RobotGeometry<double>::uniform(2, 120.0, 67.0);
+  const training::TrainedModel trained = training::train(searched, geometry, options);
+  EXPECT_EQ(trained.input_min, Eigen::VectorXd(searched.inputs.colwise().minCoeff().transpose()));
+  EXPECT_EQ(trained.input_max, Eigen::VectorXd(searched.inputs.colwise().maxCoeff().transpose()));
+
+  const training::TrainedModel refitted = training::refit(trained, all);
+  EXPECT_EQ(refitted.input_min, Eigen::VectorXd(all.inputs.colwise().minCoeff().transpose()));
+  EXPECT_EQ(refitted.input_max, Eigen::VectorXd(all.inputs.colwise().maxCoeff().transpose()));
+  const Bytes image = exporting::write_image(refitted);
+  ImageView view{};
+  ASSERT_EQ(parse_image(image.data(), image.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.fitted_rows, 12u);
+  EXPECT_EQ(view.input_max[0], 2.0f);
+  EXPECT_EQ(view.input_min[3], -2.5f);
 }
 
 // --- the float32 run time against the double-precision trainer ----------------

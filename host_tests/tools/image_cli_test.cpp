@@ -1,7 +1,8 @@
-// `cdcr inspect` and `cdcr export` on images written by the exporter: the
-// JSON report read back field by field against the model that made the
-// image, one damaged image per parser status with the check it must name,
-// and each export format checked against its library encoder and objcopy.
+// `cdcr inspect` and `cdcr export` on images written by the exporter (v2)
+// and on a v1 image built from its specification: the JSON report read back
+// field by field against the model that made the image, one damaged image per
+// parser status with the check it must name, and each export format checked
+// against its library encoder and objcopy.
 
 
 #include <cmath>
@@ -21,6 +22,7 @@
 #include <nlohmann/json.hpp>
 
 #include "cdcr/model/flash_image.hpp"
+#include "dataset/csv_dataset.hpp"
 #include "export/binary_file.hpp"
 #include "export/c_source.hpp"
 #include "export/image_writer.hpp"
@@ -28,6 +30,7 @@
 
 #include "../support/run_cdcr.hpp"
 #include "../support/synthetic_trained_model.hpp"
+#include "../support/v1_image.hpp"
 
 namespace cdcr::cli {
 namespace {
@@ -104,17 +107,19 @@ TEST_F(ImageCli, InspectJsonReportsTheModel) {
   EXPECT_EQ(j["status"], "ok");
   EXPECT_TRUE(j["failed_check"].is_null());
   EXPECT_EQ(j["file_size"], image.size());
-  for (const char* name :
-       {"size", "magic", "version", "header", "alignment", "checksum", "kind", "capacity", "layout", "finite", "positive"}) {
+  for (const char* name : {"size", "magic", "version", "header", "alignment", "checksum", "kind", "capacity", "layout",
+                           "finite", "positive", "ranges", "fitted_rows"}) {
     ASSERT_TRUE(j["checks"].contains(name)) << name;
     EXPECT_EQ(j["checks"][name]["passed"], true) << name << ": " << j["checks"][name]["detail"];
   }
 
   const json& header = j["header"];
   EXPECT_EQ(header["magic"], "0x50474443");
-  EXPECT_EQ(header["version_major"], 1);
+  EXPECT_EQ(header["version_major"], 2);
   EXPECT_EQ(header["version_minor"], 0);
   EXPECT_EQ(header["header_size"], 64);
+  EXPECT_EQ(header["variance_offset"], 0);
+  EXPECT_EQ(header["variance_rank"], 0);
   EXPECT_EQ(header["total_size"], image.size());
   EXPECT_EQ(header["trailing_bytes"], 0);
   char crc[16];
@@ -123,6 +128,9 @@ TEST_F(ImageCli, InspectJsonReportsTheModel) {
   EXPECT_EQ(header["crc32_computed"], crc);
 
   EXPECT_EQ(j["dims"], (json{{"training_points", 5}, {"input_dims", 4}, {"output_dims", 6}, {"segments", 2}}));
+  EXPECT_EQ(j["version"], "2.0");
+  EXPECT_EQ(j["model_kind"], (json{{"code", 1}, {"name", "exact-gp"}}));
+  EXPECT_EQ(j["extra_inputs"], 0);
   EXPECT_EQ(j["fitted_rows"], 5);
   EXPECT_EQ(j["scalar_type"]["name"], "float32");
   EXPECT_EQ(j["kernel"]["code"], 1);
@@ -142,6 +150,10 @@ TEST_F(ImageCli, InspectJsonReportsTheModel) {
     EXPECT_EQ(as_float(j["normalisation"]["input_scale"][k]), static_cast<float>(model.input_scale[k]));
     EXPECT_EQ(as_float(j["hyperparameters"]["length_scales"][k]), static_cast<float>(model.length_scales[k]));
   }
+  for (int k = 0; k < 4; ++k) {
+    EXPECT_EQ(as_float(j["input_range"]["input_min"][k]), static_cast<float>(model.inputs.col(k).minCoeff()));
+    EXPECT_EQ(as_float(j["input_range"]["input_max"][k]), static_cast<float>(model.inputs.col(k).maxCoeff()));
+  }
   for (int k = 0; k < 6; ++k) {
     EXPECT_EQ(as_float(j["normalisation"]["output_mean"][k]), static_cast<float>(model.output_mean[k]));
     EXPECT_EQ(as_float(j["hyperparameters"]["noise_variance"][k]), static_cast<float>(model.noise_variance[k]));
@@ -151,7 +163,7 @@ TEST_F(ImageCli, InspectJsonReportsTheModel) {
   const json expected_blocks = json::array({
       {{"name", "header"}, {"offset", 0}, {"size", 64}, {"inside_file", true}},
       {{"name", "geometry"}, {"offset", 64}, {"size", 24}, {"inside_file", true}},
-      {{"name", "parameters"}, {"offset", layout.parameters_offset}, {"size", 144}, {"inside_file", true}},
+      {{"name", "parameters"}, {"offset", layout.parameters_offset}, {"size", 176}, {"inside_file", true}},
       {{"name", "inputs"}, {"offset", layout.inputs_offset}, {"size", 80}, {"inside_file", true}},
       {{"name", "alpha"}, {"offset", layout.alpha_offset}, {"size", 120}, {"inside_file", true}},
       {{"name", "metadata"}, {"offset", layout.metadata_offset}, {"size", 88}, {"inside_file", true}},
@@ -178,10 +190,12 @@ TEST_F(ImageCli, InspectTextShowsEveryCheck) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(run.err, "");
   for (const char* expected :
-       {"  magic               0x50474443 (CDGP)\n", "  version             1.0\n", "  training points     5\n",
+       {"  magic               0x50474443 (CDGP)\n", "  version             2.0\n", "  training points     5\n",
+        "  fitted rows         5\n", "  model kind          1 (exact-gp)\n", "  variance factor     none\n",
         "  segments            2\n", "  input encoding      2 (bend-vector)\n",
         "  created             2023-11-14T22:13:20Z (unix 1700000000)\n", "  trainer             \"cdcr-test 0.1.0\"\n",
-        "  checksum    pass", "  capacity    pass", "  positive    pass", "\nvalid\n"}) {
+        "  checksum    pass", "  capacity    pass", "  positive    pass", "  ranges      pass", "  fitted_rows pass",
+        "\nvalid\n"}) {
     EXPECT_NE(run.out.find(expected), std::string::npos) << expected << "\n--- output ---\n" << run.out;
   }
   EXPECT_EQ(run.out.find("FAIL"), std::string::npos);
@@ -250,7 +264,7 @@ TEST_F(ImageCli, InspectOfAFileShorterThanAHeader) {
   const json j = json::parse(run.out);
   EXPECT_EQ(j["status"], "truncated");
   EXPECT_EQ(j["header"]["magic"], "0x50474443");
-  EXPECT_EQ(j["header"]["version_major"], 1);
+  EXPECT_EQ(j["header"]["version_major"], 2);
   EXPECT_TRUE(j["dims"].is_null());
   EXPECT_TRUE(j["fitted_rows"].is_null());
   EXPECT_EQ(j["checks"]["magic"]["passed"], true);
@@ -283,9 +297,12 @@ class ImageReportDamage : public ImageCli, public ::testing::WithParamInterface<
     if (name == "short") return Bytes(image.begin(), image.begin() + 40);
     if (name == "truncated") return Bytes(image.begin(), image.end() - 1);
     if (name == "magic") bad[0] = 'X';
-    if (name == "version") put<std::uint16_t>(bad, version_major, 2);
+    if (name == "version") put<std::uint16_t>(bad, version_major, 3);
     if (name == "header_size") put<std::uint32_t>(bad, header_size, 32);
-    if (name == "reserved") bad[reserved_b + 3] = 7;
+    if (name == "reserved") bad[reserved_b + 1] = 7;
+    if (name == "variance") put<std::uint32_t>(bad, variance_offset, layout.metadata_offset);
+    if (name == "model_kind") bad[model_kind] = 3;
+    if (name == "extra_inputs") bad[extra_inputs] = 1;
     if (name == "dims") put<std::uint16_t>(bad, input_dims, 3);
     if (name == "offset_alignment") put<std::uint32_t>(bad, alpha_offset, layout.alpha_offset + 4);
     if (name == "checksum") bad[layout.inputs_offset] ^= 1;
@@ -294,6 +311,16 @@ class ImageReportDamage : public ImageCli, public ::testing::WithParamInterface<
     if (name == "nan") put<float>(bad, layout.inputs_offset + 8, std::numeric_limits<float>::quiet_NaN());
     if (name == "zero_scale") put<float>(bad, layout.parameters_offset + 4 * 5, 0.0f);
     if (name == "negative_radius") put<float>(bad, 64 + 4, -67.0f);
+    const std::uint32_t input_min = layout.parameters_offset + 4 * (3 * 4 + 4 * 6);
+    if (name == "range_nan") put<float>(bad, input_min + 4 * 5, std::numeric_limits<float>::quiet_NaN());
+    if (name == "inverted_range") put<float>(bad, input_min + 4, get<float>(bad, input_min + 4 * 5) + 1.0f);
+    if (name == "fitted_rows") {
+      put<std::uint32_t>(bad, layout.metadata_offset + model::image_metadata_field::fitted_rows, 0);
+    }
+    if (name == "v1_reserved") {
+      bad = test_support::v1_image(model);
+      bad[model_kind] = 2;  // a v2 field in a v1 image: reserved there
+    }
     if (name != "checksum") reseal(bad);
     return bad;
   }
@@ -345,12 +372,20 @@ INSTANTIATE_TEST_SUITE_P(
                       Damage{"layout", ImageStatus::size_mismatch, "layout"},
                       Damage{"nan", ImageStatus::non_finite_payload, "finite"},
                       Damage{"zero_scale", ImageStatus::invalid_parameters, "positive"},
-                      Damage{"negative_radius", ImageStatus::invalid_parameters, "positive"}),
+                      Damage{"negative_radius", ImageStatus::invalid_parameters, "positive"},
+                      Damage{"variance", ImageStatus::bad_header, "header"},
+                      Damage{"model_kind", ImageStatus::unsupported_kind, "kind"},
+                      Damage{"extra_inputs", ImageStatus::unsupported_kind, "kind"},
+                      Damage{"range_nan", ImageStatus::non_finite_payload, "finite"},
+                      Damage{"inverted_range", ImageStatus::invalid_parameters, "ranges"},
+                      Damage{"fitted_rows", ImageStatus::invalid_parameters, "fitted_rows"},
+                      Damage{"v1_reserved", ImageStatus::bad_header, "header"}),
     [](const ::testing::TestParamInfo<Damage>& info) { return std::string(info.param.name); });
 
-// The report evaluates every check on its own; on any prefix or single
-// damaged byte its failed check must be the parser's without being told.
-TEST_F(ImageCli, ReportFindsTheParsersFailureOnItsOwn) {
+// The report's checks are the parser's: on any prefix or single damaged byte
+// its verdict is the plain parse's, and the check it names as failed has
+// failed with words to say why.
+TEST_F(ImageCli, ReportAgreesWithTheParserOnEveryDamage) {
   const auto expect_agreement = [](const Bytes& bytes, const std::string& what) {
     model::ImageView view{};
     const ImageStatus status = model::parse_image(bytes.data(), bytes.size(), view);
@@ -361,8 +396,8 @@ TEST_F(ImageCli, ReportFindsTheParsersFailureOnItsOwn) {
       return;
     }
     ASSERT_NE(report.failed_check(), nullptr) << what;
-    EXPECT_EQ(report.failed_check()->detail.find(kParserVerdict), std::string::npos)
-        << what << ": " << report.failed_check()->name << ": " << report.failed_check()->detail;
+    EXPECT_EQ(report.failed_check()->result, CheckResult::failed) << what;
+    EXPECT_FALSE(report.failed_check()->detail.empty()) << what << ": " << report.failed_check()->name;
   };
   for (std::size_t length = 0; length <= image.size(); ++length) {
     expect_agreement(Bytes(image.begin(), image.begin() + static_cast<std::ptrdiff_t>(length)),
@@ -377,6 +412,95 @@ TEST_F(ImageCli, ReportFindsTheParsersFailureOnItsOwn) {
       expect_agreement(bad, "resealed byte " + std::to_string(i) + " ^ " + std::to_string(mask));
     }
   }
+}
+
+// Two independent faults behind a valid CRC: the verdict names the first,
+// the checks show both, each in its own words.
+TEST_F(ImageCli, InspectShowsEveryIndependentFault) {
+  const model::ImageLayout layout = model::image_layout(5, 4, 2);
+  Bytes bad = image;
+  bad[model::image_field::model_kind] = 7;
+  put<float>(bad, layout.inputs_offset + 4 * 3, std::numeric_limits<float>::infinity());
+  reseal(bad);
+  const CliResult run = cdcr("inspect --json " + quoted(save("two_faults.img", bad)));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("(unsupported_kind)"), std::string::npos) << run.err;
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["status"], "unsupported_kind");
+  EXPECT_EQ(j["failed_check"], "kind");
+  EXPECT_EQ(j["checks"]["kind"]["passed"], false);
+  EXPECT_EQ(j["checks"]["kind"]["detail"], "model_kind 7 unknown");
+  EXPECT_EQ(j["checks"]["finite"]["passed"], false);
+  EXPECT_EQ(j["checks"]["finite"]["detail"], "inputs[3] is inf");
+  EXPECT_EQ(j["checks"]["positive"]["passed"], true);
+  EXPECT_EQ(j["checks"]["checksum"]["passed"], true);
+  EXPECT_TRUE(j["model_kind"]["name"].is_null());
+
+  const CliResult text = cdcr("inspect " + quoted(save("two_faults.img", bad)));
+  EXPECT_NE(text.out.find("  kind        FAIL         model_kind 7 unknown\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("  finite      FAIL         inputs[3] is inf\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("\ninvalid: kind check failed (unsupported_kind: "), std::string::npos) << text.out;
+}
+
+TEST_F(ImageCli, InspectOfASparseModel) {
+  training::TrainedModel sparse = model;
+  sparse.kind = model::ImageModelKind::sparse_gp;
+  sparse.fitted_rows = 640;
+  const CliResult run = cdcr("inspect --json " + quoted(save("sparse.img", exporting::write_image(sparse))));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["model_kind"], (json{{"code", 2}, {"name", "sparse-gp"}}));
+  EXPECT_EQ(j["dims"]["training_points"], 5);
+  EXPECT_EQ(j["fitted_rows"], 640);
+  EXPECT_EQ(j["checks"]["fitted_rows"]["passed"], true);
+
+  const CliResult text = cdcr("inspect " + quoted(save("sparse.img", exporting::write_image(sparse))));
+  EXPECT_NE(text.out.find("  inducing points     5\n  fitted rows         640\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("  model kind          2 (sparse-gp)\n"), std::string::npos) << text.out;
+}
+
+// A v1 image, built from its specification, goes through every tool that
+// reads images, as before.
+TEST_F(ImageCli, V1ImageLoadsEverywhere) {
+  const fs::path data = dir / "data.csv";
+  ASSERT_EQ(cdcr("simulate --samples 12 --seed 4 --out " + quoted(data)).exit_code, 0);
+  test_support::SyntheticModelOptions options;
+  options.segments = dataset::read_dataset_csv(data.string()).segment_count;
+  const training::TrainedModel m = test_support::synthetic_trained_model(options);
+  const Bytes v1 = test_support::v1_image(m);
+  const fs::path v1_path = save("model_v1.img", v1);
+  const fs::path v2_path = save("model_v2.img", exporting::write_image(m));
+
+  const CliResult inspect = cdcr("inspect --json " + quoted(v1_path));
+  ASSERT_EQ(inspect.exit_code, 0) << inspect.err;
+  const json j = json::parse(inspect.out);
+  EXPECT_EQ(j["valid"], true);
+  EXPECT_EQ(j["header"]["version_major"], 1);
+  EXPECT_EQ(j["version"], "1.0");
+  EXPECT_EQ(j["model_kind"]["name"], "exact-gp");
+  EXPECT_EQ(j["fitted_rows"], 5);
+  EXPECT_TRUE(j["input_range"].is_null());
+  EXPECT_FALSE(j["header"].contains("variance_offset"));
+  EXPECT_TRUE(j["checks"]["ranges"]["passed"].is_null());
+  EXPECT_TRUE(j["checks"]["fitted_rows"]["passed"].is_null());
+  for (const char* name : {"size", "magic", "version", "header", "alignment", "checksum", "kind", "capacity", "layout",
+                           "finite", "positive"}) {
+    EXPECT_EQ(j["checks"][name]["passed"], true) << name << ": " << j["checks"][name]["detail"];
+  }
+  EXPECT_EQ(j["blocks"][2]["size"], 4 * (3 * 2 * options.segments + 24));
+
+  const fs::path exported = dir / "v1.bin";
+  const CliResult export_run = cdcr("export --model " + quoted(v1_path) + " --format bin --out " + quoted(exported));
+  ASSERT_EQ(export_run.exit_code, 0) << export_run.err;
+  EXPECT_EQ(exporting::read_binary_file(exported.string()), v1);
+
+  // The same float32 model in either format: the same errors.
+  const CliResult eval_v1 = cdcr("eval --json --model " + quoted(v1_path) + " --data " + quoted(data));
+  const CliResult eval_v2 = cdcr("eval --json --model " + quoted(v2_path) + " --data " + quoted(data));
+  ASSERT_EQ(eval_v1.exit_code, 0) << eval_v1.err;
+  ASSERT_EQ(eval_v2.exit_code, 0) << eval_v2.err;
+  EXPECT_EQ(eval_v1.out, eval_v2.out);
+  EXPECT_EQ(json::parse(eval_v1.out)["n"], 12);
 }
 
 TEST(ImageStatusNames, AreDistinctIdentifiers) {

@@ -2,6 +2,7 @@
 // only argument: valid ones from synthetic models, and damaged copies.
 //
 //   model.img           5 training points, 2 segments
+//   model_v1.img        the same model in format v1, built from its specification
 //   model_trailing.img  model.img followed by 100 bytes of erased flash (0xFF)
 //   truncated.img       model.img without its last 10 bytes
 //   flipped.img         model.img with one byte of the alpha block inverted
@@ -22,6 +23,7 @@
 #include "export/image_writer.hpp"
 
 #include "../support/synthetic_trained_model.hpp"
+#include "../support/v1_image.hpp"
 
 namespace {
 
@@ -45,6 +47,7 @@ int main(int argc, char** argv) {
     using cdcr::test_support::synthetic_trained_model;
     const std::vector<std::uint8_t> image = cdcr::exporting::write_image(synthetic_trained_model());
     write(dir + "/model.img", image);
+    write(dir + "/model_v1.img", cdcr::test_support::v1_image(synthetic_trained_model()));
 
     std::vector<std::uint8_t> trailing = image;
     trailing.resize(image.size() + 100, 0xFF);

@@ -311,7 +311,7 @@ int main(int argc, char** argv) {
   CLI::App app{"Per-cycle compute time of the firmware runtime on this host (simulated bus, lockstep time)."};
   app.name("cdcr-bench-runtime");
   Options options;
-  app.add_option("--image", options.image_path, "model image (flash image v1)")->required();
+  app.add_option("--image", options.image_path, "model image (flash image v2, or v1)")->required();
   app.add_option("--forward-cycles", options.forward_cycles, "forward cycles per run")->capture_default_str();
   app.add_option("--ik-cycles", options.ik_cycles, "cycles per run of each IK kind")->capture_default_str();
   app.add_option("--repetitions", options.repetitions,

@@ -3,10 +3,11 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <initializer_list>
+#include <utility>
 
 #include <fmt/format.h>
 
-#include "cdcr/model/crc32.hpp"
 #include "cdcr/model/input_encoding.hpp"
 #include "cdcr/model/limits.hpp"
 
@@ -14,6 +15,9 @@ namespace cdcr::cli {
 
 namespace {
 
+using model::ImageCheckId;
+using model::ImageExpectation;
+using model::ImageFinding;
 using model::ImageStatus;
 
 template <typename T>
@@ -48,11 +52,6 @@ std::string magic_text(std::uint32_t magic) {
   return fmt::format("'{}' (0x{:08x})", escaped_text(bytes, 4), magic);
 }
 
-void set(ImageCheck& check, bool passed, std::string detail) {
-  check.result = passed ? CheckResult::passed : CheckResult::failed;
-  check.detail = std::move(detail);
-}
-
 std::string join(const std::vector<std::string>& parts, const char* separator = "; ") {
   std::string out;
   for (const std::string& part : parts) {
@@ -62,12 +61,241 @@ std::string join(const std::vector<std::string>& parts, const char* separator = 
   return out;
 }
 
-// The payload blocks the finite and positive checks look at.
-struct FloatBlock {
-  const char* name;
-  std::uint64_t offset;
-  std::uint64_t count;
+// Failures kept per check: a damaged header can declare a payload of
+// millions of bad values.
+constexpr std::size_t kKeptFailuresPerCheck = 16;
+// Failures a check's detail lists before it counts the rest.
+constexpr std::size_t kListedFailures = 3;
+
+// Collects the parser's findings in its order.
+class Findings final : public model::ImageCheckSink {
+ public:
+  void on_finding(const ImageFinding& finding) override {
+    auto& per_check = by_check_[static_cast<std::size_t>(finding.check)];
+    if (!finding.passed) {
+      if (!first_failure_) first_failure_ = finding.check;
+      per_check.failures += 1;
+      if (per_check.failures > kKeptFailuresPerCheck) return;
+    }
+    per_check.kept.push_back(finding);
+  }
+
+  struct PerCheck {
+    std::vector<ImageFinding> kept;  // the passes and the first failures
+    std::size_t failures = 0;
+  };
+  const PerCheck& of(ImageCheckId check) const { return by_check_[static_cast<std::size_t>(check)]; }
+  std::optional<ImageCheckId> first_failure() const { return first_failure_; }
+
+  const ImageFinding* find(ImageCheckId check, const char* field) const {
+    for (const ImageFinding& f : of(check).kept) {
+      if (std::strcmp(f.field, field) == 0) return &f;
+    }
+    return nullptr;
+  }
+
+ private:
+  std::array<PerCheck, model::kImageCheckCount> by_check_;
+  std::optional<ImageCheckId> first_failure_;
 };
+
+// Header fields are integers; payload values are floats, shown as the
+// shortest decimal that reads back as the same float.
+std::string number(double value) {
+  if (std::isfinite(value) && value == std::floor(value) && std::abs(value) < 1e18) {
+    return fmt::format("{}", static_cast<long long>(value));
+  }
+  return fmt::format("{}", static_cast<float>(value));
+}
+
+std::string subject(const ImageFinding& f) {
+  return f.index >= 0 ? fmt::format("{}[{}]", f.field, f.index) : std::string(f.field);
+}
+
+// One finding in words. Most follow from the expectation; a few fields read
+// better in their own terms.
+std::string describe(const ImageFinding& f) {
+  const std::string field = f.field;
+  const std::string value = number(f.value);
+  const std::string expected = number(f.expected);
+  switch (f.check) {
+    case ImageCheckId::size:
+      if (field == "file_size") return fmt::format("{} bytes, fewer than the {}-byte header", value, expected);
+      return fmt::format("file {} bytes, fewer than total_size {}", expected, value);
+    case ImageCheckId::magic: {
+      const std::string text = magic_text(static_cast<std::uint32_t>(f.value));
+      return f.passed ? text : text + ", expected 'CDGP'";
+    }
+    case ImageCheckId::version:
+      return fmt::format("major version {}{}", value, f.passed ? "" : ", this parser reads 1 and 2");
+    case ImageCheckId::checksum:
+      return fmt::format("stored 0x{:08x}, computed 0x{:08x}", static_cast<std::uint32_t>(f.value),
+                         static_cast<std::uint32_t>(f.expected));
+    case ImageCheckId::header:
+      if (field == "reserved") return fmt::format("reserved byte {} is non-zero", f.index);
+      if (field == "total_size") return fmt::format("total_size {} cannot hold header and trailer", value);
+      if (field == "training_points" && f.value == 0) return "no training points";
+      if (field == "segment_count" && f.value == 0) return "no segments";
+      if (field == "variance_offset" || field == "variance_rank") {
+        return fmt::format("{} {}, v2.0 defines no variance factor (must be 0)", field, value);
+      }
+      break;
+    case ImageCheckId::alignment:
+      if (field == "buffer_address") {
+        return fmt::format("buffer address 0x{:x} is not a multiple of {}", static_cast<std::uint64_t>(f.value),
+                           expected);
+      }
+      break;
+    case ImageCheckId::layout:
+      if (f.expectation == ImageExpectation::at_least) {
+        return fmt::format("the arrays the dims declare need {} bytes, total_size is {}", expected, value);
+      }
+      if (field != "metadata_size") return fmt::format("{} {}, the dims imply {}", field, value, expected);
+      break;
+    case ImageCheckId::positive:
+      if (field == "geometry" && f.index >= 0) {
+        const char* names[] = {"backbone_length_mm", "anchor_radius_mm", "theta_max_rad"};
+        return fmt::format("segment {} {} = {}", f.index / 3 + 1, names[f.index % 3], value);
+      }
+      break;
+    case ImageCheckId::ranges:
+      return fmt::format("input_min[{0}] {1} > input_max[{0}] {2}", f.index, value, expected);
+    default:
+      break;
+  }
+  switch (f.expectation) {
+    case ImageExpectation::equal: return fmt::format("{} {}, expected {}", subject(f), value, expected);
+    case ImageExpectation::at_least: return fmt::format("{} {}, expected at least {}", subject(f), value, expected);
+    case ImageExpectation::at_most: return fmt::format("{} {}, expected at most {}", subject(f), value, expected);
+    case ImageExpectation::multiple_of:
+      return fmt::format("{} {} is not a multiple of {}", subject(f), value, expected);
+    case ImageExpectation::known: return fmt::format("{} {} unknown", subject(f), value);
+    case ImageExpectation::finite: return fmt::format("{} is {}", subject(f), value);
+    case ImageExpectation::positive: return fmt::format("{} = {}", subject(f), value);
+  }
+  return subject(f);
+}
+
+std::string failures_text(const Findings::PerCheck& findings) {
+  // Listing one more failure reads better than "1 more".
+  const std::size_t listed = findings.failures > kListedFailures + 1 ? kListedFailures : findings.failures;
+  std::vector<std::string> parts;
+  for (const ImageFinding& f : findings.kept) {
+    if (!f.passed && parts.size() < listed) parts.push_back(describe(f));
+  }
+  if (parts.size() < findings.failures) parts.push_back(fmt::format("{} more", findings.failures - parts.size()));
+  return join(parts);
+}
+
+// The payload arrays a check reads, and the ones the parser could not read
+// (their block is not inside the file): no finding names them.
+std::vector<std::string> unread(const Findings& findings, ImageCheckId check,
+                                std::initializer_list<std::pair<const char*, const char*>> field_and_block) {
+  std::vector<std::string> missing;
+  for (const auto& [field, block] : field_and_block) {
+    if (findings.find(check, field) == nullptr) missing.push_back(block);
+  }
+  return missing;
+}
+
+// What a check that passed, or was not evaluated, says: display only.
+void describe_unfailed(ImageCheck& check, const Findings& findings, const ImageReport& r) {
+  const auto& kept = findings.of(check.id).kept;
+  const auto values = [&kept] {
+    std::uint64_t count = 0;
+    for (const ImageFinding& f : kept) count += f.count;
+    return count;
+  };
+  const auto pass = [&check](std::string detail) {
+    check.result = CheckResult::passed;
+    check.detail = std::move(detail);
+  };
+  const bool v1 = r.version_major && *r.version_major == 1;
+
+  if (!r.header) {
+    if (kept.empty()) {
+      check.detail = "the header is incomplete";
+    } else {
+      pass(describe(kept.front()));
+    }
+    return;
+  }
+  const ImageHeaderFields& h = *r.header;
+  switch (check.id) {
+    case ImageCheckId::finite: {
+      const std::vector<std::string> missing = unread(
+          findings, check.id,
+          {{"geometry", "geometry"}, {"parameters", "parameters"}, {"inputs", "inputs"}, {"alpha", "alpha"}});
+      if (missing.empty()) {
+        pass(fmt::format("all {} payload values finite", values()));
+      } else {
+        check.detail = fmt::format("{} values finite; not read: {}", values(), join(missing, ", "));
+      }
+      return;
+    }
+    case ImageCheckId::positive: {
+      const std::vector<std::string> missing =
+          unread(findings, check.id, {{"geometry", "geometry"}, {"input_scale", "parameters"}});
+      if (missing.empty()) {
+        pass("geometry, scales, length scales and variances are positive");
+      } else {
+        check.detail = fmt::format("not read: {}", join(missing, ", "));
+      }
+      return;
+    }
+    default:
+      break;
+  }
+  if (kept.empty()) {
+    if (check.id == ImageCheckId::ranges && v1) {
+      check.detail = "a v1 image holds no input ranges";
+    } else if (check.id == ImageCheckId::fitted_rows && v1) {
+      check.detail = "a v1 image holds no fitted_rows: it was fitted on its training points";
+    } else {
+      check.detail = "not evaluated: what it reads is not inside the file, or not where it can be read";
+    }
+    return;
+  }
+  switch (check.id) {
+    case ImageCheckId::size:
+      if (r.trailing_bytes) {
+        pass(fmt::format("file {} bytes, image {} bytes, {} trailing", r.file_size, h.total_size, *r.trailing_bytes));
+      } else {
+        check.detail = fmt::format("file {} bytes; total_size {} is not a size", r.file_size, h.total_size);
+      }
+      return;
+    case ImageCheckId::header: pass("consistent"); return;
+    case ImageCheckId::alignment: pass("buffer and block offsets aligned; offsets are multiples of 8"); return;
+    case ImageCheckId::kind:
+      pass(fmt::format("float32, squared exponential ARD, {}{}",
+                       model::to_string(static_cast<model::InputEncoding>(h.input_encoding)),
+                       v1 ? "" : fmt::format(", {}, no extra inputs",
+                                             model::to_string(static_cast<model::ImageModelKind>(h.model_kind)))));
+      return;
+    case ImageCheckId::layout: pass("offsets and sizes match the dims"); return;
+    case ImageCheckId::ranges: pass(fmt::format("input_min <= input_max for all {} inputs", values())); return;
+    case ImageCheckId::fitted_rows:
+      if (r.fitted_rows && *r.fitted_rows == h.training_points) {
+        pass(fmt::format("{} rows, the training points", *r.fitted_rows));
+      } else {
+        pass(fmt::format("{} data rows behind {} points", r.fitted_rows.value_or(0), h.training_points));
+      }
+      return;
+    default:
+      pass(describe(kept.front()));
+      return;
+  }
+}
+
+// capacity reads the same whether it passes or fails.
+std::string capacity_text(const Findings& findings) {
+  const ImageFinding* points = findings.find(ImageCheckId::capacity, "training_points");
+  const ImageFinding* segments = findings.find(ImageCheckId::capacity, "segment_count");
+  if (points == nullptr || segments == nullptr) return {};
+  return fmt::format("{} training points (firmware limit {}), {} segment{} (limit {})", number(points->value),
+                     number(points->expected), number(segments->value), segments->value == 1 ? "" : "s",
+                     number(segments->expected));
+}
 
 }  // namespace
 
@@ -89,29 +317,10 @@ const char* image_status_name(ImageStatus status) {
   return "unknown";
 }
 
-const char* check_for_status(ImageStatus status) {
-  switch (status) {
-    case ImageStatus::ok: return nullptr;
-    case ImageStatus::truncated: return "size";
-    case ImageStatus::bad_magic: return "magic";
-    case ImageStatus::unsupported_version: return "version";
-    case ImageStatus::bad_header: return "header";
-    case ImageStatus::misaligned: return "alignment";
-    case ImageStatus::checksum_mismatch: return "checksum";
-    case ImageStatus::unsupported_kind: return "kind";
-    case ImageStatus::over_capacity: return "capacity";
-    case ImageStatus::size_mismatch: return "layout";
-    case ImageStatus::non_finite_payload: return "finite";
-    case ImageStatus::invalid_parameters: return "positive";
-  }
-  return nullptr;
-}
-
 const ImageCheck* ImageReport::failed_check() const {
-  const char* name = check_for_status(status);
-  if (name == nullptr) return nullptr;
+  if (!first_failure) return nullptr;
   for (const ImageCheck& check : checks) {
-    if (std::strcmp(check.name, name) == 0) return &check;
+    if (check.id == *first_failure) return &check;
   }
   return nullptr;
 }
@@ -120,321 +329,141 @@ ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
   using namespace model::image_field;
   ImageReport r;
   r.file_size = size;
+  Findings findings;
   {
     model::ImageView view{};
-    r.status = model::parse_image(bytes, size, view);
+    r.status = model::parse_image(bytes, size, view, model::ImageCapacity{}, &findings);
   }
-  for (const char* name : {"size", "magic", "version", "header", "alignment", "checksum", "kind", "capacity", "layout",
-                           "finite", "positive"}) {
-    r.checks.push_back(ImageCheck{name, CheckResult::not_checked, {}});
-  }
-  const auto check = [&r](const char* name) -> ImageCheck& {
-    for (ImageCheck& c : r.checks) {
-      if (std::strcmp(c.name, name) == 0) return c;
-    }
-    return r.checks.front();  // unreachable: every name above is listed
-  };
+  r.first_failure = findings.first_failure();
 
-  if (size >= 4) {
-    r.magic = read<std::uint32_t>(bytes, magic);
-    set(check("magic"), *r.magic == model::kImageMagic,
-        *r.magic == model::kImageMagic ? magic_text(*r.magic) : magic_text(*r.magic) + ", expected 'CDGP'");
+  // The fields, for display: whatever of them lies inside the file.
+  if (size >= 4) r.magic = read<std::uint32_t>(bytes, magic);
+  if (size >= 6) r.version_major = read<std::uint16_t>(bytes, version_major);
+  if (size >= model::kImageHeaderSize) {
+    ImageHeaderFields h;
+    h.magic = *r.magic;
+    h.version_major = *r.version_major;
+    h.version_minor = read<std::uint16_t>(bytes, version_minor);
+    h.header_size = read<std::uint32_t>(bytes, header_size);
+    h.total_size = read<std::uint32_t>(bytes, total_size);
+    h.training_points = read<std::uint32_t>(bytes, training_points);
+    h.input_dims = read<std::uint16_t>(bytes, input_dims);
+    h.output_dims = read<std::uint16_t>(bytes, output_dims);
+    h.segment_count = read<std::uint16_t>(bytes, segment_count);
+    h.scalar_type = bytes[scalar_type];
+    h.kernel_kind = bytes[kernel_kind];
+    h.input_encoding = bytes[input_encoding];
+    h.model_kind = bytes[model_kind];
+    h.extra_inputs = bytes[extra_inputs];
+    h.geometry_offset = read<std::uint32_t>(bytes, geometry_offset);
+    h.parameters_offset = read<std::uint32_t>(bytes, parameters_offset);
+    h.inputs_offset = read<std::uint32_t>(bytes, inputs_offset);
+    h.alpha_offset = read<std::uint32_t>(bytes, alpha_offset);
+    h.metadata_offset = read<std::uint32_t>(bytes, metadata_offset);
+    h.metadata_size = read<std::uint32_t>(bytes, metadata_size);
+    h.variance_offset = read<std::uint32_t>(bytes, variance_offset);
+    h.variance_rank = read<std::uint16_t>(bytes, variance_rank);
+    r.header = h;
   }
-  if (size >= 6) {
-    r.version_major = read<std::uint16_t>(bytes, version_major);
-    set(check("version"), *r.version_major == model::kImageVersionMajor,
-        fmt::format("major version {}{}", *r.version_major,
-                    *r.version_major == model::kImageVersionMajor ? "" : ", this parser reads 1"));
+  if (const ImageFinding* f = findings.find(ImageCheckId::size, "total_size"); f != nullptr && f->passed) {
+    r.trailing_bytes = size - r.header->total_size;
   }
-  if (size < model::kImageHeaderSize) {
-    set(check("size"), false, fmt::format("{} bytes, fewer than the {}-byte header", size, model::kImageHeaderSize));
-    for (ImageCheck& c : r.checks) {
-      if (c.result == CheckResult::not_checked) c.detail = "the header is incomplete";
-    }
-    return r;
-  }
-
-  ImageHeaderFields h;
-  h.magic = *r.magic;
-  h.version_major = *r.version_major;
-  h.version_minor = read<std::uint16_t>(bytes, version_minor);
-  h.header_size = read<std::uint32_t>(bytes, header_size);
-  h.total_size = read<std::uint32_t>(bytes, total_size);
-  h.training_points = read<std::uint32_t>(bytes, training_points);
-  h.input_dims = read<std::uint16_t>(bytes, input_dims);
-  h.output_dims = read<std::uint16_t>(bytes, output_dims);
-  h.segment_count = read<std::uint16_t>(bytes, segment_count);
-  h.scalar_type = bytes[scalar_type];
-  h.kernel_kind = bytes[kernel_kind];
-  h.input_encoding = bytes[input_encoding];
-  h.geometry_offset = read<std::uint32_t>(bytes, geometry_offset);
-  h.parameters_offset = read<std::uint32_t>(bytes, parameters_offset);
-  h.inputs_offset = read<std::uint32_t>(bytes, inputs_offset);
-  h.alpha_offset = read<std::uint32_t>(bytes, alpha_offset);
-  h.metadata_offset = read<std::uint32_t>(bytes, metadata_offset);
-  h.metadata_size = read<std::uint32_t>(bytes, metadata_size);
-  r.header = h;
-
-  // size: the file holds the whole image; more is fine.
-  const bool total_plausible = h.total_size >= model::kImageHeaderSize + model::kImageTrailerSize;
-  if (!total_plausible) {
-    check("size").detail = fmt::format("total_size {} is not a size", h.total_size);
-  } else if (h.total_size <= size) {
-    r.trailing_bytes = size - h.total_size;
-    set(check("size"), true,
-        fmt::format("file {} bytes, image {} bytes, {} trailing", size, h.total_size, *r.trailing_bytes));
-  } else {
-    set(check("size"), false, fmt::format("file {} bytes, fewer than total_size {}", size, h.total_size));
+  if (const ImageFinding* f = findings.find(ImageCheckId::checksum, "crc32"); f != nullptr) {
+    r.stored_crc = static_cast<std::uint32_t>(f->value);
+    r.computed_crc = static_cast<std::uint32_t>(f->expected);
   }
 
-  // header: everything about the header itself that the parser checks.
-  {
-    std::vector<std::string> problems;
-    if (h.header_size != model::kImageHeaderSize) {
-      problems.push_back(fmt::format("header_size {}, expected {}", h.header_size, model::kImageHeaderSize));
-    }
-    if (!total_plausible) problems.push_back(fmt::format("total_size {} cannot hold header and trailer", h.total_size));
-    for (std::size_t i = 0; i < 3; ++i) {
-      if (bytes[reserved_a + i] != 0) problems.push_back(fmt::format("reserved byte {} is non-zero", reserved_a + i));
-    }
-    for (std::size_t i = 0; i < 8; ++i) {
-      if (bytes[reserved_b + i] != 0) problems.push_back(fmt::format("reserved byte {} is non-zero", reserved_b + i));
-    }
-    if (h.training_points == 0) problems.push_back("no training points");
-    if (h.segment_count == 0) problems.push_back("no segments");
-    if (h.input_dims != 2u * h.segment_count) {
-      problems.push_back(fmt::format("input_dims {} is not twice segment_count {}", h.input_dims, h.segment_count));
-    }
-    if (h.output_dims != model::kImageOutputs) {
-      problems.push_back(fmt::format("output_dims {}, expected {}", h.output_dims, model::kImageOutputs));
-    }
-    set(check("header"), problems.empty(), problems.empty() ? "consistent" : join(problems));
-  }
-  const bool dims_consistent = h.training_points > 0 && h.segment_count > 0 && h.input_dims == 2u * h.segment_count &&
-                               h.output_dims == model::kImageOutputs;
-
-  const std::uint32_t offsets[] = {h.geometry_offset, h.parameters_offset, h.inputs_offset, h.alpha_offset,
-                                   h.metadata_offset};
-  const char* offset_names[] = {"geometry_offset", "parameters_offset", "inputs_offset", "alpha_offset",
-                                "metadata_offset"};
-  {
-    std::vector<std::string> problems;
-    for (int i = 0; i < 5; ++i) {
-      if (offsets[i] % model::kImageBlockAlignment != 0) {
-        problems.push_back(fmt::format("{} {} is not a multiple of {}", offset_names[i], offsets[i],
-                                       model::kImageBlockAlignment));
-      }
-    }
-    set(check("alignment"), problems.empty(), problems.empty() ? "block offsets are multiples of 8" : join(problems));
-  }
-
-  if (total_plausible && h.total_size <= size) {
-    r.stored_crc = read<std::uint32_t>(bytes, h.total_size - model::kImageTrailerSize);
-    r.computed_crc = model::crc32(bytes, h.total_size - model::kImageTrailerSize);
-    set(check("checksum"), *r.stored_crc == *r.computed_crc,
-        fmt::format("stored 0x{:08x}, computed 0x{:08x}", *r.stored_crc, *r.computed_crc));
-  } else {
-    check("checksum").detail = "the trailer is not inside the file";
-  }
-
-  {
-    std::vector<std::string> problems;
-    if (h.scalar_type != static_cast<std::uint8_t>(model::ImageScalar::float32)) {
-      problems.push_back(fmt::format("scalar type {} unknown", h.scalar_type));
-    }
-    if (h.kernel_kind != static_cast<std::uint8_t>(model::ImageKernel::squared_exponential_ard)) {
-      problems.push_back(fmt::format("kernel kind {} unknown", h.kernel_kind));
-    }
-    if (!model::is_known(static_cast<model::InputEncoding>(h.input_encoding))) {
-      problems.push_back(fmt::format("input encoding {} unknown", h.input_encoding));
-    }
-    set(check("kind"), problems.empty(),
-        problems.empty() ? fmt::format("float32, squared exponential ARD, {}",
-                                       model::to_string(static_cast<model::InputEncoding>(h.input_encoding)))
-                         : join(problems));
-  }
-
-  {
-    const model::ImageCapacity firmware{};
-    const bool fits = h.training_points <= firmware.max_training_points && h.segment_count <= firmware.max_segments;
-    set(check("capacity"), fits,
-        fmt::format("{} training points (firmware limit {}), {} segment{} (limit {})", h.training_points,
-                    firmware.max_training_points, h.segment_count, h.segment_count == 1 ? "" : "s",
-                    firmware.max_segments));
-  }
-
-  // Blocks as the header places them, sized by its dims. 64-bit arithmetic:
-  // the dims of a damaged header can be anything.
-  const std::uint64_t n = h.training_points;
-  const std::uint64_t d = h.input_dims;
-  const std::uint64_t segments = h.segment_count;
-  const std::uint64_t block_sizes[] = {12 * segments, 4 * (3 * d + 4 * model::kImageOutputs), 4 * n * d,
-                                       4 * n * model::kImageOutputs, model::kImageMetadataSize};
-  const char* block_names[] = {"geometry", "parameters", "inputs", "alpha", "metadata"};
-  const auto inside = [size](std::uint64_t offset, std::uint64_t length) {
-    return offset <= size && length <= size - offset;
-  };
-  r.blocks.push_back({"header", 0, model::kImageHeaderSize, true});
-  for (int i = 0; i < 5; ++i) r.blocks.push_back({block_names[i], offsets[i], block_sizes[i], inside(offsets[i], block_sizes[i])});
-  if (total_plausible) {
-    r.blocks.push_back({"crc32", h.total_size - model::kImageTrailerSize, model::kImageTrailerSize,
-                        inside(h.total_size - model::kImageTrailerSize, model::kImageTrailerSize)});
-  }
-
-  if (dims_consistent) {
-    std::vector<std::string> problems;
-    const std::uint64_t arrays = 4 * n * (d + model::kImageOutputs);
-    if (arrays > h.total_size) {
-      problems.push_back(fmt::format("{} training points need {} bytes of arrays, total_size is {}", n, arrays,
-                                     h.total_size));
-    } else {
-      const model::ImageLayout expected = model::image_layout(h.training_points, h.input_dims, h.segment_count);
-      const std::uint32_t expected_offsets[] = {expected.geometry_offset, expected.parameters_offset,
-                                                expected.inputs_offset, expected.alpha_offset,
-                                                expected.metadata_offset};
-      if (h.total_size != expected.total_size) {
-        problems.push_back(fmt::format("total_size {}, the dims imply {}", h.total_size, expected.total_size));
-      }
-      for (int i = 0; i < 5; ++i) {
-        if (offsets[i] != expected_offsets[i]) {
-          problems.push_back(fmt::format("{} {}, the dims imply {}", offset_names[i], offsets[i], expected_offsets[i]));
-        }
-      }
-    }
-    if (h.metadata_size != model::kImageMetadataSize) {
-      problems.push_back(fmt::format("metadata_size {}, expected {}", h.metadata_size, model::kImageMetadataSize));
-    }
-    set(check("layout"), problems.empty(), problems.empty() ? "offsets and sizes match the dims" : join(problems));
-  } else {
-    check("layout").detail = "the dims are inconsistent";
-  }
-
-  // The payload, wherever it lies inside the file.
-  if (inside(h.geometry_offset, block_sizes[0]) && segments > 0) {
-    const std::vector<float> values = read_floats(bytes, h.geometry_offset, 3 * segments);
-    std::vector<std::array<float, 3>> geometry(static_cast<std::size_t>(segments));
-    for (std::size_t s = 0; s < geometry.size(); ++s) geometry[s] = {values[3 * s], values[3 * s + 1], values[3 * s + 2]};
-    r.geometry = std::move(geometry);
-  }
-  if (inside(h.parameters_offset, block_sizes[1])) {
-    const std::vector<float> values = read_floats(bytes, h.parameters_offset, block_sizes[1] / 4);
-    const auto slice = [&values](std::uint64_t from, std::uint64_t count) {
-      return std::vector<float>(values.begin() + static_cast<std::ptrdiff_t>(from),
-                                values.begin() + static_cast<std::ptrdiff_t>(from + count));
+  if (r.header) {
+    const ImageHeaderFields& h = *r.header;
+    const bool v1 = h.version_major == 1;
+    // Blocks as the header places them, sized by its dims. 64-bit
+    // arithmetic: the dims of a damaged header can be anything.
+    const std::uint64_t n = h.training_points;
+    const std::uint64_t d = h.input_dims;
+    const std::uint64_t segments = h.segment_count;
+    const std::uint64_t parameter_floats = (v1 ? 3 : 5) * d + 4 * model::kImageOutputs;
+    const std::uint64_t offsets[] = {h.geometry_offset, h.parameters_offset, h.inputs_offset, h.alpha_offset,
+                                     h.metadata_offset};
+    const std::uint64_t block_sizes[] = {12 * segments, 4 * parameter_floats, 4 * n * d, 4 * n * model::kImageOutputs,
+                                         model::kImageMetadataSize};
+    const char* block_names[] = {"geometry", "parameters", "inputs", "alpha", "metadata"};
+    const auto inside = [size](std::uint64_t offset, std::uint64_t length) {
+      return offset <= size && length <= size - offset;
     };
-    ImageParameters p;
-    p.input_mean = slice(0, d);
-    p.input_scale = slice(d, d);
-    p.length_scale = slice(2 * d, d);
-    p.output_mean = slice(3 * d, 6);
-    p.output_scale = slice(3 * d + 6, 6);
-    p.signal_variance = slice(3 * d + 12, 6);
-    p.noise_variance = slice(3 * d + 18, 6);
-    r.parameters = std::move(p);
-  }
-  const auto max_abs = [bytes](std::uint64_t offset, std::uint64_t count) {
-    float largest = 0.0f;
-    for (std::uint64_t i = 0; i < count; ++i) {
-      const float value = std::abs(read<float>(bytes, static_cast<std::size_t>(offset + 4 * i)));
-      if (!(value <= largest)) largest = value;  // NaN sticks
+    r.blocks.push_back({"header", 0, model::kImageHeaderSize, true});
+    for (int i = 0; i < 5; ++i) {
+      r.blocks.push_back({block_names[i], offsets[i], block_sizes[i], inside(offsets[i], block_sizes[i])});
     }
-    return largest;
-  };
-  if (inside(h.inputs_offset, block_sizes[2]) && n * d > 0) r.max_abs_input = max_abs(h.inputs_offset, n * d);
-  if (inside(h.alpha_offset, block_sizes[3]) && n > 0) r.max_abs_alpha = max_abs(h.alpha_offset, 6 * n);
-  if (inside(h.metadata_offset, model::kImageMetadataSize)) {
-    using namespace model::image_metadata_field;
-    const std::uint8_t* m = bytes + h.metadata_offset;
-    ImageMetadata meta;
-    meta.dataset_hash = read<std::uint64_t>(m, dataset_hash);
-    meta.created_unix_s = read<std::int64_t>(m, created_unix_s);
-    meta.validation_samples = read<std::uint32_t>(m, validation_samples);
-    std::memcpy(&meta.metrics, m + metrics, sizeof(model::ImageMetrics));
-    meta.trainer = escaped_text(m + trainer, 32);
-    r.metadata = std::move(meta);
-  }
+    if (h.total_size >= model::kImageTrailerSize) {
+      r.blocks.push_back({"crc32", h.total_size - model::kImageTrailerSize, model::kImageTrailerSize,
+                          inside(h.total_size - model::kImageTrailerSize, model::kImageTrailerSize)});
+    }
 
-  // finite and positive, over the blocks that are inside the file.
-  {
-    const FloatBlock payload[] = {{"geometry", h.geometry_offset, 3 * segments},
-                                  {"parameters", h.parameters_offset, block_sizes[1] / 4},
-                                  {"inputs", h.inputs_offset, n * d},
-                                  {"alpha", h.alpha_offset, 6 * n}};
-    std::vector<std::string> missing;
-    std::string first_non_finite;
-    std::uint64_t checked = 0;
-    for (const FloatBlock& block : payload) {
-      if (!inside(block.offset, 4 * block.count)) {
-        missing.push_back(block.name);
-        continue;
-      }
-      for (std::uint64_t i = 0; i < block.count && first_non_finite.empty(); ++i) {
-        const float value = read<float>(bytes, static_cast<std::size_t>(block.offset + 4 * i));
-        if (!std::isfinite(value)) first_non_finite = fmt::format("{}[{}] is {}", block.name, i, value);
-      }
-      checked += block.count;
+    if (inside(h.geometry_offset, block_sizes[0]) && segments > 0) {
+      const std::vector<float> values = read_floats(bytes, h.geometry_offset, 3 * segments);
+      std::vector<std::array<float, 3>> geometry(static_cast<std::size_t>(segments));
+      for (std::size_t s = 0; s < geometry.size(); ++s) geometry[s] = {values[3 * s], values[3 * s + 1], values[3 * s + 2]};
+      r.geometry = std::move(geometry);
     }
-    ImageCheck& finite = check("finite");
-    if (!first_non_finite.empty()) {
-      set(finite, false, first_non_finite);
-    } else if (!missing.empty()) {
-      finite.detail = fmt::format("{} values finite; not inside the file: {}", checked, join(missing, ", "));
-    } else {
-      set(finite, true, fmt::format("all {} payload values finite", checked));
-    }
-  }
-  {
-    std::vector<std::string> problems;
-    std::vector<std::string> missing;
-    if (r.geometry) {
-      const char* fields[] = {"backbone_length_mm", "anchor_radius_mm", "theta_max_rad"};
-      for (std::size_t s = 0; s < r.geometry->size(); ++s) {
-        for (int k = 0; k < 3; ++k) {
-          if (!((*r.geometry)[s][k] > 0.0f)) {
-            problems.push_back(fmt::format("segment {} {} = {}", s + 1, fields[k], (*r.geometry)[s][k]));
-          }
-        }
-      }
-    } else {
-      missing.push_back("geometry");
-    }
-    if (r.parameters) {
-      const auto positive = [&problems](const char* name, const std::vector<float>& values) {
-        for (std::size_t i = 0; i < values.size(); ++i) {
-          if (!(values[i] > 0.0f)) problems.push_back(fmt::format("{}[{}] = {}", name, i, values[i]));
-        }
+    if (inside(h.parameters_offset, block_sizes[1])) {
+      const std::vector<float> values = read_floats(bytes, h.parameters_offset, parameter_floats);
+      const auto slice = [&values](std::uint64_t from, std::uint64_t count) {
+        return std::vector<float>(values.begin() + static_cast<std::ptrdiff_t>(from),
+                                  values.begin() + static_cast<std::ptrdiff_t>(from + count));
       };
-      positive("input_scale", r.parameters->input_scale);
-      positive("length_scale", r.parameters->length_scale);
-      positive("output_scale", r.parameters->output_scale);
-      positive("signal_variance", r.parameters->signal_variance);
-      positive("noise_variance", r.parameters->noise_variance);
-    } else {
-      missing.push_back("parameters");
-    }
-    ImageCheck& positive = check("positive");
-    if (!problems.empty()) {
-      if (problems.size() > 4) {
-        const std::size_t more = problems.size() - 3;
-        problems.resize(3);
-        problems.push_back(fmt::format("{} more", more));
+      ImageParameters p;
+      p.input_mean = slice(0, d);
+      p.input_scale = slice(d, d);
+      p.length_scale = slice(2 * d, d);
+      p.output_mean = slice(3 * d, 6);
+      p.output_scale = slice(3 * d + 6, 6);
+      p.signal_variance = slice(3 * d + 12, 6);
+      p.noise_variance = slice(3 * d + 18, 6);
+      if (!v1) {
+        p.input_min = slice(3 * d + 24, d);
+        p.input_max = slice(4 * d + 24, d);
       }
-      set(positive, false, join(problems));
-    } else if (!missing.empty()) {
-      positive.detail = fmt::format("not inside the file: {}", join(missing, ", "));
-    } else {
-      set(positive, true, "geometry, scales, length scales and variances are positive");
+      r.parameters = std::move(p);
     }
+    const auto max_abs = [bytes](std::uint64_t offset, std::uint64_t count) {
+      float largest = 0.0f;
+      for (std::uint64_t i = 0; i < count; ++i) {
+        const float value = std::abs(read<float>(bytes, static_cast<std::size_t>(offset + 4 * i)));
+        if (!(value <= largest)) largest = value;  // NaN sticks
+      }
+      return largest;
+    };
+    if (inside(h.inputs_offset, block_sizes[2]) && n * d > 0) r.max_abs_input = max_abs(h.inputs_offset, n * d);
+    if (inside(h.alpha_offset, block_sizes[3]) && n > 0) r.max_abs_alpha = max_abs(h.alpha_offset, 6 * n);
+    if (inside(h.metadata_offset, model::kImageMetadataSize)) {
+      using namespace model::image_metadata_field;
+      const std::uint8_t* m = bytes + h.metadata_offset;
+      ImageMetadata meta;
+      meta.dataset_hash = read<std::uint64_t>(m, dataset_hash);
+      meta.created_unix_s = read<std::int64_t>(m, created_unix_s);
+      meta.validation_samples = read<std::uint32_t>(m, validation_samples);
+      meta.fitted_rows = read<std::uint32_t>(m, fitted_rows);
+      std::memcpy(&meta.metrics, m + metrics, sizeof(model::ImageMetrics));
+      meta.trainer = escaped_text(m + trainer, 32);
+      r.metadata = std::move(meta);
+      if (!v1) r.fitted_rows = r.metadata->fitted_rows;
+    }
+    if (v1) r.fitted_rows = h.training_points;
   }
 
-  // The parser has the last word; its failure is always shown as failed,
-  // even if the evaluation above missed it.
-  if (const char* name = check_for_status(r.status); name != nullptr) {
-    ImageCheck& failed = check(name);
-    if (failed.result != CheckResult::failed) {
-      failed.result = CheckResult::failed;
-      failed.detail += std::string(failed.detail.empty() ? "" : "; ") + kParserVerdict + model::to_string(r.status);
+  // The checks, in the parser's order, in words.
+  for (int c = 0; c < model::kImageCheckCount; ++c) {
+    const auto id = static_cast<ImageCheckId>(c);
+    ImageCheck check{id, model::to_string(id), CheckResult::not_checked, {}};
+    const Findings::PerCheck& per_check = findings.of(id);
+    if (per_check.failures > 0) {
+      check.result = CheckResult::failed;
+      check.detail = failures_text(per_check);
+    } else {
+      describe_unfailed(check, findings, r);
     }
+    if (id == ImageCheckId::capacity && !per_check.kept.empty()) check.detail = capacity_text(findings);
+    r.checks.push_back(std::move(check));
   }
   return r;
 }

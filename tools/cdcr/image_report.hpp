@@ -1,9 +1,10 @@
 #pragma once
 // Everything `cdcr inspect` can say about a flash image, including a damaged
-// one: each field is read only if it lies inside the file, and each of the
-// parser's checks is evaluated on its own, so a report shows every problem
-// rather than only the first. The verdict itself is the shared parser's
-// (model::parse_image with the firmware's compile-time capacity).
+// one: each field is read for display only if it lies inside the file, and
+// the checks are the shared parser's own (model::parse_image with the
+// firmware's compile-time capacity, reporting every check to a sink), so a
+// report shows every problem rather than only the first, and nothing here
+// decides what is valid.
 
 #include <array>
 #include <cstddef>
@@ -22,18 +23,15 @@ const char* image_status_name(model::ImageStatus status);
 
 enum class CheckResult { passed, failed, not_checked };
 
+// One of the parser's checks (model::ImageCheckId), with its findings put
+// into words.
 struct ImageCheck {
-  const char* name;  // size, magic, version, header, alignment, checksum, kind, capacity, layout, finite, positive
+  model::ImageCheckId id;
+  const char* name;  // size, magic, version, header, alignment, checksum, kind, capacity, layout, finite, positive,
+                     // ranges, fitted_rows
   CheckResult result = CheckResult::not_checked;
   std::string detail;
 };
-
-// Starts a check's detail when only the parser saw the failure.
-inline constexpr const char* kParserVerdict = "the parser reports: ";
-
-// The check that a parser status reports, e.g. "checksum" for
-// checksum_mismatch; nullptr for ok.
-const char* check_for_status(model::ImageStatus status);
 
 struct ImageHeaderFields {
   std::uint32_t magic = 0;
@@ -48,12 +46,16 @@ struct ImageHeaderFields {
   std::uint8_t scalar_type = 0;
   std::uint8_t kernel_kind = 0;
   std::uint8_t input_encoding = 0;
+  std::uint8_t model_kind = 0;    // v2
+  std::uint8_t extra_inputs = 0;  // v2
   std::uint32_t geometry_offset = 0;
   std::uint32_t parameters_offset = 0;
   std::uint32_t inputs_offset = 0;
   std::uint32_t alpha_offset = 0;
   std::uint32_t metadata_offset = 0;
   std::uint32_t metadata_size = 0;
+  std::uint32_t variance_offset = 0;  // v2
+  std::uint16_t variance_rank = 0;    // v2
 };
 
 // A block where the header says it is, with the size the dims imply.
@@ -68,12 +70,14 @@ struct ImageParameters {
   std::vector<float> input_mean, input_scale, length_scale;        // D each
   std::vector<float> output_mean, output_scale;                    // 6 each
   std::vector<float> signal_variance, noise_variance;              // 6 each
+  std::vector<float> input_min, input_max;                         // D each, v2; empty for v1
 };
 
 struct ImageMetadata {
   std::uint64_t dataset_hash = 0;
   std::int64_t created_unix_s = 0;
   std::uint32_t validation_samples = 0;
+  std::uint32_t fitted_rows = 0;  // v2; v1: reserved
   model::ImageMetrics metrics{};
   std::string trainer;  // non-printable bytes escaped as \xNN
 };
@@ -95,8 +99,12 @@ struct ImageReport {
   std::optional<float> max_abs_input;  // kernel coordinates
   std::optional<float> max_abs_alpha;
   std::optional<ImageMetadata> metadata;
+  // Data rows the model was fitted on: the metadata's for v2, the training
+  // points for v1 (whose images carry exactly the rows they were fitted on).
+  std::optional<std::uint32_t> fitted_rows;
 
   std::vector<ImageCheck> checks;  // in the parser's order
+  std::optional<model::ImageCheckId> first_failure;  // the check whose failure is the status
 
   bool valid() const { return status == model::ImageStatus::ok; }
   const ImageCheck* failed_check() const;

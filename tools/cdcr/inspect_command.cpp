@@ -44,6 +44,19 @@ const char* encoding_name(std::uint8_t code) {
   const auto encoding = static_cast<model::InputEncoding>(code);
   return model::is_known(encoding) ? model::to_string(encoding) : nullptr;
 }
+const char* model_kind_name(std::uint8_t code) {
+  const auto kind = static_cast<model::ImageModelKind>(code);
+  return model::is_known(kind) ? model::to_string(kind) : nullptr;
+}
+
+// A v1 header has no model kind: its byte is reserved and the model exact.
+bool is_v1(const ImageHeaderFields& h) { return h.version_major == 1; }
+std::uint8_t model_kind_code(const ImageHeaderFields& h) {
+  return is_v1(h) ? static_cast<std::uint8_t>(model::ImageModelKind::exact_gp) : h.model_kind;
+}
+bool is_sparse(const ImageHeaderFields& h) {
+  return model_kind_code(h) == static_cast<std::uint8_t>(model::ImageModelKind::sparse_gp);
+}
 
 std::string input_name(std::uint8_t encoding, std::size_t dim) {
   const std::size_t segment = dim / 2 + 1;
@@ -88,9 +101,21 @@ std::string format_text(const std::string& path, const ImageReport& r) {
     if (r.trailing_bytes) row("trailing bytes", fmt::format("{} (in the file after total_size, not part of the image)", *r.trailing_bytes));
     if (r.stored_crc) row("crc32", fmt::format("stored {}, computed {}", hex32(*r.stored_crc), hex32(*r.computed_crc)));
 
+    if (!is_v1(h)) {
+      row("variance factor", h.variance_offset == 0 && h.variance_rank == 0
+                                 ? std::string("none")
+                                 : fmt::format("offset {}, rank {}", h.variance_offset, h.variance_rank));
+    }
+
     t += "dims\n";
-    row("training points", fmt::format("{}", h.training_points));
+    // The points are the training inputs of an exact model, the inducing
+    // inputs of a sparse one.
+    row(is_sparse(h) ? "inducing points" : "training points", fmt::format("{}", h.training_points));
+    if (r.fitted_rows) {
+      row("fitted rows", fmt::format("{}{}", *r.fitted_rows, is_v1(h) ? " (v1: the training points)" : ""));
+    }
     row("input dims", fmt::format("{}", h.input_dims));
+    if (!is_v1(h)) row("extra inputs", fmt::format("{}", h.extra_inputs));
     row("output dims", fmt::format("{}", h.output_dims));
     row("segments", fmt::format("{}", h.segment_count));
 
@@ -98,6 +123,7 @@ std::string format_text(const std::string& path, const ImageReport& r) {
       return fmt::format("{} ({})", code, name != nullptr ? name : "unknown");
     };
     t += "kind\n";
+    row("model kind", named(model_kind_code(h), model_kind_name(model_kind_code(h))));
     row("scalar type", named(h.scalar_type, scalar_name(h.scalar_type)));
     row("kernel", named(h.kernel_kind, kernel_name(h.kernel_kind)));
     row("input encoding", named(h.input_encoding, encoding_name(h.input_encoding)));
@@ -117,11 +143,16 @@ std::string format_text(const std::string& path, const ImageReport& r) {
 
   if (r.parameters) {
     const ImageParameters& p = *r.parameters;
-    t += "input normalisation and length scales (x_n = (x - mean) / scale)\n";
-    t += fmt::format("  {:<16}{:>16}{:>16}{:>16}\n", "input", "mean", "scale", "length scale");
+    // v2 carries the range of the fitted rows, in raw input units.
+    const bool ranges = !p.input_min.empty();
+    t += fmt::format("input normalisation and length scales (x_n = (x - mean) / scale){}\n",
+                     ranges ? "; range of the fitted rows" : "");
+    t += fmt::format("  {:<16}{:>16}{:>16}{:>16}", "input", "mean", "scale", "length scale");
+    t += ranges ? fmt::format("{:>16}{:>16}\n", "min", "max") : "\n";
     for (std::size_t i = 0; i < p.input_mean.size() && i < kMaxListedRows; ++i) {
-      t += fmt::format("  {:<16}{:>16}{:>16}{:>16}\n", input_name(r.header->input_encoding, i), p.input_mean[i],
+      t += fmt::format("  {:<16}{:>16}{:>16}{:>16}", input_name(r.header->input_encoding, i), p.input_mean[i],
                        p.input_scale[i], p.length_scale[i]);
+      t += ranges ? fmt::format("{:>16}{:>16}\n", p.input_min[i], p.input_max[i]) : "\n";
     }
     if (p.input_mean.size() > kMaxListedRows) t += fmt::format("  ({} more not listed)\n", p.input_mean.size() - kMaxListedRows);
     t += "outputs, error twist (v, omega) (y = mean + scale y_n; variances in normalised units)\n";
@@ -132,9 +163,10 @@ std::string format_text(const std::string& path, const ImageReport& r) {
     }
   }
   if (r.max_abs_input || r.max_abs_alpha) {
-    t += "training set\n";
-    if (r.max_abs_input) row("max |z|", fmt::format("{} (inputs in kernel coordinates)", *r.max_abs_input));
-    if (r.max_abs_alpha) row("max |alpha|", fmt::format("{}", *r.max_abs_alpha));
+    const bool sparse = r.header && is_sparse(*r.header);
+    t += sparse ? "inducing points\n" : "training set\n";
+    if (r.max_abs_input) row("max |z|", fmt::format("{} (points in kernel coordinates)", *r.max_abs_input));
+    if (r.max_abs_alpha) row(sparse ? "max |beta|" : "max |alpha|", fmt::format("{}", *r.max_abs_alpha));
   }
 
   if (!r.blocks.empty()) {
@@ -221,6 +253,10 @@ Json format_json(const std::string& path, const ImageReport& r) {
     header["version_minor"] = h.version_minor;
     header["header_size"] = h.header_size;
     header["total_size"] = h.total_size;
+    if (!is_v1(h)) {
+      header["variance_offset"] = h.variance_offset;
+      header["variance_rank"] = h.variance_rank;
+    }
   }
   header["trailing_bytes"] = r.trailing_bytes ? Json(*r.trailing_bytes) : Json(nullptr);
   header["crc32_stored"] = r.stored_crc ? Json(hex32(*r.stored_crc)) : Json(nullptr);
@@ -233,13 +269,18 @@ Json format_json(const std::string& path, const ImageReport& r) {
                  {"input_dims", h.input_dims},
                  {"output_dims", h.output_dims},
                  {"segments", h.segment_count}};
-    // An exact GP's image carries the rows it was fitted on.
-    j["fitted_rows"] = h.training_points;
+    j["version"] = fmt::format("{}.{}", h.version_major, h.version_minor);
+    j["model_kind"] = kind_json(model_kind_code(h), model_kind_name(model_kind_code(h)));
+    j["extra_inputs"] = h.extra_inputs;
+    j["fitted_rows"] = r.fitted_rows ? Json(*r.fitted_rows) : Json(nullptr);
     j["scalar_type"] = kind_json(h.scalar_type, scalar_name(h.scalar_type));
     j["kernel"] = kind_json(h.kernel_kind, kernel_name(h.kernel_kind));
     j["input_encoding"] = kind_json(h.input_encoding, encoding_name(h.input_encoding));
   } else {
     j["dims"] = nullptr;
+    j["version"] = nullptr;
+    j["model_kind"] = nullptr;
+    j["extra_inputs"] = nullptr;
     j["fitted_rows"] = nullptr;
     j["scalar_type"] = nullptr;
     j["kernel"] = nullptr;
@@ -267,9 +308,13 @@ Json format_json(const std::string& path, const ImageReport& r) {
     j["hyperparameters"] = {{"length_scales", floats_json(p.length_scale)},
                             {"signal_variance", floats_json(p.signal_variance)},
                             {"noise_variance", floats_json(p.noise_variance)}};
+    j["input_range"] = p.input_min.empty()
+                           ? Json(nullptr)
+                           : Json{{"input_min", floats_json(p.input_min)}, {"input_max", floats_json(p.input_max)}};
   } else {
     j["normalisation"] = nullptr;
     j["hyperparameters"] = nullptr;
+    j["input_range"] = nullptr;
   }
   j["training_set"] = {{"max_abs_kernel_coordinate", r.max_abs_input ? float_json(*r.max_abs_input) : Json(nullptr)},
                        {"max_abs_alpha", r.max_abs_alpha ? float_json(*r.max_abs_alpha) : Json(nullptr)}};

@@ -1,8 +1,8 @@
 #pragma once
-// cdcr inspect: everything inside a flash image (model/flash-image-v1.md) and
-// every check of the shared parser with its outcome. A damaged image is still
-// shown as far as it can be read; the command then exits 1 with one error line
-// naming the parser's status.
+// cdcr inspect: everything inside a flash image (model/flash-image-v2.md, or
+// a v1 image) and every check of the shared parser with its outcome. A
+// damaged image is still shown as far as it can be read; the command then
+// exits 1 with one error line naming the parser's status.
 
 #include <string>
 

@@ -1,8 +1,10 @@
 #include "c_source.hpp"
 
+#include <cstring>
 #include <stdexcept>
 
 #include "cdcr/model/crc32.hpp"
+#include "cdcr/model/flash_image.hpp"
 
 namespace cdcr::exporting {
 
@@ -63,7 +65,13 @@ std::string format_c_source(const std::uint8_t* bytes, std::size_t size, const C
   const std::string count = std::to_string(size);
   std::string out;
   out.reserve(size * 6 + 1024);
-  out += "/* Trained CDCR compensation model, flash image v1 (model/flash-image-v1.md).\n";
+  // The bytes are exported as they are, so the comment names their version.
+  std::uint16_t version_major = 0;
+  if (size >= model::image_field::version_major + 2) {
+    std::memcpy(&version_major, bytes + model::image_field::version_major, 2);
+  }
+  const std::string version = std::to_string(version_major);
+  out += "/* Trained CDCR compensation model, flash image v" + version + " (model/flash-image-v" + version + ".md).\n";
   if (!options.description.empty()) out += " * " + comment_safe(options.description) + "\n";
   if (size >= 4) {
     out += " * " + count + " bytes, CRC-32 " + hex_u32(model::crc32(bytes, size - 4)) + " (of all but the trailer).\n";

@@ -47,6 +47,16 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
       model.input_mean.size() != d || model.input_scale.size() != d || model.length_scales.size() != d) {
     throw std::invalid_argument("trained model has inconsistent dimensions");
   }
+  const bool range_given = model.input_min.size() > 0 || model.input_max.size() > 0;
+  if (range_given && (model.input_min.size() != d || model.input_max.size() != d)) {
+    throw std::invalid_argument("trained model's input range has the wrong dimension");
+  }
+  // An exact model's points are the rows it was fitted on; a sparse model's
+  // rows cannot be told from its inducing points.
+  if (model.kind == model::ImageModelKind::sparse_gp && model.fitted_rows == 0) {
+    throw std::invalid_argument("a sparse model must give the number of rows it was fitted on");
+  }
+  const std::uint32_t rows_fitted = model.fitted_rows != 0 ? model.fitted_rows : static_cast<std::uint32_t>(n);
   // The format's offsets are 32-bit; far beyond any flash, but the layout
   // arithmetic must not wrap.
   if (static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(d + model::kImageOutputs) * 4 > (1ull << 31)) {
@@ -69,6 +79,8 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   image.put<std::uint8_t>(scalar_type, static_cast<std::uint8_t>(model::ImageScalar::float32));
   image.put<std::uint8_t>(kernel_kind, static_cast<std::uint8_t>(model::ImageKernel::squared_exponential_ard));
   image.put<std::uint8_t>(input_encoding, static_cast<std::uint8_t>(model.encoding));
+  image.put<std::uint8_t>(model_kind, static_cast<std::uint8_t>(model.kind));
+  image.put<std::uint8_t>(extra_inputs, 0);  // the joint encoding only
   image.put<std::uint32_t>(geometry_offset, layout.geometry_offset);
   image.put<std::uint32_t>(parameters_offset, layout.parameters_offset);
   image.put<std::uint32_t>(inputs_offset, layout.inputs_offset);
@@ -99,6 +111,13 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   put_all(model.output_scale);
   put_all(model.signal_variance);
   put_all(model.noise_variance);
+  if (range_given) {
+    put_all(model.input_min);
+    put_all(model.input_max);
+  } else {
+    put_all(Eigen::VectorXd(model.inputs.colwise().minCoeff().transpose()));
+    put_all(Eigen::VectorXd(model.inputs.colwise().maxCoeff().transpose()));
+  }
 
   // Training inputs go in as kernel coordinates, computed in double and
   // rounded once.
@@ -122,6 +141,7 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   image.put<std::uint64_t>(meta + dataset_hash, model.dataset_hash);
   image.put<std::int64_t>(meta + created_unix_s, model.created_unix_s);
   image.put<std::uint32_t>(meta + validation_samples, model.validation_samples);
+  image.put<std::uint32_t>(meta + fitted_rows, rows_fitted);
   image.put<model::ImageMetrics>(meta + metrics, model.metrics);
   std::memcpy(image.data() + meta + trainer, model.trainer.data(), std::min<std::size_t>(model.trainer.size(), 32));
 

@@ -485,7 +485,7 @@ int main(int argc, char** argv) {
   bool ideal_robot = false;
   bool circle = false;
   double rate_hz = 1000.0, seconds = 2.0, circle_radius_mm = 40.0, circle_speed_mm_s = 50.0;
-  app.add_option("--image", image_path, "model image (flash image v1)");
+  app.add_option("--image", image_path, "model image (flash image v2, or v1)");
   auto* replay_option = app.add_option("--replay", replay_path, "cable-length CSV (dataset layout) to replay");
   app.add_option("--out", out_path, "pose CSV written by --replay");
   auto* sim_option = app.add_flag("--sim", run_sim, "close the loop with the simulated robot");

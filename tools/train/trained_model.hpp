@@ -1,6 +1,6 @@
 #pragma once
 // The trainer's result in double precision: everything the flash image holds,
-// before conversion to float32 kernel coordinates (see model/flash-image-v1.md).
+// before conversion to float32 kernel coordinates (see model/flash-image-v2.md).
 
 #include <cstdint>
 #include <string>
@@ -16,6 +16,7 @@ namespace cdcr::training {
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
 struct TrainedModel {
+  model::ImageModelKind kind = model::ImageModelKind::exact_gp;
   model::InputEncoding encoding = model::InputEncoding::bend_vector;
   model::RobotGeometry<double> geometry;
 
@@ -27,8 +28,18 @@ struct TrainedModel {
   Vector6d signal_variance = Vector6d::Ones();
   Vector6d noise_variance = Vector6d::Constant(1e-2);
 
-  Eigen::MatrixXd inputs;  // N x D encoded training inputs, not normalised
-  Eigen::MatrixXd alpha;   // N x 6, (K + noise I)^-1 y_n per normalised output
+  // The points: an exact model's N training inputs, a sparse model's M
+  // inducing inputs; and their weights, alpha or the sparse beta.
+  Eigen::MatrixXd inputs;  // points x D encoded inputs, not normalised
+  Eigen::MatrixXd alpha;   // points x 6; exact: (K + noise I)^-1 y_n per normalised output
+
+  // Data rows the model was fitted on; 0 means the points (an exact model's
+  // rows are its points). A sparse model must say.
+  std::uint32_t fitted_rows = 0;
+  // Per-input range of the fitted rows, raw encoded units (D each), so the
+  // board can tell when it extrapolates; empty: the writer takes the range of
+  // `inputs`, which is the fitted rows' for an exact model.
+  Eigen::VectorXd input_min, input_max;
 
   // Metadata carried into the image.
   std::uint64_t dataset_hash = 0;
@@ -37,8 +48,14 @@ struct TrainedModel {
   model::ImageMetrics metrics{};
   std::string trainer = "cdcr";
 
-  int training_points() const { return static_cast<int>(inputs.rows()); }
+  int training_points() const { return static_cast<int>(inputs.rows()); }  // the points, N or M
   int input_dims() const { return static_cast<int>(inputs.cols()); }
+
+  // Records the range of the rows the model is fitted on (rows x D, raw).
+  void set_input_range(const Eigen::MatrixXd& fitted_inputs) {
+    input_min = fitted_inputs.colwise().minCoeff().transpose();
+    input_max = fitted_inputs.colwise().maxCoeff().transpose();
+  }
 };
 
 }  // namespace cdcr::training

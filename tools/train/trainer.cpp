@@ -31,6 +31,7 @@ TrainedModel packaged(const TrainingSet& set, const model::RobotGeometry<double>
   m.output_mean = n.output_mean;
   m.output_scale = n.output_scale;
   m.inputs = set.inputs;
+  m.set_input_range(set.inputs);
   return m;
 }
 
@@ -122,6 +123,7 @@ TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& g
       search_x, search_y, default_initial_hyperparameters(static_cast<int>(x.cols())), options.search);
 
   TrainedModel m = packaged(set, geometry, options, n);
+  m.fitted_rows = static_cast<std::uint32_t>(set.size());
   m.length_scales = search.hyperparameters.length_scales;
   m.signal_variance.setConstant(search.hyperparameters.signal_variance);
   m.noise_variance.setConstant(search.hyperparameters.noise_variance);
@@ -135,6 +137,7 @@ TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& g
     p.hyperparameters = search.hyperparameters;
     p.inducing = inducing_inputs(x, selection.points, options.inducing_iterations, options.search.seed);
     const SparseGaussianProcess gp = SparseGaussianProcess::fit(x, y, p);
+    m.kind = model::ImageModelKind::sparse_gp;
     m.inputs = denormalised(p.inducing, n.input_mean, n.input_scale);
     m.alpha = gp.beta;
   }
@@ -155,10 +158,14 @@ TrainedModel refit(const TrainedModel& model, ModelKind kind, const TrainingSet&
   const Eigen::MatrixXd x = normalise(set.inputs, model.input_mean, model.input_scale);
   const Eigen::MatrixXd y = normalise(set.error_twists, model.output_mean, model.output_scale);
   TrainedModel refitted = model;
+  refitted.set_input_range(set.inputs);
+  refitted.fitted_rows = static_cast<std::uint32_t>(set.size());
   if (kind == ModelKind::exact) {
+    refitted.kind = model::ImageModelKind::exact_gp;
     refitted.inputs = set.inputs;
     refitted.alpha = GaussianProcess::fit(x, y, h).alpha;
   } else {
+    refitted.kind = model::ImageModelKind::sparse_gp;
     SparseParameters p;
     p.hyperparameters = h;
     p.inducing = normalise(model.inputs, model.input_mean, model.input_scale);

@@ -18,7 +18,7 @@ namespace cdcr::training {
 
 // How the six outputs share hyperparameters.
 //  * shared: one kernel for all six normalised outputs, one factorisation,
-//    and the only form flash image v1 holds (one kernel row per query on the
+//    and the only form the flash image holds (one kernel row per query on the
 //    board instead of six).
 //  * per_output: six independent GPs; kept to measure what sharing costs.
 enum class HyperparameterSharing { shared, per_output };

@@ -1,11 +1,14 @@
 #pragma once
-// Flash image format v1: the trained compensation model as the firmware reads
-// it. The full specification is model/flash-image-v1.md; this header is its
-// only parser, shared by the host tools and the firmware.
+// Flash image format v2: the trained compensation model as the firmware reads
+// it. The full specification is model/flash-image-v2.md (v1, which this
+// parser still reads, is model/flash-image-v1.md); this header is its only
+// parser and its only validator, shared by the host tools and the firmware.
 //
 // parse_image() validates everything before anything is used, and returns a
 // view whose arrays point into the caller's bytes (zero-copy: on a board the
-// bytes are the flash region itself).
+// bytes are the flash region itself). Given an ImageCheckSink it also reports
+// the outcome of every check it can evaluate, which is how `cdcr inspect`
+// shows all that is wrong with an image rather than only the first thing.
 
 #include <cmath>
 #include <cstddef>
@@ -23,8 +26,9 @@
 namespace cdcr::model {
 
 inline constexpr std::uint32_t kImageMagic = 0x50474443u;  // bytes "CDGP"
-inline constexpr std::uint16_t kImageVersionMajor = 1;
+inline constexpr std::uint16_t kImageVersionMajor = 2;      // what the exporter writes
 inline constexpr std::uint16_t kImageVersionMinor = 0;
+inline constexpr std::uint16_t kImageOldestVersionMajor = 1;  // still read: deployed boards carry v1 images
 inline constexpr std::uint32_t kImageHeaderSize = 64;
 inline constexpr std::uint32_t kImageBlockAlignment = 8;
 inline constexpr std::uint32_t kImageTrailerSize = 4;  // CRC-32
@@ -36,6 +40,25 @@ enum class ImageScalar : std::uint8_t { float32 = 1 };
 // signal and noise variance per output.
 enum class ImageKernel : std::uint8_t { squared_exponential_ard = 1 };
 
+// What the points and weights are. The board's mean is the same sum over the
+// points for both: sum_i w_i k(x, p_i).
+enum class ImageModelKind : std::uint8_t {
+  exact_gp = 1,   // the N training inputs, weights alpha = (K + noise I)^-1 y
+  sparse_gp = 2,  // M inducing inputs (Titsias VFE), weights the sparse posterior mean's beta
+};
+
+constexpr bool is_known(ImageModelKind kind) {
+  return kind == ImageModelKind::exact_gp || kind == ImageModelKind::sparse_gp;
+}
+
+constexpr const char* to_string(ImageModelKind kind) {
+  switch (kind) {
+    case ImageModelKind::exact_gp: return "exact-gp";
+    case ImageModelKind::sparse_gp: return "sparse-gp";
+  }
+  return "unknown";
+}
+
 enum class ImageStatus : std::uint8_t {
   ok = 0,
   truncated,            // fewer bytes than the header, or than its total_size
@@ -45,10 +68,10 @@ enum class ImageStatus : std::uint8_t {
   size_mismatch,        // total_size disagrees with the size the dims imply
   misaligned,           // buffer not 4-byte aligned, or a block offset not 8-byte aligned
   checksum_mismatch,
-  unsupported_kind,     // scalar type, kernel or input encoding this parser does not know
+  unsupported_kind,     // scalar type, kernel, input encoding, model kind or extra inputs this parser does not know
   over_capacity,        // dims beyond the caller's compile-time capacity
   non_finite_payload,   // NaN or Inf anywhere in the float payload
-  invalid_parameters,   // non-positive scale, variance or geometry
+  invalid_parameters,   // non-positive scale, variance or geometry; inverted input range; bad fitted_rows
 };
 
 constexpr const char* to_string(ImageStatus status) {
@@ -61,10 +84,11 @@ constexpr const char* to_string(ImageStatus status) {
     case ImageStatus::size_mismatch: return "image size does not match its dimensions";
     case ImageStatus::misaligned: return "image or one of its blocks is misaligned";
     case ImageStatus::checksum_mismatch: return "image checksum mismatch (corrupted)";
-    case ImageStatus::unsupported_kind: return "unsupported scalar type, kernel or input encoding";
+    case ImageStatus::unsupported_kind: return "unsupported scalar type, kernel, input encoding or model kind";
     case ImageStatus::over_capacity: return "image dimensions exceed this build's capacity";
     case ImageStatus::non_finite_payload: return "image payload contains NaN or Inf";
-    case ImageStatus::invalid_parameters: return "image holds a non-positive scale, variance or geometry value";
+    case ImageStatus::invalid_parameters:
+      return "image holds a non-positive scale, variance or geometry value, an inverted input range or a bad row count";
   }
   return "unknown image status";
 }
@@ -81,21 +105,25 @@ inline constexpr std::size_t version_major = 4;     // u16
 inline constexpr std::size_t version_minor = 6;     // u16
 inline constexpr std::size_t header_size = 8;       // u32
 inline constexpr std::size_t total_size = 12;       // u32, including the CRC trailer
-inline constexpr std::size_t training_points = 16;  // u32, N
-inline constexpr std::size_t input_dims = 20;       // u16, D = 2 * segments
+inline constexpr std::size_t training_points = 16;  // u32, the points: N training inputs or M inducing inputs
+inline constexpr std::size_t input_dims = 20;       // u16, D = 2 * segments + extra_inputs
 inline constexpr std::size_t output_dims = 22;      // u16, always 6
 inline constexpr std::size_t segment_count = 24;    // u16
 inline constexpr std::size_t scalar_type = 26;      // u8, ImageScalar
 inline constexpr std::size_t kernel_kind = 27;      // u8, ImageKernel
 inline constexpr std::size_t input_encoding = 28;   // u8, InputEncoding
-inline constexpr std::size_t reserved_a = 29;       // 3 bytes, zero
+inline constexpr std::size_t model_kind = 29;       // u8, ImageModelKind (v1: reserved, zero)
+inline constexpr std::size_t extra_inputs = 30;     // u8, inputs after the joint encoding (v1: reserved, zero)
+inline constexpr std::size_t reserved_a = 31;       // 1 byte, zero (v1: bytes 29..31)
 inline constexpr std::size_t geometry_offset = 32;  // u32
 inline constexpr std::size_t parameters_offset = 36;
 inline constexpr std::size_t inputs_offset = 40;
 inline constexpr std::size_t alpha_offset = 44;
 inline constexpr std::size_t metadata_offset = 48;
 inline constexpr std::size_t metadata_size = 52;    // u32, kImageMetadataSize
-inline constexpr std::size_t reserved_b = 56;       // 8 bytes, zero
+inline constexpr std::size_t variance_offset = 56;  // u32, zero in v2.0 (v1: reserved)
+inline constexpr std::size_t variance_rank = 60;    // u16, zero in v2.0 (v1: reserved)
+inline constexpr std::size_t reserved_b = 62;       // 2 bytes, zero (v1: bytes 56..63)
 }  // namespace image_field
 
 // Byte offsets inside the metadata block.
@@ -103,7 +131,7 @@ namespace image_metadata_field {
 inline constexpr std::size_t dataset_hash = 0;        // u64, FNV-1a of the training data file
 inline constexpr std::size_t created_unix_s = 8;      // i64
 inline constexpr std::size_t validation_samples = 16; // u32
-inline constexpr std::size_t reserved = 20;           // u32, zero
+inline constexpr std::size_t fitted_rows = 20;        // u32, data rows the model was fitted on (v1: reserved, zero)
 inline constexpr std::size_t metrics = 24;            // 8 x f32, ImageMetrics order
 inline constexpr std::size_t trainer = 56;            // 32 bytes, NUL-padded text
 }  // namespace image_metadata_field
@@ -121,9 +149,12 @@ struct ImageMetrics {
 
 // The validated image. Arrays point into the parsed bytes.
 struct ImageView {
+  std::uint16_t version_major;
   std::uint16_t version_minor;
   std::uint32_t total_size;
-  std::uint32_t training_points;  // N
+  ImageModelKind model_kind;      // exact_gp for a v1 image
+  std::uint32_t training_points;  // the points: N training inputs (exact) or M inducing inputs (sparse)
+  std::uint32_t fitted_rows;      // data rows behind the model; N for an exact model and for every v1 image
   int input_dims;                 // D
   int segment_count;
   InputEncoding encoding;
@@ -135,8 +166,10 @@ struct ImageView {
   const float* output_scale;    // 6
   const float* signal_variance; // 6, normalised output units
   const float* noise_variance;  // 6, normalised output units
-  const float* inputs;          // N x D row-major, kernel coordinates: (x - mean) / (scale * length_scale)
-  const float* alpha;           // N x 6 row-major: (K + noise I)^-1 y per normalised output
+  const float* input_min;       // D, raw input units, the fitted data's range; nullptr for a v1 image
+  const float* input_max;       // D, likewise
+  const float* inputs;          // points x D row-major, kernel coordinates: (x - mean) / (scale * length_scale)
+  const float* alpha;           // points x 6 row-major: the weights (alpha or beta) per normalised output
   std::uint64_t dataset_hash;
   std::int64_t created_unix_s;
   std::uint32_t validation_samples;
@@ -158,19 +191,22 @@ constexpr std::uint32_t align_up(std::uint32_t value, std::uint32_t alignment) {
   return (value + alignment - 1) / alignment * alignment;
 }
 
-constexpr std::uint32_t image_parameter_floats(std::uint32_t input_dims) {
-  return 3 * input_dims + 4 * kImageOutputs;
+// v2 appends input_min and input_max (D each) to v1's parameters. A major
+// version this parser does not know is laid out as the newest it does.
+constexpr std::uint32_t image_parameter_floats(std::uint32_t input_dims,
+                                               std::uint16_t version_major = kImageVersionMajor) {
+  return (version_major == 1 ? 3 : 5) * input_dims + 4 * kImageOutputs;
 }
 
 // Blocks follow the header in this order, each 8-byte aligned, then the CRC.
 constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t input_dims,
-                                   std::uint32_t segment_count) {
+                                   std::uint32_t segment_count, std::uint16_t version_major = kImageVersionMajor) {
   ImageLayout layout{};
   std::uint32_t at = kImageHeaderSize;
   layout.geometry_offset = at;
   at = align_up(at + 4 * 3 * segment_count, kImageBlockAlignment);
   layout.parameters_offset = at;
-  at = align_up(at + 4 * image_parameter_floats(input_dims), kImageBlockAlignment);
+  at = align_up(at + 4 * image_parameter_floats(input_dims, version_major), kImageBlockAlignment);
   layout.inputs_offset = at;
   at = align_up(at + 4 * training_points * input_dims, kImageBlockAlignment);
   layout.alpha_offset = at;
@@ -181,121 +217,456 @@ constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t 
   return layout;
 }
 
+// --- reporting every check -----------------------------------------------------
+
+// The checks, in the order parse_image() first evaluates them. Each maps to
+// one ImageStatus, except that several checks share invalid_parameters.
+enum class ImageCheckId : std::uint8_t {
+  size,         // truncated
+  magic,        // bad_magic
+  version,      // unsupported_version
+  header,       // bad_header
+  alignment,    // misaligned
+  checksum,     // checksum_mismatch
+  kind,         // unsupported_kind
+  capacity,     // over_capacity
+  layout,       // size_mismatch
+  finite,       // non_finite_payload
+  positive,     // invalid_parameters
+  ranges,       // invalid_parameters, v2: input_min <= input_max
+  fitted_rows,  // invalid_parameters, v2: the metadata's fitted_rows
+};
+inline constexpr int kImageCheckCount = static_cast<int>(ImageCheckId::fitted_rows) + 1;
+
+constexpr const char* to_string(ImageCheckId check) {
+  switch (check) {
+    case ImageCheckId::size: return "size";
+    case ImageCheckId::magic: return "magic";
+    case ImageCheckId::version: return "version";
+    case ImageCheckId::header: return "header";
+    case ImageCheckId::alignment: return "alignment";
+    case ImageCheckId::checksum: return "checksum";
+    case ImageCheckId::kind: return "kind";
+    case ImageCheckId::capacity: return "capacity";
+    case ImageCheckId::layout: return "layout";
+    case ImageCheckId::finite: return "finite";
+    case ImageCheckId::positive: return "positive";
+    case ImageCheckId::ranges: return "ranges";
+    case ImageCheckId::fitted_rows: return "fitted_rows";
+  }
+  return "unknown";
+}
+
+// How a finding's value relates to its expected value when the check passes.
+enum class ImageExpectation : std::uint8_t {
+  equal,        // value == expected
+  at_least,     // value >= expected
+  at_most,      // value <= expected
+  multiple_of,  // value is a multiple of expected
+  known,        // value is a code this parser knows; expected is the newest one
+  finite,       // value is neither NaN nor Inf
+  positive,     // value > 0
+};
+
+// One evaluated condition. Values are doubles so that one type holds every
+// u32 field, a float of the payload, and a NaN as it is.
+struct ImageFinding {
+  ImageCheckId check;
+  bool passed;
+  ImageStatus status;     // what the condition makes parse_image() return when it fails first
+  const char* field;      // a header or metadata field, a block, or a parameter array
+  std::int32_t index;     // element of an array field, or byte offset of a reserved byte; -1 for a single value
+  std::uint32_t count;    // values the finding covers: an array that passed as a whole, else 1
+  double value;           // what the image holds
+  double expected;        // what the expectation compares it to
+  ImageExpectation expectation;
+};
+
+// Receives the findings of parse_image(..., every_check) in evaluation order.
+// The first failed finding is the one whose status parse_image() returns.
+class ImageCheckSink {
+ public:
+  virtual void on_finding(const ImageFinding& finding) = 0;
+
+ protected:
+  ~ImageCheckSink() = default;
+};
+
 namespace detail {
 inline std::uint16_t read_u16(const std::uint8_t* p) { std::uint16_t v; std::memcpy(&v, p, 2); return v; }
 inline std::uint32_t read_u32(const std::uint8_t* p) { std::uint32_t v; std::memcpy(&v, p, 4); return v; }
 inline std::uint64_t read_u64(const std::uint8_t* p) { std::uint64_t v; std::memcpy(&v, p, 8); return v; }
 
-inline bool all_finite(const float* values, std::uint32_t count) {
-  for (std::uint32_t i = 0; i < count; ++i) {
-    if (!std::isfinite(values[i])) return false;
+// The firmware's run: the first failure decides, nothing after it is read.
+// The finding's details are unused here and compile away.
+struct StopAtFirstFailure {
+  static constexpr bool kEveryCheck = false;
+  ImageStatus status = ImageStatus::ok;
+
+  bool expect(bool passed, ImageCheckId, ImageStatus failure, const char*, std::int32_t, double, double,
+              ImageExpectation, std::uint32_t = 1) {
+    if (!passed) status = failure;
+    return passed;
   }
+  // Names that only a report needs stay out of the firmware's flash.
+  static constexpr const char* name(const char*) { return nullptr; }
+};
+
+// The host tools' run: every outcome goes to the sink and evaluation goes on
+// (as far as the bytes can be read safely); the first failure still decides.
+struct ReportEveryCheck {
+  static constexpr bool kEveryCheck = true;
+  ImageCheckSink& sink;
+  ImageStatus status = ImageStatus::ok;
+
+  bool expect(bool passed, ImageCheckId check, ImageStatus failure, const char* field, std::int32_t index,
+              double value, double expected, ImageExpectation expectation, std::uint32_t count = 1) {
+    if (!passed && status == ImageStatus::ok) status = failure;
+    sink.on_finding(ImageFinding{check, passed, failure, field, index, count, value, expected, expectation});
+    return true;
+  }
+  static constexpr const char* name(const char* field) { return field; }
+};
+
+// Each value against `good`; a failure per bad value, or one pass for all.
+// Returns false where a StopAtFirstFailure run must stop.
+template <typename Run, typename Good>
+bool expect_each(Run& run, const float* values, std::uint32_t count, Good good, ImageCheckId check,
+                 ImageStatus failure, const char* field, ImageExpectation expectation) {
+  bool all_good = true;
+  for (std::uint32_t i = 0; i < count; ++i) {
+    if (good(values[i])) continue;
+    all_good = false;
+    if (!run.expect(false, check, failure, field, static_cast<std::int32_t>(i), values[i], 0.0, expectation)) {
+      return false;
+    }
+  }
+  if (all_good) run.expect(true, check, failure, field, -1, 0.0, 0.0, expectation, count);
   return true;
 }
-inline bool all_positive(const float* values, std::uint32_t count) {
-  for (std::uint32_t i = 0; i < count; ++i) {
-    if (!(values[i] > 0.0f)) return false;
-  }
-  return true;
-}
-}  // namespace detail
+
+inline bool is_finite(float value) { return std::isfinite(value); }
+inline bool is_positive(float value) { return value > 0.0f; }
 
 // Checks run from what is needed to read the rest (size, magic, version,
 // header) to the integrity check and then to the meaning of the payload, so
-// every rejection reports the first thing that is wrong.
-inline ImageStatus parse_image(const std::uint8_t* bytes, std::size_t size, ImageView& view,
-                               const ImageCapacity& capacity = {}) {
+// every rejection reports the first thing that is wrong. A reporting run
+// goes past failures, but evaluates a check only where its bytes lie inside
+// the buffer (and floats only where they are aligned).
+template <typename Run>
+ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& view, const ImageCapacity& capacity,
+                        Run& run) {
   using namespace image_field;
-  using detail::read_u16;
-  using detail::read_u32;
-  if (bytes == nullptr || size < kImageHeaderSize) return ImageStatus::truncated;
-  if (read_u32(bytes + magic) != kImageMagic) return ImageStatus::bad_magic;
-  if (read_u16(bytes + version_major) != kImageVersionMajor) return ImageStatus::unsupported_version;
-  if (read_u32(bytes + header_size) != kImageHeaderSize) return ImageStatus::bad_header;
+  using Check = ImageCheckId;
+  using Status = ImageStatus;
+  using Expect = ImageExpectation;
+
+  const bool whole_header = bytes != nullptr && size >= kImageHeaderSize;
+  if (!run.expect(whole_header, Check::size, Status::truncated, "file_size", -1, static_cast<double>(size),
+                  kImageHeaderSize, Expect::at_least)) {
+    return run.status;
+  }
+  // A file too short for a header may still show what it is.
+  if (bytes != nullptr && size >= magic + 4) {
+    const std::uint32_t declared_magic = read_u32(bytes + magic);
+    if (!run.expect(declared_magic == kImageMagic, Check::magic, Status::bad_magic, "magic", -1, declared_magic,
+                    kImageMagic, Expect::equal)) {
+      return run.status;
+    }
+  }
+  std::uint16_t major = kImageVersionMajor;
+  if (bytes != nullptr && size >= version_major + 2) {
+    major = read_u16(bytes + version_major);
+    const bool readable = major >= kImageOldestVersionMajor && major <= kImageVersionMajor;
+    if (!run.expect(readable, Check::version, Status::unsupported_version, "version_major", -1, major,
+                    kImageVersionMajor, Expect::known)) {
+      return run.status;
+    }
+  }
+  if (!whole_header) return run.status;
+  const bool v1 = major == 1;
+
+  const std::uint32_t declared_header = read_u32(bytes + header_size);
+  if (!run.expect(declared_header == kImageHeaderSize, Check::header, Status::bad_header, "header_size", -1,
+                  declared_header, kImageHeaderSize, Expect::equal)) {
+    return run.status;
+  }
   const std::uint32_t declared_total = read_u32(bytes + total_size);
-  if (declared_total < kImageHeaderSize + kImageTrailerSize) return ImageStatus::bad_header;
-  if (declared_total > size) return ImageStatus::truncated;
-  if (reinterpret_cast<std::uintptr_t>(bytes) % alignof(float) != 0) return ImageStatus::misaligned;
-
-  std::uint32_t stored_crc = read_u32(bytes + declared_total - kImageTrailerSize);
-  if (crc32(bytes, declared_total - kImageTrailerSize) != stored_crc) return ImageStatus::checksum_mismatch;
-
-  for (std::size_t i = 0; i < 3; ++i) {
-    if (bytes[reserved_a + i] != 0) return ImageStatus::bad_header;
+  const bool total_holds_trailer = declared_total >= kImageHeaderSize + kImageTrailerSize;
+  if (!run.expect(total_holds_trailer, Check::header, Status::bad_header, "total_size", -1, declared_total,
+                  kImageHeaderSize + kImageTrailerSize, Expect::at_least)) {
+    return run.status;
   }
-  for (std::size_t i = 0; i < 8; ++i) {
-    if (bytes[reserved_b + i] != 0) return ImageStatus::bad_header;
+  if (total_holds_trailer && !run.expect(declared_total <= size, Check::size, Status::truncated, "total_size", -1,
+                                         declared_total, static_cast<double>(size), Expect::at_most)) {
+    return run.status;
   }
-  if (bytes[scalar_type] != static_cast<std::uint8_t>(ImageScalar::float32) ||
-      bytes[kernel_kind] != static_cast<std::uint8_t>(ImageKernel::squared_exponential_ard) ||
-      !is_known(static_cast<InputEncoding>(bytes[input_encoding]))) {
-    return ImageStatus::unsupported_kind;
+  const std::uintptr_t address = reinterpret_cast<std::uintptr_t>(bytes);
+  const bool aligned = address % alignof(float) == 0;
+  if (!run.expect(aligned, Check::alignment, Status::misaligned, "buffer_address", -1, static_cast<double>(address),
+                  alignof(float), Expect::multiple_of)) {
+    return run.status;
+  }
+
+  if (total_holds_trailer && declared_total <= size) {
+    const std::uint32_t stored_crc = read_u32(bytes + declared_total - kImageTrailerSize);
+    const std::uint32_t computed_crc = crc32(bytes, declared_total - kImageTrailerSize);
+    if (!run.expect(stored_crc == computed_crc, Check::checksum, Status::checksum_mismatch, "crc32", -1, stored_crc,
+                    computed_crc, Expect::equal)) {
+      return run.status;
+    }
+  }
+
+  // v2 gives bytes 29 and 30 a meaning, and bytes 56..61 a meaning that v2.0
+  // requires to be zero; reserved bytes are zero in both versions.
+  for (std::size_t at = v1 ? model_kind : reserved_a; at < geometry_offset; ++at) {
+    if (!run.expect(bytes[at] == 0, Check::header, Status::bad_header, "reserved", static_cast<std::int32_t>(at),
+                    bytes[at], 0, Expect::equal)) {
+      return run.status;
+    }
+  }
+  if (!v1) {
+    // Room for a predictive-variance factor that a later minor version
+    // defines; until then an image carrying one is not what this parser reads.
+    const std::uint32_t declared_variance_offset = read_u32(bytes + variance_offset);
+    const std::uint16_t declared_variance_rank = read_u16(bytes + variance_rank);
+    if (!run.expect(declared_variance_offset == 0, Check::header, Status::bad_header, "variance_offset", -1,
+                    declared_variance_offset, 0, Expect::equal) ||
+        !run.expect(declared_variance_rank == 0, Check::header, Status::bad_header, "variance_rank", -1,
+                    declared_variance_rank, 0, Expect::equal)) {
+      return run.status;
+    }
+  }
+  for (std::size_t at = v1 ? variance_offset : reserved_b; at < kImageHeaderSize; ++at) {
+    if (!run.expect(bytes[at] == 0, Check::header, Status::bad_header, "reserved", static_cast<std::int32_t>(at),
+                    bytes[at], 0, Expect::equal)) {
+      return run.status;
+    }
+  }
+
+  if (!run.expect(bytes[scalar_type] == static_cast<std::uint8_t>(ImageScalar::float32), Check::kind,
+                  Status::unsupported_kind, "scalar_type", -1, bytes[scalar_type],
+                  static_cast<std::uint8_t>(ImageScalar::float32), Expect::equal) ||
+      !run.expect(bytes[kernel_kind] == static_cast<std::uint8_t>(ImageKernel::squared_exponential_ard), Check::kind,
+                  Status::unsupported_kind, "kernel_kind", -1, bytes[kernel_kind],
+                  static_cast<std::uint8_t>(ImageKernel::squared_exponential_ard), Expect::equal) ||
+      !run.expect(is_known(static_cast<InputEncoding>(bytes[input_encoding])), Check::kind, Status::unsupported_kind,
+                  "input_encoding", -1, bytes[input_encoding], static_cast<std::uint8_t>(InputEncoding::bend_vector),
+                  Expect::known)) {
+    return run.status;
+  }
+  const ImageModelKind kind = v1 ? ImageModelKind::exact_gp : static_cast<ImageModelKind>(bytes[model_kind]);
+  const std::uint32_t extra = v1 ? 0 : bytes[extra_inputs];
+  if (!v1) {
+    // The payload input a later change adds; this parser evaluates only the
+    // joint encoding.
+    if (!run.expect(is_known(kind), Check::kind, Status::unsupported_kind, "model_kind", -1, bytes[model_kind],
+                    static_cast<std::uint8_t>(ImageModelKind::sparse_gp), Expect::known) ||
+        !run.expect(extra == 0, Check::kind, Status::unsupported_kind, "extra_inputs", -1, extra, 0, Expect::equal)) {
+      return run.status;
+    }
   }
 
   const std::uint32_t n = read_u32(bytes + training_points);
   const std::uint32_t d = read_u16(bytes + input_dims);
   const std::uint32_t segments = read_u16(bytes + segment_count);
-  if (n == 0 || segments == 0 || d != 2 * segments || read_u16(bytes + output_dims) != kImageOutputs) {
-    return ImageStatus::bad_header;
+  const std::uint32_t outputs = read_u16(bytes + output_dims);
+  if (!run.expect(n >= 1, Check::header, Status::bad_header, "training_points", -1, n, 1, Expect::at_least) ||
+      !run.expect(segments >= 1, Check::header, Status::bad_header, "segment_count", -1, segments, 1,
+                  Expect::at_least) ||
+      !run.expect(d == 2 * segments + extra, Check::header, Status::bad_header, "input_dims", -1, d,
+                  2 * segments + extra, Expect::equal) ||
+      !run.expect(outputs == kImageOutputs, Check::header, Status::bad_header, "output_dims", -1, outputs,
+                  kImageOutputs, Expect::equal)) {
+    return run.status;
   }
-  if (n > capacity.max_training_points || segments > capacity.max_segments) return ImageStatus::over_capacity;
+  if (!run.expect(n <= capacity.max_training_points, Check::capacity, Status::over_capacity, "training_points", -1, n,
+                  capacity.max_training_points, Expect::at_most) ||
+      !run.expect(segments <= capacity.max_segments, Check::capacity, Status::over_capacity, "segment_count", -1,
+                  segments, capacity.max_segments, Expect::at_most)) {
+    return run.status;
+  }
 
+  constexpr const char* offset_names[] = {"geometry_offset", "parameters_offset", "inputs_offset", "alpha_offset",
+                                          "metadata_offset"};
   const std::uint32_t offsets[] = {read_u32(bytes + geometry_offset), read_u32(bytes + parameters_offset),
                                    read_u32(bytes + inputs_offset), read_u32(bytes + alpha_offset),
                                    read_u32(bytes + metadata_offset)};
-  for (std::uint32_t offset : offsets) {
-    if (offset % kImageBlockAlignment != 0) return ImageStatus::misaligned;
+  for (int i = 0; i < 5; ++i) {
+    if (!run.expect(offsets[i] % kImageBlockAlignment == 0, Check::alignment, Status::misaligned, offset_names[i], -1,
+                    offsets[i], kImageBlockAlignment, Expect::multiple_of)) {
+      return run.status;
+    }
   }
   // Under a generous capacity the 32-bit layout arithmetic below could wrap
   // into a size that matches; dims whose arrays alone exceed the image cannot.
-  if (std::uint64_t{n} * (d + kImageOutputs) * 4 > declared_total) return ImageStatus::size_mismatch;
-  const ImageLayout expected = image_layout(n, d, segments);
-  if (declared_total != expected.total_size || read_u32(bytes + metadata_size) != kImageMetadataSize ||
-      offsets[0] != expected.geometry_offset || offsets[1] != expected.parameters_offset ||
-      offsets[2] != expected.inputs_offset || offsets[3] != expected.alpha_offset ||
-      offsets[4] != expected.metadata_offset) {
-    return ImageStatus::size_mismatch;
+  const std::uint64_t array_bytes = std::uint64_t{n} * (d + kImageOutputs) * 4;
+  if (!run.expect(array_bytes <= declared_total, Check::layout, Status::size_mismatch, "total_size", -1,
+                  declared_total, static_cast<double>(array_bytes), Expect::at_least)) {
+    return run.status;
+  }
+  if (array_bytes <= declared_total) {
+    const ImageLayout expected = image_layout(n, d, segments, major);
+    const std::uint32_t expected_offsets[] = {expected.geometry_offset, expected.parameters_offset,
+                                              expected.inputs_offset, expected.alpha_offset,
+                                              expected.metadata_offset};
+    if (!run.expect(declared_total == expected.total_size, Check::layout, Status::size_mismatch, "total_size", -1,
+                    declared_total, expected.total_size, Expect::equal)) {
+      return run.status;
+    }
+    const std::uint32_t declared_metadata_size = read_u32(bytes + metadata_size);
+    if (!run.expect(declared_metadata_size == kImageMetadataSize, Check::layout, Status::size_mismatch,
+                    "metadata_size", -1, declared_metadata_size, kImageMetadataSize, Expect::equal)) {
+      return run.status;
+    }
+    for (int i = 0; i < 5; ++i) {
+      if (!run.expect(offsets[i] == expected_offsets[i], Check::layout, Status::size_mismatch, offset_names[i], -1,
+                      offsets[i], expected_offsets[i], Expect::equal)) {
+        return run.status;
+      }
+    }
   }
 
-  const auto floats_at = [bytes](std::uint32_t offset) { return reinterpret_cast<const float*>(bytes + offset); };
+  // From here on a stopping run has verified every block to lie where the
+  // dims put it, inside the image. A reporting run reads a block where the
+  // header puts it, if it lies inside the buffer.
+  const auto block = [&](std::uint32_t offset, std::uint64_t floats) -> const float* {
+    if constexpr (Run::kEveryCheck) {
+      if (!aligned || offset % alignof(float) != 0 || offset > size || 4 * floats > size - offset) return nullptr;
+    }
+    return reinterpret_cast<const float*>(bytes + offset);
+  };
+  const std::uint32_t parameter_floats = image_parameter_floats(d, major);
+  const float* geometry = block(offsets[0], 3 * std::uint64_t{segments});
+  const float* parameters = block(offsets[1], parameter_floats);
+  const float* inputs = block(offsets[2], std::uint64_t{n} * d);
+  const float* alpha = block(offsets[3], std::uint64_t{n} * kImageOutputs);
+  const std::uint8_t* metadata =
+      reinterpret_cast<const std::uint8_t*>(block(offsets[4], kImageMetadataSize / sizeof(float)));
+
+  const struct {
+    const char* name;
+    const float* values;
+    std::uint32_t count;
+  } payload[] = {{Run::name("geometry"), geometry, 3 * segments},
+                 {Run::name("parameters"), parameters, parameter_floats},
+                 {Run::name("inputs"), inputs, n * d},
+                 {Run::name("alpha"), alpha, n * kImageOutputs}};
+  for (const auto& values : payload) {
+    if (values.values != nullptr && !expect_each(run, values.values, values.count, is_finite, Check::finite,
+                                                 Status::non_finite_payload, values.name, Expect::finite)) {
+      return run.status;
+    }
+  }
+
+  // The parameter arrays, back to back; none where the block is not readable.
+  const auto parameter = [parameters](std::uint32_t first) {
+    return parameters != nullptr ? parameters + first : nullptr;
+  };
+  const float* input_scale = parameter(d);
+  const float* length_scale = parameter(2 * d);
+  const float* output_mean = parameter(3 * d);
+  const float* output_scale = parameter(3 * d + kImageOutputs);
+  const float* signal_variance = parameter(3 * d + 2 * kImageOutputs);
+  const float* noise_variance = parameter(3 * d + 3 * kImageOutputs);
+  const struct {
+    const char* name;
+    const float* values;
+    std::uint32_t count;
+  } must_be_positive[] = {{Run::name("geometry"), geometry, 3 * segments},
+                          {Run::name("input_scale"), input_scale, d},
+                          {Run::name("length_scale"), length_scale, d},
+                          {Run::name("output_scale"), output_scale, kImageOutputs},
+                          {Run::name("signal_variance"), signal_variance, kImageOutputs},
+                          {Run::name("noise_variance"), noise_variance, kImageOutputs}};
+  for (const auto& values : must_be_positive) {
+    if (values.values != nullptr && !expect_each(run, values.values, values.count, is_positive, Check::positive,
+                                                 Status::invalid_parameters, values.name, Expect::positive)) {
+      return run.status;
+    }
+  }
+
+  const float* input_min = v1 ? nullptr : parameter(3 * d + 4 * kImageOutputs);
+  const float* input_max = v1 ? nullptr : parameter(4 * d + 4 * kImageOutputs);
+  if (input_min != nullptr) {
+    bool all_ordered = true;
+    for (std::uint32_t i = 0; i < d; ++i) {
+      if (input_min[i] <= input_max[i]) continue;
+      all_ordered = false;
+      if (!run.expect(false, Check::ranges, Status::invalid_parameters, "input_min", static_cast<std::int32_t>(i),
+                      input_min[i], input_max[i], Expect::at_most)) {
+        return run.status;
+      }
+    }
+    if (all_ordered) {
+      run.expect(true, Check::ranges, Status::invalid_parameters, "input_min", -1, 0, 0, Expect::at_most, d);
+    }
+  }
+
+  std::uint32_t fitted = n;  // a v1 image was fitted on exactly the rows it carries
+  if (!v1 && metadata != nullptr) {
+    fitted = read_u32(metadata + image_metadata_field::fitted_rows);
+    if (!run.expect(fitted >= 1, Check::fitted_rows, Status::invalid_parameters, "fitted_rows", -1, fitted, 1,
+                    Expect::at_least)) {
+      return run.status;
+    }
+    // An exact model's points are its rows; a sparse model's rows may be
+    // any number, its points summarise them.
+    if (kind == ImageModelKind::exact_gp &&
+        !run.expect(fitted == n, Check::fitted_rows, Status::invalid_parameters, "fitted_rows", -1, fitted, n,
+                    Expect::equal)) {
+      return run.status;
+    }
+  }
+  if (run.status != Status::ok) return run.status;
+
   ImageView v{};
+  v.version_major = major;
   v.version_minor = read_u16(bytes + version_minor);
   v.total_size = declared_total;
+  v.model_kind = kind;
   v.training_points = n;
+  v.fitted_rows = fitted;
   v.input_dims = static_cast<int>(d);
   v.segment_count = static_cast<int>(segments);
   v.encoding = static_cast<InputEncoding>(bytes[input_encoding]);
-  v.geometry = floats_at(expected.geometry_offset);
-  const float* parameters = floats_at(expected.parameters_offset);
+  v.geometry = geometry;
   v.input_mean = parameters;
-  v.input_scale = parameters + d;
-  v.length_scale = parameters + 2 * d;
-  v.output_mean = parameters + 3 * d;
-  v.output_scale = v.output_mean + kImageOutputs;
-  v.signal_variance = v.output_scale + kImageOutputs;
-  v.noise_variance = v.signal_variance + kImageOutputs;
-  v.inputs = floats_at(expected.inputs_offset);
-  v.alpha = floats_at(expected.alpha_offset);
-
-  const std::uint8_t* metadata = bytes + expected.metadata_offset;
-  v.dataset_hash = detail::read_u64(metadata + image_metadata_field::dataset_hash);
-  v.created_unix_s = static_cast<std::int64_t>(detail::read_u64(metadata + image_metadata_field::created_unix_s));
+  v.input_scale = input_scale;
+  v.length_scale = length_scale;
+  v.output_mean = output_mean;
+  v.output_scale = output_scale;
+  v.signal_variance = signal_variance;
+  v.noise_variance = noise_variance;
+  v.input_min = input_min;
+  v.input_max = input_max;
+  v.inputs = inputs;
+  v.alpha = alpha;
+  v.dataset_hash = read_u64(metadata + image_metadata_field::dataset_hash);
+  v.created_unix_s = static_cast<std::int64_t>(read_u64(metadata + image_metadata_field::created_unix_s));
   v.validation_samples = read_u32(metadata + image_metadata_field::validation_samples);
   std::memcpy(&v.metrics, metadata + image_metadata_field::metrics, sizeof(ImageMetrics));
   v.trainer = reinterpret_cast<const char*>(metadata + image_metadata_field::trainer);
-
-  if (!detail::all_finite(v.geometry, 3 * segments) || !detail::all_finite(parameters, image_parameter_floats(d)) ||
-      !detail::all_finite(v.inputs, n * d) || !detail::all_finite(v.alpha, n * kImageOutputs)) {
-    return ImageStatus::non_finite_payload;
-  }
-  if (!detail::all_positive(v.geometry, 3 * segments) || !detail::all_positive(v.input_scale, d) ||
-      !detail::all_positive(v.length_scale, d) || !detail::all_positive(v.output_scale, kImageOutputs) ||
-      !detail::all_positive(v.signal_variance, kImageOutputs) ||
-      !detail::all_positive(v.noise_variance, kImageOutputs)) {
-    return ImageStatus::invalid_parameters;
-  }
   view = v;
-  return ImageStatus::ok;
+  return Status::ok;
+}
+}  // namespace detail
+
+// Returns the first failure, in the order of the specification's validation
+// table, and fills `view` only for a valid image.
+inline ImageStatus parse_image(const std::uint8_t* bytes, std::size_t size, ImageView& view,
+                               const ImageCapacity& capacity = {}) {
+  detail::StopAtFirstFailure run;
+  return detail::check_image(bytes, size, view, capacity, run);
+}
+
+// The same verdict; with a sink, every check that can be evaluated is, and
+// its findings go to `every_check` (the firmware never needs this).
+inline ImageStatus parse_image(const std::uint8_t* bytes, std::size_t size, ImageView& view,
+                               const ImageCapacity& capacity, ImageCheckSink* every_check) {
+  if (every_check == nullptr) return parse_image(bytes, size, view, capacity);
+  detail::ReportEveryCheck run{*every_check};
+  return detail::check_image(bytes, size, view, capacity, run);
 }
 
 }  // namespace cdcr::model
