@@ -900,7 +900,7 @@ TEST(TrainerInputRange, IsTheRangeOfTheRowsTheModelIsFittedOn) {
   EXPECT_EQ(trained.input_min, Eigen::VectorXd(searched.inputs.colwise().minCoeff().transpose()));
   EXPECT_EQ(trained.input_max, Eigen::VectorXd(searched.inputs.colwise().maxCoeff().transpose()));
 
-  const training::TrainedModel refitted = training::refit(trained, all);
+  const training::TrainedModel refitted = training::refit(trained, training::ModelKind::exact, all);
   EXPECT_EQ(refitted.input_min, Eigen::VectorXd(all.inputs.colwise().minCoeff().transpose()));
   EXPECT_EQ(refitted.input_max, Eigen::VectorXd(all.inputs.colwise().maxCoeff().transpose()));
   const Bytes image = exporting::write_image(refitted);

@@ -223,7 +223,10 @@ TEST(TrainEndToEnd, TooManyRowsForTheBoardGiveASparseModel) {
   EXPECT_LE(trained.at("image").at("bytes").get<int>(), 12 * 1024);
   run = run_cdcr("inspect " + sparse_image + " --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  EXPECT_EQ(nlohmann::json::parse(run.out).at("dims").at("training_points").get<int>(), points) << run.out;
+  const nlohmann::json inspected = nlohmann::json::parse(run.out);
+  EXPECT_EQ(inspected.at("dims").at("training_points").get<int>(), points) << run.out;
+  EXPECT_EQ(inspected.at("model_kind").at("code").get<int>(), 2) << run.out;
+  EXPECT_EQ(inspected.at("fitted_rows").get<int>(), 600) << run.out;
 
   run = run_cdcr("train --data " + data + " --out " + exact_image + " --holdout 0 --restarts 0 --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
