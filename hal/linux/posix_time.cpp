@@ -25,25 +25,6 @@ void PosixPeriodicTimer::start(std::int64_t period_ns) {
   overruns_ = 0;
 }
 
-void PosixPeriodicTimer::set_warm_up(std::int64_t lead_ns, void (*hook)(void*), void* context) {
-  warm_up_lead_ns_ = hook != nullptr && lead_ns > 0 ? lead_ns : 0;
-  warm_up_hook_ = hook;
-  warm_up_context_ = context;
-}
-
-namespace {
-
-void sleep_until(std::int64_t deadline_ns) {
-  const timespec deadline{static_cast<time_t>(deadline_ns / kNanosecondsPerSecond),
-                          static_cast<long>(deadline_ns % kNanosecondsPerSecond)};
-  // The deadline is absolute, so a sleep cut short by a signal resumes to the
-  // same instant.
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
-  }
-}
-
-}  // namespace
-
 hal::TimerTick PosixPeriodicTimer::wait_next() {
   hal::TimerTick tick;
   // A release already in the past is missed, not served late: serving it
@@ -55,13 +36,11 @@ hal::TimerTick PosixPeriodicTimer::wait_next() {
     tick.missed_releases = behind > 0xFFFFFFFF ? 0xFFFFFFFFu : std::uint32_t(behind);
   }
   overruns_ += tick.missed_releases;
-  if (warm_up_lead_ns_ > 0 && next_release_ns_ - now_ns > warm_up_lead_ns_) {
-    sleep_until(next_release_ns_ - warm_up_lead_ns_);
-    warm_up_hook_(warm_up_context_);
-    while (monotonic_now_ns() < next_release_ns_) {
-    }
-  } else {
-    sleep_until(next_release_ns_);
+  const timespec deadline{static_cast<time_t>(next_release_ns_ / kNanosecondsPerSecond),
+                          static_cast<long>(next_release_ns_ % kNanosecondsPerSecond)};
+  // The deadline is absolute, so a sleep cut short by a signal resumes to the
+  // same instant.
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
   }
   tick.release_ns = next_release_ns_;
   next_release_ns_ += period_ns_;

@@ -7,8 +7,6 @@
 #include <string>
 #include <unistd.h>
 
-#include <vector>
-
 #include <gtest/gtest.h>
 
 #include "linux/mapped_model_storage.hpp"
@@ -85,40 +83,6 @@ TEST(PosixPeriodicTimer, CountsEveryMissedRelease) {
   EXPECT_GE(late.missed_releases, 3u);
   EXPECT_EQ(late.release_ns - first.release_ns, std::int64_t(late.missed_releases + 1) * kPeriodNs);
   EXPECT_EQ(timer.overruns(), late.missed_releases);
-}
-
-// The warm-up runs before the release it prepares, and the release is never
-// served early. A loaded host may wake too late for a warm-up (within the
-// lead of the release), which is then skipped, so only some are required.
-TEST(PosixPeriodicTimer, WarmsUpBeforeReleasesAndNeverReleasesEarly) {
-  PosixMonotonicClock clock;
-  PosixPeriodicTimer timer(clock);
-  struct Record {
-    const PosixMonotonicClock* clock;
-    std::vector<std::int64_t> at_ns;
-  } record{&clock, {}};
-  timer.set_warm_up(
-      500'000, [](void* context) {
-        auto* r = static_cast<Record*>(context);
-        r->at_ns.push_back(r->clock->now_ns());
-      },
-      &record);
-  constexpr std::int64_t kPeriodNs = 2'000'000;
-  timer.start(kPeriodNs);
-  int warmed = 0;
-  for (int k = 0; k < 6; ++k) {
-    const std::size_t before = record.at_ns.size();
-    const hal::TimerTick tick = timer.wait_next();
-    const std::int64_t returned_ns = clock.now_ns();
-    EXPECT_GE(returned_ns, tick.release_ns);
-    ASSERT_LE(record.at_ns.size(), before + 1);
-    if (record.at_ns.size() == before + 1) {
-      ++warmed;
-      EXPECT_LE(record.at_ns.back(), returned_ns);
-      EXPECT_GE(record.at_ns.back(), tick.release_ns - 500'000);
-    }
-  }
-  EXPECT_GE(warmed, 1);
 }
 
 TEST(SocketCanBus, MissingInterfaceOrNoAfCanIsAOneLineError) {

@@ -186,14 +186,10 @@ std::int64_t thread_cpu_ns() {
   return std::int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
 }
 
-// Back to back, or one cycle per millisecond of the monotonic clock, with
-// or without the Linux backend's warm-up before each release.
-enum class Pacing { back_to_back, one_khz, one_khz_warmed };
-
-// One run of one cycle kind on a freshly booted runtime.
+// One run of one cycle kind on a freshly booted runtime; paced: one cycle
+// per millisecond of the monotonic clock, else back to back.
 CycleSamples run_cycles(const std::vector<std::uint8_t>& image, const Workload& w, CycleKind kind, int cycles,
-                        Pacing pacing) {
-  const bool paced = pacing != Pacing::back_to_back;
+                        bool paced) {
   auto platform = std::make_unique<sim::SimulatedPlatform>();
   platform->storage.assign(image);
   auto runtime = std::make_unique<fw::Runtime>(platform->hal, fw::Geometry::prototype());
@@ -216,11 +212,6 @@ CycleSamples run_cycles(const std::vector<std::uint8_t>& image, const Workload& 
   // The Linux backend's timer, as cdcr-runtime paces its cycles.
   const cdcr::linux_host::PosixMonotonicClock clock;
   cdcr::linux_host::PosixPeriodicTimer pace(clock);
-  if (pacing == Pacing::one_khz_warmed) {
-    pace.set_warm_up(
-        cdcr::linux_host::kWarmUpLeadNs,
-        [](void* context) { static_cast<const fw::Runtime*>(context)->warm_caches(); }, runtime.get());
-  }
   if (paced) pace.start(kPeriodNs);
   for (int k = 0; k < cycles; ++k) {
     const std::size_t i = std::size_t(k) % kRingSize;
@@ -348,7 +339,7 @@ int main(int argc, char** argv) {
     const fw::Geometry& geometry = probe.geometry();
 
     std::vector<double> fk_ns, gp_ns, evaluation_ns;
-    std::vector<double> p50[kKindCount], p99[kKindCount], paced_p99[kKindCount], cold_p99[kKindCount];
+    std::vector<double> p50[kKindCount], p99[kKindCount], paced_p99[kKindCount];
     std::vector<std::int64_t> all_iterations[kKindCount], all_request_cycles[kKindCount];
     std::int64_t worst_ns[kKindCount] = {}, worst_cpu_ns[kKindCount] = {};
     long converged[kKindCount] = {}, total[kKindCount] = {};
@@ -372,9 +363,8 @@ int main(int argc, char** argv) {
       for (int k = 0; k < kKindCount; ++k) {
         const CycleKind kind = kKinds[k];
         const int cycles = kind == CycleKind::forward ? options.forward_cycles : options.ik_cycles;
-        const CycleSamples s = run_cycles(image, w, kind, cycles, Pacing::back_to_back);
-        paced_p99[k].push_back(percentile(run_cycles(image, w, kind, cycles, Pacing::one_khz_warmed).ns, 0.99));
-        cold_p99[k].push_back(percentile(run_cycles(image, w, kind, cycles, Pacing::one_khz).ns, 0.99));
+        const CycleSamples s = run_cycles(image, w, kind, cycles, false);
+        paced_p99[k].push_back(percentile(run_cycles(image, w, kind, cycles, true).ns, 0.99));
         p50[k].push_back(percentile(s.ns, 0.50));
         p99[k].push_back(percentile(s.ns, 0.99));
         worst_ns[k] = std::max(worst_ns[k], *std::max_element(s.ns.begin(), s.ns.end()));
@@ -396,19 +386,19 @@ int main(int argc, char** argv) {
     std::printf("%d runs; per run %d forward cycles and %d cycles of each IK kind, back to back and then at "
                 "1 kHz. p50/p99: median over runs; max: worst of all runs back to back.\n\n",
                 options.repetitions, options.forward_cycles, options.ik_cycles);
-    std::printf("| cycle | p50 us | p99 us | max us | max us, thread CPU | p99 us at 1 kHz | p99 us at 1 kHz, no "
-                "warm-up | p50 / FK | p99 / FK | requests | cycles per request p50 / p99 / max | "
-                "iterations p50 / p99 / max | converged |\n");
-    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+    std::printf("| cycle | p50 us | p99 us | max us | max us, thread CPU | p99 us at 1 kHz | p50 / FK | "
+                "p99 / FK | requests | cycles per request p50 / p99 / max | iterations p50 / p99 / max | "
+                "converged |\n");
+    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
     double worst_p99_us = 0;
     double worst_paced_p99_us = 0;
     for (int k = 0; k < kKindCount; ++k) {
       const double m50 = median(p50[k]), m99 = median(p99[k]), paced99 = median(paced_p99[k]);
       worst_p99_us = std::max(worst_p99_us, m99 * 1e-3);
       worst_paced_p99_us = std::max(worst_paced_p99_us, paced99 * 1e-3);
-      std::printf("| %s | %.2f | %.2f | %.1f | %.1f | %.2f | %.2f | %.1f | %.1f |", label(kKinds[k]), m50 * 1e-3,
+      std::printf("| %s | %.2f | %.2f | %.1f | %.1f | %.2f | %.1f | %.1f |", label(kKinds[k]), m50 * 1e-3,
                   m99 * 1e-3, double(worst_ns[k]) * 1e-3, double(worst_cpu_ns[k]) * 1e-3, paced99 * 1e-3,
-                  median(cold_p99[k]) * 1e-3, m50 / fk_baseline_ns, m99 / fk_baseline_ns);
+                  m50 / fk_baseline_ns, m99 / fk_baseline_ns);
       if (total[k] == 0) {
         std::printf(" - | - | - | - |\n");
       } else {
@@ -419,11 +409,11 @@ int main(int argc, char** argv) {
                     100.0 * double(converged[k]) / double(total[k]));
       }
     }
-    std::printf("| baseline: nominal FK (`forward_kinematics_bend`, float) | %.3f | | | | | | 1.0 | | | | | |\n",
+    std::printf("| baseline: nominal FK (`forward_kinematics_bend`, float) | %.3f | | | | | 1.0 | | | | | |\n",
                 fk_baseline_ns * 1e-3);
-    std::printf("| baseline: bare GP predict (%u points) | %.2f | | | | | | %.1f | | | | | |\n", view.training_points,
+    std::printf("| baseline: bare GP predict (%u points) | %.2f | | | | | %.1f | | | | | |\n", view.training_points,
                 gp_baseline_ns * 1e-3, gp_baseline_ns / fk_baseline_ns);
-    std::printf("| one full model evaluation (FK, Jacobian, GP mean and gradient) | %.2f | | | | | | %.1f | | | | | |\n",
+    std::printf("| one full model evaluation (FK, Jacobian, GP mean and gradient) | %.2f | | | | | %.1f | | | | | |\n",
                 evaluation_baseline_ns * 1e-3, evaluation_baseline_ns / fk_baseline_ns);
     std::printf("\nHost goal p99 <= 15 us for every kind of cycle: %s (worst p99 %.2f us back to back, %.2f us at "
                 "1 kHz)\n",

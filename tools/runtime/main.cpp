@@ -456,8 +456,6 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
   const std::int64_t start_ns = clock.now_ns();
   const std::int64_t end_ns = seconds > 0 ? start_ns + static_cast<std::int64_t>(std::llround(seconds * 1e9)) : 0;
-  timer.set_warm_up(
-      cdcr::linux_host::kWarmUpLeadNs, [](void* context) { static_cast<const fw::Runtime*>(context)->warm_caches(); }, &runtime);
   timer.start(period_ns);
   while (stop_requested == 0) {
     const cdcr::hal::TimerTick tick = timer.wait_next();

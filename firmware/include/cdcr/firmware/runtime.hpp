@@ -118,23 +118,6 @@ class Runtime {
   // One cycle of work for the given release.
   void run_cycle(const hal::TimerTick& tick);
 
-  // Reads the model and the runtime's own state and changes nothing, so
-  // that a cycle after a long sleep finds them in the caches: a host's
-  // warm-up just before each release (the Linux backend's
-  // PosixPeriodicTimer::set_warm_up). Boards without data caches skip it.
-  void warm_caches() const {
-    const auto touch = [](const void* data, std::size_t bytes) {
-      constexpr std::size_t kCacheLine = 64;
-      const auto* byte = static_cast<const volatile std::uint8_t*>(data);
-      for (std::size_t i = 0; i < bytes; i += kCacheLine) static_cast<void>(byte[i]);
-    };
-    touch(this, sizeof(*this));
-    if (image_.inputs != nullptr && image_.alpha != nullptr) {
-      touch(image_.inputs, std::size_t{image_.training_points} * std::size_t(image_.input_dims) * sizeof(float));
-      touch(image_.alpha, std::size_t{image_.training_points} * 6 * sizeof(float));
-    }
-  }
-
   // The forward path run_cycle applies to the latest cable set: nominal or
   // compensated by state. Writes `estimate` only on success.
   model::Status estimate_pose(const Cables& cables_mm, PoseEstimate& estimate) const;
