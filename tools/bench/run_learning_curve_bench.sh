@@ -23,8 +23,14 @@ cdcr=$build_dir/bin/cdcr
 "$cdcr" simulate --samples 4000 --seed 1 --workspace-theta-max 0.7 --out "$work_dir/train.csv" >/dev/null
 "$cdcr" simulate --samples 200 --seed 1 --session 1 --workspace-theta-max 0.7 --out "$work_dir/test.csv" --json \
   >"$work_dir/test-simulate.json"
-floor=$(/usr/bin/python3 -c 'import json,sys; f=json.load(open(sys.argv[1]))["noise_floor"]; print(f"{f[\"position_mm\"]},{f[\"orientation_deg\"]}")' \
-  "$work_dir/test-simulate.json")
+floor=$(/usr/bin/python3 - "$work_dir/test-simulate.json" <<'PYTHON'
+import json
+import sys
+
+floor = json.load(open(sys.argv[1]))["noise_floor"]
+print("{},{}".format(floor["position_mm"], floor["orientation_deg"]))
+PYTHON
+)
 echo "noise floor of the test set: $floor (mm, deg)"
 "$cdcr" learning-curve --data "$work_dir/train.csv" --test-data "$work_dir/test.csv" \
   --sizes 250,500,1000,2000,4000 --encodings bend-vector --models exact,sparse --inducing 1024 \

@@ -31,7 +31,7 @@ struct TrainCommandOptions {
   std::uint64_t flash_budget = 96 * 1024;
   GeometryOptions geometry;
   TrainingFlags training;
-  bool calibrate = false;
+  bool calibrate = true;
   bool json = false;
 };
 
@@ -93,14 +93,18 @@ CommandOutput run_train(const TrainCommandOptions& o) {
   Sets sets = build_sets(design);
   std::optional<training::Calibration> calibration;
   model::RobotGeometry<double> geometry = design;
+  // Rows too few to identify the geometry, or a search that leaves the
+  // plausible range, keep the design geometry; the output says why.
+  std::string calibration_skipped;
   if (o.calibrate && sets.train.size() >= 2) {
     try {
       calibration = training::calibrate_geometry(sets.train, design);
+      geometry = calibration->geometry;
+      sets = build_sets(geometry);
     } catch (const std::invalid_argument& e) {
-      throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
+      calibration.reset();
+      calibration_skipped = e.what();
     }
-    geometry = calibration->geometry;
-    sets = build_sets(geometry);
   }
   const training::TrainingSet& all = sets.all;
   const training::TrainingSet& train_set = sets.train;
@@ -159,6 +163,7 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     } else {
       j["calibration"] = nullptr;
     }
+    j["calibration_skipped"] = calibration_skipped.empty() ? Json(nullptr) : Json(calibration_skipped);
     j["encoding"] = model::to_string(m.encoding);
     j["kernel"] = o.training.kernel;
     j["length_scales"] = std::vector<double>(m.length_scales.data(), m.length_scales.data() + m.length_scales.size());
@@ -212,6 +217,8 @@ CommandOutput run_train(const TrainCommandOptions& o) {
                          geometry.segments[i].anchor_radius_mm);
       }
       t += "\n";
+    } else if (!calibration_skipped.empty()) {
+      t += fmt::format("  design geometry: not calibrated ({})\n", calibration_skipped);
     }
     t += fmt::format("  encoding {}, kernel {} squared exponential, hyperparameters shared by the 6 outputs\n",
                      model::to_string(m.encoding), o.training.kernel);
@@ -274,9 +281,10 @@ void register_train_command(CLI::App& app, CommandOutput& output) {
   command->add_option("--flash-budget", o->flash_budget, "Largest image, in bytes (suffixes K, KiB, M accepted)")
       ->transform(CLI::AsSizeValue(false))
       ->default_str("96KiB");
-  command->add_flag("--calibrate", o->calibrate,
+  command->add_flag("--calibrate,!--no-calibrate", o->calibrate,
                     "Identify each segment's backbone length and anchor radius (its bending gain) from the data "
-                    "before the GP; the image carries the calibrated geometry");
+                    "before the GP, and ship the calibrated geometry in the image (default; --no-calibrate keeps "
+                    "the design geometry)");
   add_geometry_options(*command, o->geometry, "Number of segments (default: from the dataset's cable columns)");
   add_training_flags(*command, o->training);
   command->add_flag("--json", o->json, "Print one JSON object");
