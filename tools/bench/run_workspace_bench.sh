@@ -5,7 +5,7 @@
 #   paper      the default workspace (bends up to 0.2 rad), 700 rows, 400 test rows;
 #   low-noise  the same with the per-sample noise at a quarter (--noise-scale 0.25);
 #   wide       bends up to 0.7 rad, 4,000 rows, 200 test rows.
-# Each with the design geometry (--no-calibrate) and calibrated (the default).
+# Each with the design geometry and with --calibrate.
 # "float32 max" is the largest difference between the image's float32 path
 # (double accumulators, as on the M7 and the host) and the double-precision
 # trainer on the held-out rows.
@@ -56,8 +56,8 @@ simulate_case paper 700 400
 simulate_case low-noise 700 400 --noise-scale 0.25
 simulate_case wide 4000 200 --workspace-theta-max 0.7
 for name in paper low-noise wide; do
-  train_case "$name" "$name" --no-calibrate
-  train_case "$name" "$name-calibrated"
+  train_case "$name" "$name"
+  train_case "$name" "$name-calibrated" --calibrate
 done
 
 if [[ $skip_sklearn == 0 ]]; then

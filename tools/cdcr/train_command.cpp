@@ -31,7 +31,7 @@ struct TrainCommandOptions {
   std::uint64_t flash_budget = 96 * 1024;
   GeometryOptions geometry;
   TrainingFlags training;
-  bool calibrate = true;
+  bool calibrate = false;
   bool json = false;
 };
 
@@ -281,10 +281,9 @@ void register_train_command(CLI::App& app, CommandOutput& output) {
   command->add_option("--flash-budget", o->flash_budget, "Largest image, in bytes (suffixes K, KiB, M accepted)")
       ->transform(CLI::AsSizeValue(false))
       ->default_str("96KiB");
-  command->add_flag("--calibrate,!--no-calibrate", o->calibrate,
+  command->add_flag("--calibrate", o->calibrate,
                     "Identify each segment's backbone length and anchor radius (its bending gain) from the data "
-                    "before the GP, and ship the calibrated geometry in the image (default; --no-calibrate keeps "
-                    "the design geometry)");
+                    "before the GP, and ship the calibrated geometry in the image");
   add_geometry_options(*command, o->geometry, "Number of segments (default: from the dataset's cable columns)");
   add_training_flags(*command, o->training);
   command->add_flag("--json", o->json, "Print one JSON object");
