@@ -114,14 +114,9 @@ CommandOutput run_train(const TrainCommandOptions& o) {
                                  train_set.size() == 1 ? "" : "s"));
   }
   // The exported model is fitted on every row of --data once the held-out
-  // rows have measured it; a model too large for the board is sparse.
+  // rows have measured it; a model too large for the board is sparse (a
+  // request the board cannot hold is refused before any training).
   const training::TrainingSet& fitted_set = all;
-  try {
-    static_cast<void>(training::select_model(all.size(), static_cast<int>(all.inputs.cols()), geometry.segment_count,
-                                             options.model, options.inducing_points, options.board));
-  } catch (const std::invalid_argument& e) {
-    throw InputError(e.what());
-  }
 
   const auto now = std::chrono::system_clock::now();
   const auto start = std::chrono::steady_clock::now();

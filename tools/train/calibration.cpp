@@ -28,6 +28,17 @@ model::RobotGeometry<double> geometry_at(const model::RobotGeometry<double>& des
   return g;
 }
 
+// The nominal tip pose for commanded cables, or false when `g` cannot map
+// them to joints.
+bool nominal_pose(const TrainingSet& set, int row, const model::RobotGeometry<double>& g,
+                  model::Pose<double>& pose) {
+  const model::CableVector<double> cables = set.cables_mm.row(row).transpose();
+  model::JointVector<double> joints;
+  if (model::joints_from_cables(cables, g, joints) != model::Status::ok) return false;
+  pose = model::forward_kinematics_bend(model::bend_from_joints(joints), g);
+  return true;
+}
+
 struct TwistResiduals {
   using Scalar = double;
   enum { InputsAtCompileTime = Eigen::Dynamic, ValuesAtCompileTime = Eigen::Dynamic };
@@ -47,14 +58,13 @@ struct TwistResiduals {
     ++*evaluations;
     const model::RobotGeometry<double> g = geometry_at(design, ratios);
     residuals.resize(values());
+    const bool valid = g.validate() == model::Status::ok;
     for (int i = 0; i < set->size(); ++i) {
-      const model::CableVector<double> cables = set->cables_mm.row(i).transpose();
-      model::JointVector<double> joints;
-      if (g.validate() != model::Status::ok || model::joints_from_cables(cables, g, joints) != model::Status::ok) {
+      model::Pose<double> nominal;
+      if (!valid || !nominal_pose(*set, i, g, nominal)) {
         residuals.segment<6>(6 * i).setConstant(kUnmappedResidual);
         continue;
       }
-      const model::Pose<double> nominal = model::forward_kinematics_bend(model::bend_from_joints(joints), g);
       const model::Twist<double> twist = model::tip_error_twist(set->measured[i], nominal);
       residuals.segment<3>(6 * i) = twist.head<3>();
       residuals.segment<3>(6 * i + 3) = rotation_weight_mm * twist.tail<3>();
@@ -66,12 +76,11 @@ struct TwistResiduals {
 std::vector<model::Pose<double>> nominal_poses(const TrainingSet& set, const model::RobotGeometry<double>& g) {
   std::vector<model::Pose<double>> poses;
   for (int i = 0; i < set.size(); ++i) {
-    const model::CableVector<double> cables = set.cables_mm.row(i).transpose();
-    model::JointVector<double> joints;
-    if (model::joints_from_cables(cables, g, joints) != model::Status::ok) {
+    model::Pose<double> pose;
+    if (!nominal_pose(set, i, g, pose)) {
       throw std::invalid_argument("the calibrated geometry rejects the cables of sample " + std::to_string(i + 1));
     }
-    poses.push_back(model::forward_kinematics_bend(model::bend_from_joints(joints), g));
+    poses.push_back(pose);
   }
   return poses;
 }
