@@ -580,11 +580,13 @@ TEST_F(FlashImage, ReservedHeaderBytesMustBeZero) {
   }
 }
 
-// Room for a predictive-variance factor that v2.0 does not define: an image
-// carrying one is refused, not half-read.
-TEST_F(FlashImage, VarianceFactorFieldsMustBeZero) {
+// A v2.0 image has no variance block (2.1 defines it): one that claims one
+// is refused, not half-read.
+TEST_F(FlashImage, VarianceFactorFieldsMustBeZeroInVersion20) {
   for (std::size_t byte = 0; byte < 6; ++byte) {
     Bytes bad = image;
+    bad[image_field::version_minor] = 0;
+    bad[image_field::version_minor + 1] = 0;
     bad[image_field::variance_offset + byte] = 8;
     reseal(bad);
     EXPECT_EQ(parse_failing(bad, ImageCheckId::header), ImageStatus::bad_header) << "byte " << byte;

@@ -108,7 +108,7 @@ TEST_F(ImageCli, InspectJsonReportsTheModel) {
   EXPECT_TRUE(j["failed_check"].is_null());
   EXPECT_EQ(j["file_size"], image.size());
   for (const char* name : {"size", "magic", "version", "header", "alignment", "checksum", "kind", "capacity", "layout",
-                           "finite", "positive", "ranges", "fitted_rows"}) {
+                           "finite", "positive", "ranges", "fitted_rows", "variance"}) {
     ASSERT_TRUE(j["checks"].contains(name)) << name;
     EXPECT_EQ(j["checks"][name]["passed"], true) << name << ": " << j["checks"][name]["detail"];
   }
@@ -116,7 +116,7 @@ TEST_F(ImageCli, InspectJsonReportsTheModel) {
   const json& header = j["header"];
   EXPECT_EQ(header["magic"], "0x50474443");
   EXPECT_EQ(header["version_major"], 2);
-  EXPECT_EQ(header["version_minor"], 0);
+  EXPECT_EQ(header["version_minor"], 1);
   EXPECT_EQ(header["header_size"], 64);
   EXPECT_EQ(header["variance_offset"], 0);
   EXPECT_EQ(header["variance_rank"], 0);
@@ -128,7 +128,7 @@ TEST_F(ImageCli, InspectJsonReportsTheModel) {
   EXPECT_EQ(header["crc32_computed"], crc);
 
   EXPECT_EQ(j["dims"], (json{{"training_points", 5}, {"input_dims", 4}, {"output_dims", 6}, {"segments", 2}}));
-  EXPECT_EQ(j["version"], "2.0");
+  EXPECT_EQ(j["version"], "2.1");
   EXPECT_EQ(j["model_kind"], (json{{"code", 1}, {"name", "exact-gp"}}));
   EXPECT_EQ(j["extra_inputs"], 0);
   EXPECT_EQ(j["fitted_rows"], 5);
@@ -190,7 +190,7 @@ TEST_F(ImageCli, InspectTextShowsEveryCheck) {
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(run.err, "");
   for (const char* expected :
-       {"  magic               0x50474443 (CDGP)\n", "  version             2.0\n", "  training points     5\n",
+       {"  magic               0x50474443 (CDGP)\n", "  version             2.1\n", "  training points     5\n",
         "  fitted rows         5\n", "  model kind          1 (exact-gp)\n", "  variance factor     none\n",
         "  segments            2\n", "  input encoding      2 (bend-vector)\n",
         "  created             2023-11-14T22:13:20Z (unix 1700000000)\n", "  trainer             \"cdcr-test 0.1.0\"\n",
@@ -300,7 +300,10 @@ class ImageReportDamage : public ImageCli, public ::testing::WithParamInterface<
     if (name == "version") put<std::uint16_t>(bad, version_major, 3);
     if (name == "header_size") put<std::uint32_t>(bad, header_size, 32);
     if (name == "reserved") bad[reserved_b + 1] = 7;
-    if (name == "variance") put<std::uint32_t>(bad, variance_offset, layout.metadata_offset);
+    if (name == "variance") {  // a variance block in a v2.0 image
+      put<std::uint16_t>(bad, version_minor, 0);
+      put<std::uint32_t>(bad, variance_offset, layout.metadata_offset);
+    }
     if (name == "model_kind") bad[model_kind] = 3;
     if (name == "extra_inputs") bad[extra_inputs] = 1;
     if (name == "dims") put<std::uint16_t>(bad, input_dims, 3);
@@ -494,13 +497,17 @@ TEST_F(ImageCli, V1ImageLoadsEverywhere) {
   ASSERT_EQ(export_run.exit_code, 0) << export_run.err;
   EXPECT_EQ(exporting::read_binary_file(exported.string()), v1);
 
-  // The same float32 model in either format: the same errors.
+  // The same float32 model in either format: the same errors. Only v2 holds
+  // the input ranges that tell extrapolating rows.
   const CliResult eval_v1 = cdcr("eval --json --model " + quoted(v1_path) + " --data " + quoted(data));
   const CliResult eval_v2 = cdcr("eval --json --model " + quoted(v2_path) + " --data " + quoted(data));
   ASSERT_EQ(eval_v1.exit_code, 0) << eval_v1.err;
   ASSERT_EQ(eval_v2.exit_code, 0) << eval_v2.err;
-  EXPECT_EQ(eval_v1.out, eval_v2.out);
-  EXPECT_EQ(json::parse(eval_v1.out)["n"], 12);
+  const json v1_errors = json::parse(eval_v1.out);
+  const json v2_errors = json::parse(eval_v2.out);
+  for (const char* key : {"n", "initial", "compensated"}) EXPECT_EQ(v1_errors[key], v2_errors[key]) << key;
+  EXPECT_EQ(v1_errors["outside_range"], 0);
+  EXPECT_EQ(v1_errors["n"], 12);
 }
 
 TEST(ImageStatusNames, AreDistinctIdentifiers) {

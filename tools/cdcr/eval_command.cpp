@@ -36,14 +36,18 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
   }
   training::TrainingSet set;
   std::vector<model::Pose<double>> compensated;
+  std::vector<training::FirmwareEstimate> estimates;
   try {
     set = training::make_training_set(data, geometry, image.view.encoding);
     compensated = training::firmware_poses(image.view, set.cables_mm);
+    estimates = training::firmware_estimates(image.view, set.cables_mm);
   } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
   }
   const training::MeanErrors initial = training::mean_errors(set.measured, set.nominal);
   const training::MeanErrors after = training::mean_errors(set.measured, compensated);
+  const bool has_variance = image.view.variance_rank > 0;
+  const training::CoverageCheck coverage = training::check_coverage(set.measured, estimates);
 
   CommandOutput output;
   if (o.json) {
@@ -51,6 +55,17 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     j["n"] = set.size();
     j["initial"] = {{"position_mm", initial.position_mm}, {"orientation_deg", initial.orientation_deg}};
     j["compensated"] = {{"position_mm", after.position_mm}, {"orientation_deg", after.orientation_deg}};
+    j["extrapolating"] = coverage.extrapolating;
+    j["outside_range"] = coverage.outside_range;
+    if (has_variance) {
+      j["coverage"] = {{"r95_mm", coverage.position_coverage},
+                       {"r95_deg", coverage.orientation_coverage},
+                       {"median_r95_mm", coverage.median_r95_mm},
+                       {"median_r95_deg", coverage.median_r95_deg},
+                       {"median_latent_share", coverage.median_latent_share}};
+    } else {
+      j["coverage"] = nullptr;
+    }
     output.text = j.dump() + "\n";
   } else {
     output.text = fmt::format(
@@ -58,6 +73,16 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
         "  initial (nominal)    {:13.4f}   {:17.4f}\n"
         "  compensated          {:13.4f}   {:17.4f}\n",
         set.size(), initial.position_mm, initial.orientation_deg, after.position_mm, after.orientation_deg);
+    if (has_variance) {
+      output.text += fmt::format(
+          "  within r95           {:12.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
+          100.0 * coverage.position_coverage, 100.0 * coverage.orientation_coverage, coverage.median_r95_mm,
+          coverage.median_r95_deg);
+    } else {
+      output.text += "  within r95           the image carries no variance\n";
+    }
+    output.text += fmt::format("  extrapolating        {} of {} samples ({} outside the fitted input range)\n",
+                               coverage.extrapolating, set.size(), coverage.outside_range);
   }
   return output;
 }

@@ -274,6 +274,12 @@ void describe_unfailed(ImageCheck& check, const Findings& findings, const ImageR
       return;
     case ImageCheckId::layout: pass("offsets and sizes match the dims"); return;
     case ImageCheckId::ranges: pass(fmt::format("input_min <= input_max for all {} inputs", values())); return;
+    case ImageCheckId::variance:
+      pass(h.variance_rank == 0
+               ? std::string("no variance block")
+               : fmt::format("{} variance points, positive factor diagonals, one kernel for every output",
+                             h.variance_rank));
+      return;
     case ImageCheckId::fitted_rows:
       if (r.fitted_rows && *r.fitted_rows == h.training_points) {
         pass(fmt::format("{} rows, the training points", *r.fitted_rows));

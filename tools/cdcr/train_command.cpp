@@ -28,6 +28,7 @@ struct TrainCommandOptions {
   int holdout = 50;
   std::string model = "auto";
   int inducing = 0;
+  int variance_points = 64;
   std::uint64_t flash_budget = 96 * 1024;
   GeometryOptions geometry;
   TrainingFlags training;
@@ -54,6 +55,11 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     throw InputError("--inducing applies to a sparse model, not to --model exact");
   }
   options.inducing_points = o.inducing;
+  if (o.variance_points < 0 || o.variance_points > static_cast<int>(model::kMaxVarianceRank)) {
+    throw InputError(fmt::format("--variance-points must be between 0 and {} (got {})", model::kMaxVarianceRank,
+                                 o.variance_points));
+  }
+  options.variance_rank = o.variance_points;
   if (o.flash_budget > std::numeric_limits<std::uint32_t>::max()) {
     throw InputError(fmt::format("--flash-budget {} is beyond a 32-bit image size", o.flash_budget));
   }
@@ -272,6 +278,10 @@ void register_train_command(CLI::App& app, CommandOutput& output) {
       ->check(CLI::IsMember({"auto", "exact", "sparse"}))
       ->capture_default_str();
   command->add_option("--inducing", o->inducing, "Inducing points M of a sparse model (0: the most that fit the board)")
+      ->capture_default_str();
+  command->add_option("--variance-points", o->variance_points,
+                      "Points R of the predictive-variance factor the image carries (0: no variance; the board "
+                      "spends R kernel values and R (R + 1) multiply-adds on it per cycle)")
       ->capture_default_str();
   command->add_option("--flash-budget", o->flash_budget, "Largest image, in bytes (suffixes K, KiB, M accepted)")
       ->transform(CLI::AsSizeValue(false))

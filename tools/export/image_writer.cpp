@@ -62,9 +62,18 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   if (static_cast<std::uint64_t>(n) * static_cast<std::uint64_t>(d + model::kImageOutputs) * 4 > (1ull << 31)) {
     throw std::invalid_argument("trained model is too large for a flash image");
   }
+  const training::VarianceFactor& variance = model.variance;
+  const int rank = variance.rank();
+  if (rank > 0 && (variance.points.cols() != d || variance.inducing_factor.rows() != rank ||
+                   variance.inducing_factor.cols() != rank || variance.posterior_factor.rows() != rank ||
+                   variance.posterior_factor.cols() != rank)) {
+    throw std::invalid_argument("trained model's variance factor has inconsistent dimensions");
+  }
+  if (rank > 0xFFFF) throw std::invalid_argument("trained model's variance factor is too large for a flash image");
   const model::ImageLayout layout =
       model::image_layout(static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(d),
-                          static_cast<std::uint32_t>(segments));
+                          static_cast<std::uint32_t>(segments), model::kImageVersionMajor,
+                          static_cast<std::uint32_t>(rank));
   ImageBuffer image(layout.total_size);
 
   image.put<std::uint32_t>(magic, model::kImageMagic);
@@ -87,6 +96,8 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   image.put<std::uint32_t>(alpha_offset, layout.alpha_offset);
   image.put<std::uint32_t>(metadata_offset, layout.metadata_offset);
   image.put<std::uint32_t>(metadata_size, model::kImageMetadataSize);
+  image.put<std::uint32_t>(variance_offset, layout.variance_offset);
+  image.put<std::uint16_t>(variance_rank, static_cast<std::uint16_t>(rank));
 
   std::size_t at = layout.geometry_offset;
   for (int i = 0; i < segments; ++i) {
@@ -136,6 +147,29 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
     }
   }
 
+  if (rank > 0) {
+    using namespace model::image_variance_field;
+    const std::size_t block = layout.variance_offset;
+    image.put_float(block + 4 * position_scale, variance.position_scale);
+    image.put_float(block + 4 * orientation_scale, variance.orientation_scale);
+    image.put_float(block + 4 * extrapolation_variance, variance.extrapolation_variance);
+    at = block + 4 * points;
+    for (int i = 0; i < rank; ++i) {
+      for (int k = 0; k < d; ++k) {
+        image.put_float(at, variance.points(i, k));
+        at += 4;
+      }
+    }
+    for (const Eigen::MatrixXd* factor : {&variance.inducing_factor, &variance.posterior_factor}) {
+      for (int i = 0; i < rank; ++i) {
+        for (int j = 0; j <= i; ++j) {
+          image.put_float(at, (*factor)(i, j));
+          at += 4;
+        }
+      }
+    }
+  }
+
   using namespace model::image_metadata_field;
   const std::size_t meta = layout.metadata_offset;
   image.put<std::uint64_t>(meta + dataset_hash, model.dataset_hash);
@@ -153,6 +187,7 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   // image, so none is imposed.
   model::ImageView view{};
   const model::ImageCapacity any_capacity{std::numeric_limits<std::uint32_t>::max(),
+                                          std::numeric_limits<std::uint16_t>::max(),
                                           std::numeric_limits<std::uint16_t>::max()};
   if (const model::ImageStatus status = model::parse_image(image.data(), layout.total_size, view, any_capacity);
       status != model::ImageStatus::ok) {

@@ -8,9 +8,7 @@
 
 namespace cdcr::training {
 
-namespace {
-constexpr double kDegreesPerRadian = 57.295779513082320876;
-}
+using model::kDegreesPerRadian;
 
 MeanErrors mean_errors(const std::vector<model::Pose<double>>& reference, const std::vector<model::Pose<double>>& poses) {
   const Fidelity f = compare_poses(reference, poses);
@@ -99,6 +97,69 @@ std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, c
       break;
   }
   return firmware_poses_with<double>(image, cables_mm);
+}
+
+std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
+  model::RobotGeometry<float> geometry;
+  if (const model::Status s = model::geometry_from_image(image, geometry); s != model::Status::ok) {
+    throw std::invalid_argument(std::string("image geometry: ") + model::to_string(s));
+  }
+  model::GpCorrection<float, double> correction;
+  model::GpUncertainty<float> uncertainty;
+  if (correction.bind(image) != model::Status::ok || uncertainty.bind(image) != model::Status::ok) {
+    throw std::invalid_argument("image: cannot bind its correction");
+  }
+  std::vector<FirmwareEstimate> estimates;
+  estimates.reserve(static_cast<std::size_t>(cables_mm.rows()));
+  for (Eigen::Index i = 0; i < cables_mm.rows(); ++i) {
+    const model::CableVector<float> cables = cables_mm.row(i).transpose().cast<float>();
+    model::ForwardResult<float> result;
+    if (const model::Status s = model::compensated_forward(cables, geometry, correction, result);
+        s != model::Status::ok) {
+      throw std::invalid_argument("sample " + std::to_string(i + 1) + ": " + model::to_string(s));
+    }
+    float z[model::GpCorrection<float>::kMaxInputs];
+    correction.kernel_coordinates(model::bend_from_joints(result.joints), z);
+    const model::PoseUncertainty<float> u = uncertainty.evaluate(z, result.compensated.position_mm);
+    FirmwareEstimate e;
+    e.pose = result.compensated.cast<double>();
+    e.uncertainty.r95_mm = u.r95_mm;
+    e.uncertainty.r95_deg = u.r95_deg;
+    e.uncertainty.latent_share = u.latent_share;
+    e.uncertainty.outside_range = u.outside_range;
+    e.uncertainty.extrapolating = u.extrapolating;
+    estimates.push_back(e);
+  }
+  return estimates;
+}
+
+CoverageCheck check_coverage(const std::vector<model::Pose<double>>& measured,
+                             const std::vector<FirmwareEstimate>& estimates) {
+  if (measured.size() != estimates.size() || measured.empty()) throw std::invalid_argument("pose lists differ in size");
+  CoverageCheck c;
+  c.samples = static_cast<int>(measured.size());
+  std::vector<double> radii_mm, radii_deg, shares;
+  for (std::size_t i = 0; i < measured.size(); ++i) {
+    const model::PoseError<double> e = model::pose_error(measured[i], estimates[i].pose);
+    const model::PoseUncertainty<double>& u = estimates[i].uncertainty;
+    if (e.position_mm <= u.r95_mm) c.position_coverage += 1.0;
+    if (e.orientation_rad * kDegreesPerRadian <= u.r95_deg) c.orientation_coverage += 1.0;
+    if (u.extrapolating) ++c.extrapolating;
+    if (u.outside_range) ++c.outside_range;
+    radii_mm.push_back(u.r95_mm);
+    radii_deg.push_back(u.r95_deg);
+    shares.push_back(u.latent_share);
+  }
+  c.position_coverage /= c.samples;
+  c.orientation_coverage /= c.samples;
+  const auto median = [](std::vector<double>& v) {
+    std::nth_element(v.begin(), v.begin() + static_cast<std::ptrdiff_t>(v.size() / 2), v.end());
+    return v[v.size() / 2];
+  };
+  c.median_r95_mm = median(radii_mm);
+  c.median_r95_deg = median(radii_deg);
+  c.median_latent_share = median(shares);
+  return c;
 }
 
 }  // namespace cdcr::training

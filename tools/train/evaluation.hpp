@@ -8,6 +8,7 @@
 #include <Eigen/Core>
 
 #include "cdcr/model/flash_image.hpp"
+#include "cdcr/model/gp_uncertainty.hpp"
 #include "cdcr/model/se3.hpp"
 #include "training_set.hpp"
 
@@ -51,6 +52,30 @@ struct Fidelity {
   double max_orientation_deg = 0.0;
   double mean_orientation_deg = 0.0;
 };
+
+// The firmware's uncertainty path (model::GpUncertainty on the parsed
+// image, float32) for each sample, beside its compensated pose.
+struct FirmwareEstimate {
+  model::Pose<double> pose;
+  model::PoseUncertainty<double> uncertainty;
+};
+std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm);
+
+// How well the radii describe measured poses: the share of samples whose
+// measured position lies within r95_mm of the compensated one (and the
+// orientation within r95_deg), and how many are flagged as extrapolating.
+struct CoverageCheck {
+  int samples = 0;
+  double position_coverage = 0.0;
+  double orientation_coverage = 0.0;
+  double median_r95_mm = 0.0;
+  double median_r95_deg = 0.0;
+  double median_latent_share = 0.0;
+  int extrapolating = 0;
+  int outside_range = 0;
+};
+CoverageCheck check_coverage(const std::vector<model::Pose<double>>& measured,
+                             const std::vector<FirmwareEstimate>& estimates);
 
 Fidelity compare_poses(const std::vector<model::Pose<double>>& reference, const std::vector<model::Pose<double>>& poses);
 

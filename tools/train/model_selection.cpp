@@ -13,19 +13,20 @@ const char* to_string(ModelKind kind) { return kind == ModelKind::sparse ? "spar
 
 namespace {
 
-std::uint32_t image_bytes(int points, int input_dims, int segments) {
+std::uint32_t image_bytes(int points, int input_dims, int segments, std::uint32_t variance_rank) {
   return model::image_layout(static_cast<std::uint32_t>(points), static_cast<std::uint32_t>(input_dims),
-                             static_cast<std::uint32_t>(segments))
+                             static_cast<std::uint32_t>(segments), model::kImageVersionMajor, variance_rank)
       .total_size;
 }
 
 // The most points whose image fits the budget: the size grows with them.
-int points_within_flash(int input_dims, int segments, std::uint32_t budget, int at_most) {
+int points_within_flash(int input_dims, int segments, std::uint32_t variance_rank, std::uint32_t budget,
+                        int at_most) {
   int low = 0;
   int high = at_most;
   while (low < high) {
     const int middle = (low + high + 1) / 2;
-    if (image_bytes(middle, input_dims, segments) <= budget) {
+    if (image_bytes(middle, input_dims, segments, variance_rank) <= budget) {
       low = middle;
     } else {
       high = middle - 1;
@@ -41,7 +42,8 @@ ModelSelection select_model(int rows, int input_dims, int segments, ModelChoice 
   if (rows < 1) throw std::invalid_argument("no rows to fit a model on");
   if (requested_points < 0) throw std::invalid_argument(fmt::format("--inducing must not be negative (got {})", requested_points));
   const int capacity = static_cast<int>(limits.capacity_points);
-  const int by_flash = points_within_flash(input_dims, segments, limits.flash_budget_bytes, capacity);
+  const int by_flash =
+      points_within_flash(input_dims, segments, limits.variance_rank, limits.flash_budget_bytes, capacity);
   const int by_cycle = static_cast<int>(limits.forward_cycle.points_within(limits.forward_cycle_instructions));
   const int largest = std::min({capacity, by_flash, by_cycle});
   // The tightest of the three limits, in words.
@@ -49,7 +51,10 @@ ModelSelection select_model(int rows, int input_dims, int segments, ModelChoice 
   if (largest == capacity) {
     limit = fmt::format("the runtime's capacity of {} points", capacity);
   } else if (largest == by_flash) {
-    limit = fmt::format("the flash budget of {} bytes ({} points)", limits.flash_budget_bytes, by_flash);
+    limit = limits.variance_rank > 0
+                ? fmt::format("the flash budget of {} bytes beside a variance factor of {} points ({} points)",
+                              limits.flash_budget_bytes, limits.variance_rank, by_flash)
+                : fmt::format("the flash budget of {} bytes ({} points)", limits.flash_budget_bytes, by_flash);
   } else {
     limit = fmt::format("the Cortex-M7 forward cycle of {} instructions ({} points)",
                         limits.forward_cycle_instructions, by_cycle);
@@ -87,7 +92,7 @@ ModelSelection select_model(int rows, int input_dims, int segments, ModelChoice 
       s.reason = fmt::format("sparse GP, {} inducing points: an exact GP's {} points exceed {}", points, rows, limit);
     }
   }
-  s.image_bytes = image_bytes(s.points, input_dims, segments);
+  s.image_bytes = image_bytes(s.points, input_dims, segments, limits.variance_rank);
   s.forward_cycle_instructions = limits.forward_cycle.for_points(static_cast<std::uint32_t>(s.points));
   return s;
 }

@@ -24,6 +24,9 @@ struct BoardLimits {
   std::uint32_t forward_cycle_instructions = 60'000;
   model::ForwardCycleInstructions forward_cycle = model::kCortexM7ForwardCycle;
   std::uint32_t capacity_points = model::kMaxTrainingPoints;
+  // Points of the variance factor the image carries beside the model's own
+  // (its block counts against the flash budget).
+  std::uint32_t variance_rank = 0;
 };
 
 struct ModelSelection {

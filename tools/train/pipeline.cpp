@@ -8,6 +8,7 @@
 
 #include "cdcr/model/flash_image.hpp"
 #include "export/image_writer.hpp"
+#include "predictive_variance.hpp"
 
 namespace cdcr::training {
 
@@ -64,14 +65,26 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   ExportResult r;
   // The shipped model's kind and size are those for the rows it is fitted
   // on; the search's model on fewer rows is of the same kind.
+  BoardLimits limits = options.board;
+  limits.variance_rank = static_cast<std::uint32_t>(std::clamp(options.variance_rank, 0, fitted_set.size()));
   const ModelSelection shipped =
       select_model(fitted_set.size(), static_cast<int>(fitted_set.inputs.cols()), geometry.segment_count,
-                   options.model, options.inducing_points, options.board);
+                   options.model, options.inducing_points, limits);
   TrainingOptions search_options = options;
+  search_options.board = limits;
   search_options.model = shipped.kind == ModelKind::exact ? ModelChoice::exact : ModelChoice::sparse;
   search_options.inducing_points = shipped.kind == ModelKind::exact ? 0 : std::min(shipped.points, train_set.size());
-  const TrainedModel searched = train(train_set, geometry, search_options, &r.report);
+  TrainedModel searched = train(train_set, geometry, search_options, &r.report);
   r.report.selection = shipped;
+  const auto add_variance = [&](TrainedModel& m, const TrainingSet& rows) {
+    if (options.variance_rank <= 0) return;
+    const int rank = std::min(options.variance_rank, rows.size());
+    m.variance = fit_variance_factor(m, rows.inputs, variance_points(m, rows.inputs, rank, options.search.seed));
+    const RadiusCalibration calibration = calibrate_radii(m, rows, 0.95, 1000, options.search.seed);
+    m.variance.position_scale = calibration.position_scale;
+    m.variance.orientation_scale = calibration.orientation_scale;
+  };
+  add_variance(searched, train_set);
   if (validation_set.size() > 0) {
     const Eigen::MatrixXd predicted = predict_error_twists(searched, validation_set.bends);
     r.validation = evaluate(validation_set, predicted);
@@ -81,9 +94,18 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
     r.firmware.compensated = mean_errors(
         validation_set.measured,
         firmware_poses(parsed(image), validation_set.cables_mm, FirmwareAccumulator::float64));
+    if (searched.variance.rank() > 0) {
+      r.validation_coverage =
+          check_coverage(validation_set.measured, firmware_estimates(parsed(image), validation_set.cables_mm));
+    }
   }
 
-  r.model = same_rows(fitted_set, train_set) ? searched : refit(searched, shipped.kind, fitted_set);
+  if (same_rows(fitted_set, train_set)) {
+    r.model = searched;
+  } else {
+    r.model = refit(searched, shipped.kind, fitted_set);
+    add_variance(r.model, fitted_set);
+  }
   r.fitted_rows = fitted_set.size();
   r.model.dataset_hash = dataset_hash;
   r.model.created_unix_s = created_unix_s;

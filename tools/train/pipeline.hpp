@@ -35,6 +35,9 @@ struct ExportResult {
   // the float32 image path with double accumulators.
   Evaluation validation;
   Evaluation firmware;
+  // The radii of the model fitted on the training rows, on the held-out
+  // samples (samples 0 when none are held out or the image has no variance).
+  CoverageCheck validation_coverage;
   // The exported image's float32 path against its double-precision model,
   // on the held-out samples (on the fitted rows when none are held out).
   // float32 path vs double trainer, one entry per FirmwareAccumulator.

@@ -15,6 +15,20 @@ namespace cdcr::training {
 
 using Vector6d = Eigen::Matrix<double, 6, 1>;
 
+// The predictive variance as the image's variance block holds it (rank 0:
+// none); see predictive_variance.hpp for what the factors are.
+struct VarianceFactor {
+  Eigen::MatrixXd points;            // R x D kernel coordinates
+  Eigen::MatrixXd inducing_factor;   // R x R lower triangle L_u
+  Eigen::MatrixXd posterior_factor;  // R x R lower triangle L_c
+  double position_scale = 1.0;
+  double orientation_scale = 1.0;
+  double extrapolation_variance = 1.0;
+  double jitter = 0.0;  // added to R_uu's diagonal before L_u
+
+  int rank() const { return static_cast<int>(points.rows()); }
+};
+
 struct TrainedModel {
   model::ImageModelKind kind = model::ImageModelKind::exact_gp;
   model::InputEncoding encoding = model::InputEncoding::bend_vector;
@@ -40,6 +54,7 @@ struct TrainedModel {
   // board can tell when it extrapolates; empty: the writer takes the range of
   // `inputs`, which is the fitted rows' for an exact model.
   Eigen::VectorXd input_min, input_max;
+  VarianceFactor variance;
 
   // Metadata carried into the image.
   std::uint64_t dataset_hash = 0;

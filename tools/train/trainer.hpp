@@ -38,6 +38,9 @@ struct TrainingOptions {
   // Lloyd iterations that move the inducing inputs from their k-means++
   // seeds to the centres of the rows nearest each.
   int inducing_iterations = 10;
+  // Points of the predictive-variance factor the image carries (0: none);
+  // see predictive_variance.hpp.
+  int variance_rank = 64;
 };
 
 struct TrainingReport {

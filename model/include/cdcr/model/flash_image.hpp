@@ -27,7 +27,7 @@ namespace cdcr::model {
 
 inline constexpr std::uint32_t kImageMagic = 0x50474443u;  // bytes "CDGP"
 inline constexpr std::uint16_t kImageVersionMajor = 2;      // what the exporter writes
-inline constexpr std::uint16_t kImageVersionMinor = 0;
+inline constexpr std::uint16_t kImageVersionMinor = 1;  // 2.1: the predictive-variance block
 inline constexpr std::uint16_t kImageOldestVersionMajor = 1;  // still read: deployed boards carry v1 images
 inline constexpr std::uint32_t kImageHeaderSize = 64;
 inline constexpr std::uint32_t kImageBlockAlignment = 8;
@@ -96,7 +96,25 @@ constexpr const char* to_string(ImageStatus status) {
 struct ImageCapacity {
   std::uint32_t max_training_points = kMaxTrainingPoints;
   std::uint32_t max_segments = kMaxSegments;
+  std::uint32_t max_variance_rank = kMaxVarianceRank;
 };
+
+// The predictive-variance block (v2.1): a few calibration values, then the
+// variance points and two packed lower-triangular factors (see
+// model/flash-image-v2.md, "Variance").
+namespace image_variance_field {
+inline constexpr std::uint32_t position_scale = 0;          // f32, r95_mm = position_scale * the Gaussian radius
+inline constexpr std::uint32_t orientation_scale = 1;       // f32, likewise for r95_deg
+inline constexpr std::uint32_t extrapolation_variance = 2;  // f32, latent variance / signal variance that flags a query
+inline constexpr std::uint32_t reserved = 3;                // f32, zero
+inline constexpr std::uint32_t points = 4;                  // R x D kernel coordinates, then the two factors
+}  // namespace image_variance_field
+
+constexpr std::uint32_t packed_triangle_floats(std::uint32_t rank) { return rank * (rank + 1) / 2; }
+
+constexpr std::uint32_t image_variance_floats(std::uint32_t rank, std::uint32_t input_dims) {
+  return rank == 0 ? 0 : image_variance_field::points + rank * input_dims + 2 * packed_triangle_floats(rank);
+}
 
 // Byte offsets of the header fields (all little-endian).
 namespace image_field {
@@ -121,8 +139,8 @@ inline constexpr std::size_t inputs_offset = 40;
 inline constexpr std::size_t alpha_offset = 44;
 inline constexpr std::size_t metadata_offset = 48;
 inline constexpr std::size_t metadata_size = 52;    // u32, kImageMetadataSize
-inline constexpr std::size_t variance_offset = 56;  // u32, zero in v2.0 (v1: reserved)
-inline constexpr std::size_t variance_rank = 60;    // u16, zero in v2.0 (v1: reserved)
+inline constexpr std::size_t variance_offset = 56;  // u32, the variance block; zero without one (v1: reserved)
+inline constexpr std::size_t variance_rank = 60;    // u16, R, the variance points; zero without (v1: reserved)
 inline constexpr std::size_t reserved_b = 62;       // 2 bytes, zero (v1: bytes 56..63)
 }  // namespace image_field
 
@@ -170,6 +188,12 @@ struct ImageView {
   const float* input_max;       // D, likewise
   const float* inputs;          // points x D row-major, kernel coordinates: (x - mean) / (scale * length_scale)
   const float* alpha;           // points x 6 row-major: the weights (alpha or beta) per normalised output
+  // The predictive variance (v2.1; rank 0 and null pointers without it).
+  std::uint32_t variance_rank;                // R
+  const float* variance_calibration;          // 4: image_variance_field order
+  const float* variance_points;               // R x D row-major, kernel coordinates
+  const float* variance_inducing_factor;      // packed lower triangle L_u, R (R + 1) / 2: chol(K_uu / signal_variance)
+  const float* variance_posterior_factor;     // packed lower triangle L_c: chol(I + L_u^-1 K_uf K_fu L_u^-T / (signal noise))
   std::uint64_t dataset_hash;
   std::int64_t created_unix_s;
   std::uint32_t validation_samples;
@@ -183,6 +207,7 @@ struct ImageLayout {
   std::uint32_t parameters_offset;
   std::uint32_t inputs_offset;
   std::uint32_t alpha_offset;
+  std::uint32_t variance_offset;  // 0 without a variance block
   std::uint32_t metadata_offset;
   std::uint32_t total_size;
 };
@@ -200,7 +225,8 @@ constexpr std::uint32_t image_parameter_floats(std::uint32_t input_dims,
 
 // Blocks follow the header in this order, each 8-byte aligned, then the CRC.
 constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t input_dims,
-                                   std::uint32_t segment_count, std::uint16_t version_major = kImageVersionMajor) {
+                                   std::uint32_t segment_count, std::uint16_t version_major = kImageVersionMajor,
+                                   std::uint32_t variance_rank = 0) {
   ImageLayout layout{};
   std::uint32_t at = kImageHeaderSize;
   layout.geometry_offset = at;
@@ -211,6 +237,10 @@ constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t 
   at = align_up(at + 4 * training_points * input_dims, kImageBlockAlignment);
   layout.alpha_offset = at;
   at = align_up(at + 4 * training_points * kImageOutputs, kImageBlockAlignment);
+  if (variance_rank > 0) {
+    layout.variance_offset = at;
+    at = align_up(at + 4 * image_variance_floats(variance_rank, input_dims), kImageBlockAlignment);
+  }
   layout.metadata_offset = at;
   at = align_up(at + kImageMetadataSize, kImageBlockAlignment);
   layout.total_size = at + kImageTrailerSize;
@@ -235,8 +265,9 @@ enum class ImageCheckId : std::uint8_t {
   positive,     // invalid_parameters
   ranges,       // invalid_parameters, v2: input_min <= input_max
   fitted_rows,  // invalid_parameters, v2: the metadata's fitted_rows
+  variance,     // invalid_parameters, v2.1: what the variance block requires of the model
 };
-inline constexpr int kImageCheckCount = static_cast<int>(ImageCheckId::fitted_rows) + 1;
+inline constexpr int kImageCheckCount = static_cast<int>(ImageCheckId::variance) + 1;
 
 constexpr const char* to_string(ImageCheckId check) {
   switch (check) {
@@ -253,6 +284,7 @@ constexpr const char* to_string(ImageCheckId check) {
     case ImageCheckId::positive: return "positive";
     case ImageCheckId::ranges: return "ranges";
     case ImageCheckId::fitted_rows: return "fitted_rows";
+    case ImageCheckId::variance: return "variance";
   }
   return "unknown";
 }
@@ -425,15 +457,15 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
       return run.status;
     }
   }
-  if (!v1) {
-    // Room for a predictive-variance factor that a later minor version
-    // defines; until then an image carrying one is not what this parser reads.
-    const std::uint32_t declared_variance_offset = read_u32(bytes + variance_offset);
-    const std::uint16_t declared_variance_rank = read_u16(bytes + variance_rank);
+  // v2.0 reserves the variance fields and requires them to be zero; v2.1
+  // defines the block they locate.
+  const std::uint16_t minor = read_u16(bytes + version_minor);
+  const std::uint32_t declared_variance_offset = v1 ? 0 : read_u32(bytes + variance_offset);
+  const std::uint32_t rank = v1 ? 0 : read_u16(bytes + variance_rank);
+  if (!v1 && minor == 0) {
     if (!run.expect(declared_variance_offset == 0, Check::header, Status::bad_header, "variance_offset", -1,
                     declared_variance_offset, 0, Expect::equal) ||
-        !run.expect(declared_variance_rank == 0, Check::header, Status::bad_header, "variance_rank", -1,
-                    declared_variance_rank, 0, Expect::equal)) {
+        !run.expect(rank == 0, Check::header, Status::bad_header, "variance_rank", -1, rank, 0, Expect::equal)) {
       return run.status;
     }
   }
@@ -483,16 +515,18 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   if (!run.expect(n <= capacity.max_training_points, Check::capacity, Status::over_capacity, "training_points", -1, n,
                   capacity.max_training_points, Expect::at_most) ||
       !run.expect(segments <= capacity.max_segments, Check::capacity, Status::over_capacity, "segment_count", -1,
-                  segments, capacity.max_segments, Expect::at_most)) {
+                  segments, capacity.max_segments, Expect::at_most) ||
+      !run.expect(rank <= capacity.max_variance_rank, Check::capacity, Status::over_capacity, "variance_rank", -1,
+                  rank, capacity.max_variance_rank, Expect::at_most)) {
     return run.status;
   }
 
   constexpr const char* offset_names[] = {"geometry_offset", "parameters_offset", "inputs_offset", "alpha_offset",
-                                          "metadata_offset"};
+                                          "metadata_offset", "variance_offset"};
   const std::uint32_t offsets[] = {read_u32(bytes + geometry_offset), read_u32(bytes + parameters_offset),
-                                   read_u32(bytes + inputs_offset), read_u32(bytes + alpha_offset),
-                                   read_u32(bytes + metadata_offset)};
-  for (int i = 0; i < 5; ++i) {
+                                   read_u32(bytes + inputs_offset),   read_u32(bytes + alpha_offset),
+                                   read_u32(bytes + metadata_offset), declared_variance_offset};
+  for (int i = 0; i < 6; ++i) {
     if (!run.expect(offsets[i] % kImageBlockAlignment == 0, Check::alignment, Status::misaligned, offset_names[i], -1,
                     offsets[i], kImageBlockAlignment, Expect::multiple_of)) {
       return run.status;
@@ -500,16 +534,17 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   }
   // Under a generous capacity the 32-bit layout arithmetic below could wrap
   // into a size that matches; dims whose arrays alone exceed the image cannot.
-  const std::uint64_t array_bytes = std::uint64_t{n} * (d + kImageOutputs) * 4;
+  const std::uint64_t array_bytes =
+      (std::uint64_t{n} * (d + kImageOutputs) + std::uint64_t{image_variance_floats(rank, d)}) * 4;
   if (!run.expect(array_bytes <= declared_total, Check::layout, Status::size_mismatch, "total_size", -1,
                   declared_total, static_cast<double>(array_bytes), Expect::at_least)) {
     return run.status;
   }
   if (array_bytes <= declared_total) {
-    const ImageLayout expected = image_layout(n, d, segments, major);
+    const ImageLayout expected = image_layout(n, d, segments, major, rank);
     const std::uint32_t expected_offsets[] = {expected.geometry_offset, expected.parameters_offset,
-                                              expected.inputs_offset, expected.alpha_offset,
-                                              expected.metadata_offset};
+                                              expected.inputs_offset,   expected.alpha_offset,
+                                              expected.metadata_offset, expected.variance_offset};
     if (!run.expect(declared_total == expected.total_size, Check::layout, Status::size_mismatch, "total_size", -1,
                     declared_total, expected.total_size, Expect::equal)) {
       return run.status;
@@ -519,7 +554,7 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
                     "metadata_size", -1, declared_metadata_size, kImageMetadataSize, Expect::equal)) {
       return run.status;
     }
-    for (int i = 0; i < 5; ++i) {
+    for (int i = 0; i < 6; ++i) {
       if (!run.expect(offsets[i] == expected_offsets[i], Check::layout, Status::size_mismatch, offset_names[i], -1,
                       offsets[i], expected_offsets[i], Expect::equal)) {
         return run.status;
@@ -543,6 +578,8 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   const float* alpha = block(offsets[3], std::uint64_t{n} * kImageOutputs);
   const std::uint8_t* metadata =
       reinterpret_cast<const std::uint8_t*>(block(offsets[4], kImageMetadataSize / sizeof(float)));
+  const std::uint32_t variance_floats = image_variance_floats(rank, d);
+  const float* variance = rank > 0 ? block(offsets[5], variance_floats) : nullptr;
 
   const struct {
     const char* name;
@@ -551,7 +588,8 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   } payload[] = {{Run::name("geometry"), geometry, 3 * segments},
                  {Run::name("parameters"), parameters, parameter_floats},
                  {Run::name("inputs"), inputs, n * d},
-                 {Run::name("alpha"), alpha, n * kImageOutputs}};
+                 {Run::name("alpha"), alpha, n * kImageOutputs},
+                 {Run::name("variance"), variance, variance_floats}};
   for (const auto& values : payload) {
     if (values.values != nullptr && !expect_each(run, values.values, values.count, is_finite, Check::finite,
                                                  Status::non_finite_payload, values.name, Expect::finite)) {
@@ -618,6 +656,51 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
       return run.status;
     }
   }
+  // The variance block: positive calibration, a threshold that is a share
+  // of the signal variance, a zero reserved word, positive factor diagonals
+  // (they are divided by), and the one kernel it was computed with: its
+  // factors hold signal / noise, so every output must share both.
+  const float* variance_points = variance != nullptr ? variance + image_variance_field::points : nullptr;
+  const float* inducing_factor = variance_points != nullptr ? variance_points + rank * d : nullptr;
+  const float* posterior_factor = inducing_factor != nullptr ? inducing_factor + packed_triangle_floats(rank) : nullptr;
+  if (variance == nullptr && Run::kEveryCheck) {
+    // Nothing to judge; the report still names the check.
+    run.expect(true, Check::variance, Status::invalid_parameters, "variance_rank", -1, rank, 0, Expect::at_least);
+  }
+  if (variance != nullptr) {
+    using namespace image_variance_field;
+    if (!expect_each(run, variance, reserved, is_positive, Check::positive, Status::invalid_parameters,
+                     Run::name("variance_calibration"), Expect::positive)) {
+      return run.status;
+    }
+    for (std::uint32_t i = 0; i < rank; ++i) {
+      const std::uint32_t diagonal = packed_triangle_floats(i + 1) - 1;
+      if (!run.expect(is_positive(inducing_factor[diagonal]), Check::variance, Status::invalid_parameters,
+                      "variance_inducing_factor", static_cast<std::int32_t>(diagonal), inducing_factor[diagonal], 0,
+                      Expect::positive) ||
+          !run.expect(is_positive(posterior_factor[diagonal]), Check::variance, Status::invalid_parameters,
+                      "variance_posterior_factor", static_cast<std::int32_t>(diagonal), posterior_factor[diagonal],
+                      0, Expect::positive)) {
+        return run.status;
+      }
+    }
+    if (!run.expect(variance[extrapolation_variance] <= 1.0f, Check::variance, Status::invalid_parameters,
+                    "extrapolation_variance", -1, variance[extrapolation_variance], 1, Expect::at_most) ||
+        !run.expect(variance[reserved] == 0.0f, Check::variance, Status::invalid_parameters, "variance_reserved", -1,
+                    variance[reserved], 0, Expect::equal)) {
+      return run.status;
+    }
+    if (signal_variance != nullptr) {
+      for (int k = 1; k < kImageOutputs; ++k) {
+        if (!run.expect(signal_variance[k] == signal_variance[0], Check::variance, Status::invalid_parameters,
+                        "signal_variance", k, signal_variance[k], signal_variance[0], Expect::equal) ||
+            !run.expect(noise_variance[k] == noise_variance[0], Check::variance, Status::invalid_parameters,
+                        "noise_variance", k, noise_variance[k], noise_variance[0], Expect::equal)) {
+          return run.status;
+        }
+      }
+    }
+  }
   if (run.status != Status::ok) return run.status;
 
   ImageView v{};
@@ -642,6 +725,11 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   v.input_max = input_max;
   v.inputs = inputs;
   v.alpha = alpha;
+  v.variance_rank = rank;
+  v.variance_calibration = variance;
+  v.variance_points = variance_points;
+  v.variance_inducing_factor = inducing_factor;
+  v.variance_posterior_factor = posterior_factor;
   v.dataset_hash = read_u64(metadata + image_metadata_field::dataset_hash);
   v.created_unix_s = static_cast<std::int64_t>(read_u64(metadata + image_metadata_field::created_unix_s));
   v.validation_samples = read_u32(metadata + image_metadata_field::validation_samples);

@@ -72,6 +72,14 @@ class GpCorrection {
 
   std::uint32_t training_points() const { return training_points_; }
 
+  // z = (x - input_mean) / (input_scale * length_scale) for x = encode(bend):
+  // the coordinates the points are stored in (input_dims() values).
+  void kernel_coordinates(const JointVector<S, MaxSegments>& bend, S* z) const {
+    Input x(input_dims_);
+    encode_inputs(encoding_, bend, x);
+    for (int d = 0; d < input_dims_; ++d) z[d] = (x[d] - input_mean_[d]) * input_gain_[d];
+  }
+
   // The error twist eps (v, omega) for a stacked bend vector.
   Twist<S> predict(const JointVector<S, MaxSegments>& bend) const {
     S z[kMaxInputs];
@@ -214,11 +222,6 @@ class GpCorrection {
     }
   }
 
-  void kernel_coordinates(const JointVector<S, MaxSegments>& bend, S* z) const {
-    Input x(input_dims_);
-    encode_inputs(encoding_, bend, x);
-    for (int d = 0; d < input_dims_; ++d) z[d] = (x[d] - input_mean_[d]) * input_gain_[d];
-  }
 
   // The mean's loop: Dims inputs (0: input_dims_ at run time). The terms are
   // summed in S over blocks of kBlockPoints training points and each block

@@ -1,0 +1,208 @@
+#pragma once
+// How far the measured tip may lie from the compensated pose, and whether a
+// query lies outside what the model was fitted on: the predictive variance
+// of flash image v2.1 (model/flash-image-v2.md, "Variance").
+//
+// The GP's latent variance at a query, as a share of the signal variance s,
+// is the variational (VFE) posterior's on R variance points u, fitted on
+// every data row:
+//   share(z) = 1 - |a|^2 + |L_c^-1 a|^2,  a = L_u^-1 r,  r_j = exp(-|z - u_j|^2 / 2),
+// L_u = chol(R_uu), L_c = chol(I + (s / n) L_u^-1 R_uf R_fu L_u^-T), with R
+// the kernel without its amplitude. With the variance points at the data
+// rows this is the exact GP's variance. Per query it costs R kernel values
+// and two triangular solves: R (R + 1) multiply-adds and 2 R divisions. The
+// solves, not a stored inverse, keep float rounding bounded when the
+// variance points are close together and R_uu is ill-conditioned.
+//
+// Output k's predictive variance, the measurement noise n the model learned
+// included, is output_scale_k^2 (s share + n). A twist perturbation (dv,
+// domega) moves the compensated tip by dv + domega x p, so the tip's
+// covariance is S_v + [p]x S_omega [p]x^T; the outputs are independent GPs.
+// The radius holding 95 % of a zero-mean Gaussian with covariance S comes
+// from tr S and tr S^2: a scaled chi-square with the same two moments
+// (Patnaik), its quantile by Wilson and Hilferty's cube root; it is within
+// 3 % of the exact radius for every shape of S. The image's calibration
+// scales the radii (the trainer measures it on held-out rows).
+
+#include <cmath>
+#include <cstdint>
+
+#include "cdcr/model/flash_image.hpp"
+#include "cdcr/model/kernel_exp.hpp"
+#include "cdcr/model/limits.hpp"
+#include "cdcr/model/status.hpp"
+#include "cdcr/model/types.hpp"
+
+namespace cdcr::model {
+
+inline constexpr double kDegreesPerRadian = 57.295779513082320876798;
+
+template <typename S>
+struct PoseUncertainty {
+  S r95_mm = S(0);
+  S r95_deg = S(0);
+  S latent_share = S(0);       // latent variance / signal variance, 0 (known) to 1 (prior)
+  bool outside_range = false;  // some input beyond the range of the rows the model was fitted on
+  bool extrapolating = false;  // outside_range, or latent_share above the image's threshold
+};
+
+// The radius of the ball around 0 that holds 95 % of N(0, S), from
+// trace = tr S and trace_of_square = tr S^2 of the 3 x 3 covariance S.
+template <typename S>
+S gaussian_radius_95(S trace, S trace_of_square) {
+  if (!(trace > S(0)) || !(trace_of_square > S(0))) return S(0);
+  const S scale = trace_of_square / trace;             // c in c chi^2_nu
+  const S dof = trace * trace / trace_of_square;       // nu, 1 to 3
+  const S h = S(2) / (S(9) * dof);
+  const S cube_root = S(1) - h + S(1.6448536) * std::sqrt(h);  // z_0.95
+  return std::sqrt(scale * dof * cube_root * cube_root * cube_root);
+}
+
+// The uncalibrated radii (mm, deg) for independent error-twist variances
+// (v in mm^2, then omega in rad^2) at a compensated tip position.
+template <typename S>
+void gaussian_radii_95(const S (&variances)[kImageOutputs], const Vec3<S>& tip_mm, S& r95_mm, S& r95_deg) {
+  const S* v = variances;
+  const S* w = variances + 3;
+  // S_p = diag(v) + P diag(w) P^T with P = [p]x.
+  const S px = tip_mm.x();
+  const S py = tip_mm.y();
+  const S pz = tip_mm.z();
+  const S xx = v[0] + w[1] * pz * pz + w[2] * py * py;
+  const S yy = v[1] + w[0] * pz * pz + w[2] * px * px;
+  const S zz = v[2] + w[0] * py * py + w[1] * px * px;
+  const S xy = -w[2] * px * py;
+  const S xz = -w[1] * px * pz;
+  const S yz = -w[0] * py * pz;
+  const S trace = xx + yy + zz;
+  const S trace_of_square = xx * xx + yy * yy + zz * zz + S(2) * (xy * xy + xz * xz + yz * yz);
+  r95_mm = gaussian_radius_95(trace, trace_of_square);
+  r95_deg = gaussian_radius_95(w[0] + w[1] + w[2], w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * S(kDegreesPerRadian);
+}
+
+template <typename S, int MaxInputs = 2 * kMaxSegments>
+class GpUncertainty {
+ public:
+  static constexpr int kMaxRank = static_cast<int>(kMaxVarianceRank);
+
+  // Takes a view from parse_image(); the image bytes must outlive this
+  // object. An image without a variance block (v1, v2.0) still gives the
+  // range check, where it has ranges; its radii stay 0.
+  Status bind(const ImageView& image) {
+    if (image.input_dims < 1 || image.input_dims > MaxInputs ||
+        image.variance_rank > static_cast<std::uint32_t>(kMaxRank)) {
+      return Status::correction_failed;
+    }
+    dims_ = image.input_dims;
+    has_range_ = image.input_min != nullptr && image.input_max != nullptr;
+    for (int d = 0; d < dims_; ++d) {
+      // Kernel coordinates grow with x (the gain is positive), so the range
+      // maps bound to bound.
+      const S gain = S(1) / (S(image.input_scale[d]) * S(image.length_scale[d]));
+      if (has_range_) {
+        range_min_[d] = (S(image.input_min[d]) - S(image.input_mean[d])) * gain;
+        range_max_[d] = (S(image.input_max[d]) - S(image.input_mean[d])) * gain;
+      }
+    }
+    rank_ = static_cast<int>(image.variance_rank);
+    if (rank_ > 0) {
+      points_ = image.variance_points;
+      inducing_factor_ = image.variance_inducing_factor;
+      posterior_factor_ = image.variance_posterior_factor;
+      position_scale_ = S(image.variance_calibration[image_variance_field::position_scale]);
+      orientation_scale_ = S(image.variance_calibration[image_variance_field::orientation_scale]);
+      threshold_ = S(image.variance_calibration[image_variance_field::extrapolation_variance]);
+      signal_ = S(image.signal_variance[0]);
+      noise_ = S(image.noise_variance[0]);
+      for (int k = 0; k < kImageOutputs; ++k) {
+        const S scale = S(image.output_scale[k]);
+        output_scale_sq_[k] = scale * scale;
+      }
+    }
+    bound_ = true;
+    return Status::ok;
+  }
+
+  bool bound() const { return bound_; }
+  bool has_variance() const { return rank_ > 0; }
+  int rank() const { return rank_; }
+
+  // share(z) for kernel coordinates z (GpCorrection::kernel_coordinates).
+  S latent_share(const S* z) const {
+    S a[kMaxRank];
+    const float* u = points_;
+    for (int j = 0; j < rank_; ++j) {
+      S distance_sq = S(0);
+      for (int d = 0; d < dims_; ++d) {
+        const S difference = z[d] - S(u[d]);
+        distance_sq = multiply_add(difference, difference, distance_sq);
+      }
+      u += dims_;
+      a[j] = gaussian(distance_sq);
+    }
+    const S known = solve_lower_in_place(inducing_factor_, a);
+    const S recovered = solve_lower_in_place(posterior_factor_, a);
+    const S share = S(1) - known + recovered;
+    return share < S(0) ? S(0) : (share > S(1) ? S(1) : share);
+  }
+
+  bool outside_range(const S* z) const {
+    if (!has_range_) return false;
+    for (int d = 0; d < dims_; ++d) {
+      if (z[d] < range_min_[d] || z[d] > range_max_[d]) return true;
+    }
+    return false;
+  }
+
+  // The radii around the compensated pose whose tip is at tip_mm, and the
+  // extrapolation flag, for the query with kernel coordinates z.
+  PoseUncertainty<S> evaluate(const S* z, const Vec3<S>& tip_mm) const {
+    PoseUncertainty<S> result;
+    result.outside_range = outside_range(z);
+    result.extrapolating = result.outside_range;
+    if (rank_ == 0) return result;
+    result.latent_share = latent_share(z);
+    result.extrapolating = result.extrapolating || result.latent_share > threshold_;
+    const S normalised = signal_ * result.latent_share + noise_;
+    S variances[kImageOutputs];
+    for (int k = 0; k < kImageOutputs; ++k) variances[k] = output_scale_sq_[k] * normalised;
+    gaussian_radii_95(variances, tip_mm, result.r95_mm, result.r95_deg);
+    result.r95_mm *= position_scale_;
+    result.r95_deg *= orientation_scale_;
+    return result;
+  }
+
+ private:
+  // x = L^-1 x for the packed lower triangle L (row i: i + 1 values, the
+  // diagonal last); returns |x|^2 after the solve.
+  S solve_lower_in_place(const float* factor, S* x) const {
+    S norm_sq = S(0);
+    const float* row = factor;
+    for (int i = 0; i < rank_; ++i) {
+      S sum = x[i];
+      for (int j = 0; j < i; ++j) sum = multiply_add(-S(row[j]), x[j], sum);
+      x[i] = sum / S(row[i]);
+      norm_sq = multiply_add(x[i], x[i], norm_sq);
+      row += i + 1;
+    }
+    return norm_sq;
+  }
+
+  bool bound_ = false;
+  int dims_ = 0;
+  int rank_ = 0;
+  bool has_range_ = false;
+  S range_min_[MaxInputs] = {};
+  S range_max_[MaxInputs] = {};
+  const float* points_ = nullptr;
+  const float* inducing_factor_ = nullptr;
+  const float* posterior_factor_ = nullptr;
+  S position_scale_ = S(1);
+  S orientation_scale_ = S(1);
+  S threshold_ = S(1);
+  S signal_ = S(0);
+  S noise_ = S(0);
+  S output_scale_sq_[kImageOutputs] = {};
+};
+
+}  // namespace cdcr::model
