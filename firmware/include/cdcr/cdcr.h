@@ -45,7 +45,7 @@ extern "C" {
 /* Bytes of cdcr_runtime: enough for every supported target (host, Cortex-M7,
  * Cortex-M4F), checked when the library is compiled;
  * cdcr_runtime_storage_size() says how much this build uses. */
-#define CDCR_RUNTIME_STORAGE_BYTES 12288u
+#define CDCR_RUNTIME_STORAGE_BYTES 8192u
 
 /* Opaque: the caller provides the storage, typically as a static variable. */
 typedef struct cdcr_runtime {
@@ -228,7 +228,8 @@ cdcr_result cdcr_set_segment_cable_lengths(cdcr_runtime *runtime, int segment, c
  * publishes setpoints when it converges (see cdcr_status.ik_outcome). */
 cdcr_result cdcr_set_target(cdcr_runtime *runtime, const cdcr_target *target);
 
-/* The latest pose: CDCR_ERROR_NO_DATA before the first. */
+/* The latest pose: CDCR_ERROR_NO_DATA before the first, and in FAULT (the
+ * runtime publishes no pose then). */
 cdcr_result cdcr_get_pose(const cdcr_runtime *runtime, cdcr_pose *pose);
 /* The latest setpoints: CDCR_ERROR_NO_DATA before the first converged target. */
 cdcr_result cdcr_get_setpoints(const cdcr_runtime *runtime, cdcr_setpoints *setpoints);
