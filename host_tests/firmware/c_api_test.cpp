@@ -1,0 +1,387 @@
+// The C API (cdcr/cdcr.h) against the C++ runtime it wraps: the same pose
+// from the same cable lengths, bit for bit; the paper's Table 1 pose without
+// an image; targets solved to setpoints; the states and faults as the
+// runtime reports them; and an error code for every argument it cannot use.
+
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include <cdcr/cdcr.h>
+#include <cdcr/firmware/protocol.hpp>
+#include <cdcr/firmware/runtime.hpp>
+
+#include "c_api_check.h"
+#include "export/image_writer.hpp"
+#include "synthetic_trained_model.hpp"
+
+namespace cdcr::firmware {
+namespace {
+
+// Corrections of a few tenths of a millimetre, as a trained model makes.
+std::vector<std::uint8_t> small_image(int segments = 2) {
+  test_support::SyntheticModelOptions options;
+  options.segments = segments;
+  training::TrainedModel m = test_support::synthetic_trained_model(options);
+  for (int k = 0; k < 6; ++k) {
+    m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
+    m.output_scale[k] *= k < 3 ? 0.1 : 0.001;
+  }
+  return exporting::write_image(m);
+}
+
+// A HAL with nothing on it but the image, for the C++ runtime beside the C one.
+struct QuietHal final : hal::MonotonicClock, hal::PeriodicTimer, hal::CanBus, hal::ModelStorage, hal::Console {
+  explicit QuietHal(const std::vector<std::uint8_t>& image) : image(image) {}
+  std::int64_t now_ns() const override { return 0; }
+  void start(std::int64_t) override {}
+  hal::TimerTick wait_next() override { return {}; }
+  std::int64_t period_ns() const override { return 0; }
+  std::uint32_t overruns() const override { return 0; }
+  hal::CanStatus send(const hal::CanFrame&) override { return hal::CanStatus::ok; }
+  hal::CanStatus receive(hal::CanFrame&) override { return hal::CanStatus::empty; }
+  bool set_filters(const hal::CanFilter*, std::size_t) override { return true; }
+  hal::CanErrorCounters error_counters() const override { return {}; }
+  hal::MemoryRegion model_region() const override { return {image.data(), image.size()}; }
+  void write_line(const char*) override {}
+  hal::Hal hal() { return hal::Hal{*this, *this, *this, *this, *this}; }
+  std::vector<std::uint8_t> image;
+};
+
+// Lengths of a bent robot, on the protocol's 0.01 mm steps.
+std::vector<float> bent_cables(const Geometry& geometry, double theta_rad = 0.15) {
+  model::RobotGeometry<double, kMaxSegments> g = geometry.cast<double>();
+  model::JointVector<double, kMaxSegments> joints(2 * g.segment_count);
+  for (int s = 0; s < g.segment_count; ++s) {
+    joints[2 * s] = 0.7 * (s + 1);
+    joints[2 * s + 1] = theta_rad;
+  }
+  model::CableVector<double, kMaxSegments> cables;
+  EXPECT_EQ(model::cables_from_joints(joints, g, cables), model::Status::ok);
+  std::vector<float> out;
+  for (int i = 0; i < cables.size(); ++i) out.push_back(float(std::round(cables[i] * 100.0) / 100.0));
+  return out;
+}
+
+TEST(CApi, PoseFromCableLengthsIsTheRuntimes) {
+  const std::vector<std::uint8_t> image = small_image();
+  QuietHal platform(image);
+  Runtime runtime(platform.hal(), Geometry::prototype());
+  ASSERT_EQ(runtime.init(), RuntimeState::run);
+  const std::vector<float> lengths = bent_cables(runtime.geometry());
+
+  cdcr_pose pose{};
+  cdcr_status status{};
+  ASSERT_EQ(c_api_check_pose(image.data(), std::uint32_t(image.size()), nullptr, lengths.data(), lengths.size(), 3,
+                             &pose, &status),
+            0);
+  EXPECT_EQ(status.state, CDCR_STATE_RUN);
+  EXPECT_EQ(status.fault, CDCR_FAULT_NONE);
+  EXPECT_EQ(status.cycles, 3u);
+
+  // What the runtime makes of the lengths a drive sends in a frame.
+  Cables cables(lengths.size());
+  for (std::size_t i = 0; i < lengths.size(); ++i) {
+    cables[i] = Scalar(protocol::cable_length_as_transmitted(lengths[i]));
+  }
+  PoseEstimate expected;
+  ASSERT_EQ(runtime.estimate_pose(cables, expected), model::Status::ok);
+  ASSERT_TRUE(expected.compensated);
+  EXPECT_EQ(pose.compensated, 1);
+  EXPECT_EQ(pose.segment_count, 2);
+  EXPECT_EQ(pose.count, 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(pose.position_mm[i], expected.pose.position_mm[i]) << "position " << i;
+    for (int j = 0; j < 3; ++j) EXPECT_EQ(pose.rotation[3 * i + j], expected.pose.rotation(i, j)) << i << "," << j;
+  }
+  for (int i = 0; i < 4; ++i) EXPECT_EQ(pose.joints[i], expected.joints[i]) << "joint " << i;
+  // The quaternion is the rotation's, w >= 0.
+  const Eigen::Quaternionf q(pose.quaternion[0], pose.quaternion[1], pose.quaternion[2], pose.quaternion[3]);
+  EXPECT_GE(pose.quaternion[0], 0.0f);
+  EXPECT_LT((q.toRotationMatrix() - expected.pose.rotation).cwiseAbs().maxCoeff(), 1e-5f);
+}
+
+// The paper's Table 1, case 2 (L = 120 mm, r = 70 mm): without an image the
+// C API gives the nominal pose printed there.
+TEST(CApi, NominalPoseWithoutAnImageIsTable1) {
+  const float lengths[16] = {118, 123, 124, 115, 124, 115, 118, 121, 110, 117, 125, 123, 124, 105, 112, 128};
+  const cdcr_geometry geometry = {4, 120.0f, 70.0f, 1.5707963f};
+  cdcr_pose pose{};
+  cdcr_status status{};
+  ASSERT_EQ(c_api_check_pose(nullptr, 0, &geometry, lengths, 16, 1, &pose, &status), 0);
+  EXPECT_EQ(status.state, CDCR_STATE_DEGRADED);
+  EXPECT_EQ(status.boot_fault, CDCR_FAULT_IMAGE_MISSING);
+  EXPECT_EQ(pose.compensated, 0);
+  const float expected[12] = {0.9997f, 0.0125f,  0.0200f, 19.2070f, -0.0084f, 0.9814f,
+                              -0.1917f, -6.3962f, -0.0220f, 0.1914f, 0.9813f, 478.3811f};
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_NEAR(pose.position_mm[i], expected[4 * i + 3], 2e-3) << "position " << i;
+    for (int j = 0; j < 3; ++j) EXPECT_NEAR(pose.rotation[3 * i + j], expected[4 * i + j], 1e-4) << i << "," << j;
+  }
+}
+
+class CApiRuntime : public ::testing::Test {
+ protected:
+  void init(const std::vector<std::uint8_t>& image_bytes) {
+    image = image_bytes;
+    config = cdcr_config{};
+    config.model_image = image.empty() ? nullptr : image.data();
+    config.model_image_size = std::uint32_t(image.size());
+    config.fallback_geometry = cdcr_geometry{2, 120.0f, 67.0f, 1.5707963f};
+    ASSERT_EQ(cdcr_init(&runtime, &config), CDCR_OK);
+  }
+  void step_with(const std::vector<float>& lengths, int steps = 1) {
+    for (int k = 0; k < steps; ++k) {
+      ASSERT_EQ(cdcr_set_cable_lengths(&runtime, lengths.data(), lengths.size()), CDCR_OK);
+      ASSERT_EQ(cdcr_step(&runtime), CDCR_OK);
+    }
+  }
+  cdcr_status status() {
+    cdcr_status s{};
+    EXPECT_EQ(cdcr_get_status(&runtime, &s), CDCR_OK);
+    return s;
+  }
+
+  std::vector<std::uint8_t> image;
+  cdcr_config config{};
+  cdcr_runtime runtime{};
+};
+
+// A pose target from the C API: solved over steps, setpoints out, and the
+// drives at the setpoints put the tip on the target.
+TEST_F(CApiRuntime, TargetIsSolvedToSetpoints) {
+  init(small_image());
+  std::vector<float> lengths = bent_cables(Geometry::uniform(2, 120.0f, 67.0f), 0.1);
+  step_with(lengths, 2);
+  cdcr_pose start{};
+  ASSERT_EQ(cdcr_get_pose(&runtime, &start), CDCR_OK);
+  cdcr_setpoints setpoints{};
+  EXPECT_EQ(cdcr_get_setpoints(&runtime, &setpoints), CDCR_ERROR_NO_DATA);
+  EXPECT_EQ(status().ik_outcome, CDCR_IK_NONE);
+
+  cdcr_target target{};
+  target.position_mm[0] = start.position_mm[0] + 4.0f;
+  target.position_mm[1] = start.position_mm[1] - 3.0f;
+  target.position_mm[2] = start.position_mm[2] - 1.0f;
+  target.mode = CDCR_TARGET_POSITION;
+  target.sequence = 42;
+  ASSERT_EQ(cdcr_set_target(&runtime, &target), CDCR_OK);
+  int steps = 0;
+  do {
+    step_with(lengths);
+  } while (status().ik_running && ++steps < 300);
+  const cdcr_status done = status();
+  EXPECT_EQ(done.ik_outcome, CDCR_IK_CONVERGED);
+  EXPECT_EQ(done.ik_sequence, 42);
+  EXPECT_EQ(done.targets_received, 1u);
+  EXPECT_LT(done.ik_position_error_mm, 0.05f);
+  ASSERT_EQ(cdcr_get_setpoints(&runtime, &setpoints), CDCR_OK);
+  ASSERT_EQ(setpoints.cable_count, 8);
+  EXPECT_GE(setpoints.count, 1u);
+
+  lengths.assign(setpoints.lengths_mm, setpoints.lengths_mm + setpoints.cable_count);
+  step_with(lengths);
+  cdcr_pose reached{};
+  ASSERT_EQ(cdcr_get_pose(&runtime, &reached), CDCR_OK);
+  // Within the solver's acceptance and the drives' 0.01 mm steps.
+  const float distance = std::hypot(reached.position_mm[0] - target.position_mm[0],
+                                    reached.position_mm[1] - target.position_mm[1],
+                                    reached.position_mm[2] - target.position_mm[2]);
+  EXPECT_LT(distance, 0.1f);
+}
+
+TEST_F(CApiRuntime, SilentDrivesAreAFaultWithNoPose) {
+  init(small_image());
+  const std::vector<float> lengths = bent_cables(Geometry::uniform(2, 120.0f, 67.0f));
+  step_with(lengths);
+  cdcr_pose pose{};
+  EXPECT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_OK);
+  for (int k = 0; k < 12; ++k) ASSERT_EQ(cdcr_step(&runtime), CDCR_OK);
+  EXPECT_EQ(status().state, CDCR_STATE_FAULT);
+  EXPECT_EQ(status().fault, CDCR_FAULT_CABLE_INPUT_STALE);
+  EXPECT_EQ(status().stale_events, 1u);
+  EXPECT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_ERROR_NO_DATA);
+  step_with(lengths);
+  EXPECT_EQ(status().state, CDCR_STATE_RUN);
+  EXPECT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_OK);
+}
+
+TEST_F(CApiRuntime, DamagedImageIsDegradedWithTheParsersReason) {
+  std::vector<std::uint8_t> damaged = small_image();
+  damaged[damaged.size() / 2] ^= 0x40;
+  init(damaged);
+  EXPECT_EQ(status().state, CDCR_STATE_DEGRADED);
+  EXPECT_EQ(status().boot_fault, CDCR_FAULT_IMAGE_INVALID);
+  EXPECT_EQ(status().fault_detail, std::uint8_t(model::ImageStatus::checksum_mismatch));
+  step_with(bent_cables(Geometry::uniform(2, 120.0f, 67.0f)));
+  cdcr_pose pose{};
+  ASSERT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_OK);
+  EXPECT_EQ(pose.compensated, 0);
+}
+
+// A board on the CAN protocol: its frames through the callbacks.
+struct Bus {
+  std::vector<cdcr_can_frame> sent;
+  std::vector<cdcr_can_frame> inbox;
+  int filters_set = 0;
+};
+
+TEST_F(CApiRuntime, CanCallbacksCarryTheProtocol) {
+  Bus bus;
+  image = small_image();
+  config = cdcr_config{};
+  config.model_image = image.data();
+  config.model_image_size = std::uint32_t(image.size());
+  config.callbacks.user = &bus;
+  config.callbacks.can_send = [](void* user, const cdcr_can_frame* frame) {
+    static_cast<Bus*>(user)->sent.push_back(*frame);
+    return 0;
+  };
+  config.callbacks.can_receive = [](void* user, cdcr_can_frame* frame) {
+    Bus& b = *static_cast<Bus*>(user);
+    if (b.inbox.empty()) return 0;
+    *frame = b.inbox.front();
+    b.inbox.erase(b.inbox.begin());
+    return 1;
+  };
+  config.callbacks.can_set_filters = [](void* user, const cdcr_can_filter*, size_t count) {
+    static_cast<Bus*>(user)->filters_set = int(count);
+    return 1;
+  };
+  ASSERT_EQ(cdcr_init(&runtime, &config), CDCR_OK);
+  EXPECT_EQ(bus.filters_set, 2);
+  EXPECT_EQ(status().fault, CDCR_FAULT_NONE);
+
+  // The same lengths as frames on the caller's bus give the same pose as fed.
+  const std::vector<float> lengths = bent_cables(Geometry::uniform(2, 120.0f, 67.0f));
+  for (int s = 0; s < 2; ++s) {
+    protocol::CableFeedback feedback;
+    feedback.segment = s;
+    for (int k = 0; k < 4; ++k) feedback.lengths_mm[k] = lengths[4 * s + k];
+    hal::CanFrame frame;
+    ASSERT_TRUE(protocol::encode(feedback, frame));
+    cdcr_can_frame out{};
+    out.id = frame.id;
+    out.dlc = frame.dlc;
+    std::memcpy(out.data, frame.data, 8);
+    bus.inbox.push_back(out);
+  }
+  ASSERT_EQ(cdcr_step(&runtime), CDCR_OK);
+  cdcr_pose from_bus{};
+  ASSERT_EQ(cdcr_get_pose(&runtime, &from_bus), CDCR_OK);
+  bool pose_sent = false;
+  for (const cdcr_can_frame& frame : bus.sent) pose_sent = pose_sent || frame.id == protocol::pose_position_xy::kMessage.id;
+  EXPECT_TRUE(pose_sent);
+
+  step_with(lengths);
+  cdcr_pose fed{};
+  ASSERT_EQ(cdcr_get_pose(&runtime, &fed), CDCR_OK);
+  EXPECT_EQ(std::memcmp(fed.position_mm, from_bus.position_mm, sizeof fed.position_mm), 0);
+
+  // A receive without filters is the runtime's standing fault.
+  config.callbacks.can_set_filters = nullptr;
+  ASSERT_EQ(cdcr_init(&runtime, &config), CDCR_OK);
+  EXPECT_EQ(status().fault, CDCR_FAULT_CAN_FILTERS_REFUSED);
+}
+
+TEST_F(CApiRuntime, EveryUnusableArgumentHasItsErrorCode) {
+  cdcr_status s{};
+  cdcr_pose pose{};
+  cdcr_setpoints setpoints{};
+  const float four[4] = {120, 120, 120, 120};
+  // Storage no init has succeeded on.
+  EXPECT_EQ(cdcr_step(&runtime), CDCR_ERROR_NOT_INITIALIZED);
+  EXPECT_EQ(cdcr_get_status(&runtime, &s), CDCR_ERROR_NOT_INITIALIZED);
+  EXPECT_EQ(cdcr_set_segment_cable_lengths(&runtime, 0, four), CDCR_ERROR_NOT_INITIALIZED);
+  EXPECT_EQ(cdcr_step(nullptr), CDCR_ERROR_NULL_ARGUMENT);
+  EXPECT_EQ(cdcr_init(nullptr, &config), CDCR_ERROR_NULL_ARGUMENT);
+  EXPECT_EQ(cdcr_init(&runtime, nullptr), CDCR_ERROR_NULL_ARGUMENT);
+  config.model_image_size = 100;  // a size without an image
+  EXPECT_EQ(cdcr_init(&runtime, &config), CDCR_ERROR_NULL_ARGUMENT);
+  config.model_image_size = 0;
+  config.fallback_geometry = cdcr_geometry{9, 120.0f, 67.0f, 1.5f};
+  EXPECT_EQ(cdcr_init(&runtime, &config), CDCR_ERROR_INVALID_ARGUMENT);
+  config.fallback_geometry = cdcr_geometry{2, 120.0f, -67.0f, 1.5f};
+  EXPECT_EQ(cdcr_init(&runtime, &config), CDCR_ERROR_INVALID_ARGUMENT);
+  config.fallback_geometry = cdcr_geometry{};
+  config.period_ns = -1;
+  EXPECT_EQ(cdcr_init(&runtime, &config), CDCR_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(cdcr_step(&runtime), CDCR_ERROR_NOT_INITIALIZED);
+
+  init({});  // two segments, no image
+  EXPECT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_ERROR_NO_DATA);
+  EXPECT_EQ(cdcr_get_setpoints(&runtime, &setpoints), CDCR_ERROR_NO_DATA);
+  EXPECT_EQ(cdcr_get_pose(&runtime, nullptr), CDCR_ERROR_NULL_ARGUMENT);
+  EXPECT_EQ(cdcr_get_setpoints(&runtime, nullptr), CDCR_ERROR_NULL_ARGUMENT);
+  EXPECT_EQ(cdcr_get_status(&runtime, nullptr), CDCR_ERROR_NULL_ARGUMENT);
+
+  // Cable lengths.
+  const float eight[8] = {120, 120, 120, 120, 120, 120, 120, 120};
+  EXPECT_EQ(cdcr_set_cable_lengths(&runtime, nullptr, 8), CDCR_ERROR_NULL_ARGUMENT);
+  EXPECT_EQ(cdcr_set_cable_lengths(&runtime, eight, 4), CDCR_ERROR_INVALID_ARGUMENT);  // 2 segments: 8
+  EXPECT_EQ(cdcr_set_cable_lengths(&runtime, eight, 16), CDCR_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(cdcr_set_segment_cable_lengths(&runtime, 2, four), CDCR_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(cdcr_set_segment_cable_lengths(&runtime, -1, four), CDCR_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(cdcr_set_segment_cable_lengths(&runtime, 0, nullptr), CDCR_ERROR_NULL_ARGUMENT);
+  for (const float bad : {std::nanf(""), INFINITY, 0.0f, -5.0f, 655.35f, 700.0f}) {
+    float lengths[8] = {120, 120, 120, 120, 120, 120, 120, 120};
+    lengths[5] = bad;
+    EXPECT_EQ(cdcr_set_cable_lengths(&runtime, lengths, 8), CDCR_ERROR_OUT_OF_RANGE) << bad;
+  }
+  // Nothing of a refused set reached the runtime.
+  ASSERT_EQ(cdcr_step(&runtime), CDCR_OK);
+  EXPECT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_ERROR_NO_DATA);
+  EXPECT_EQ(status().rejected_frames, 0u);
+
+  // Targets.
+  cdcr_target target{};
+  target.position_mm[2] = 230.0f;
+  target.quaternion[0] = 1.0f;
+  target.mode = CDCR_TARGET_POSE;
+  EXPECT_EQ(cdcr_set_target(&runtime, nullptr), CDCR_ERROR_NULL_ARGUMENT);
+  target.quaternion[0] = 0.9f;  // not of unit norm
+  EXPECT_EQ(cdcr_set_target(&runtime, &target), CDCR_ERROR_INVALID_ARGUMENT);
+  target.quaternion[0] = 2.0f;  // would saturate to a unit quaternion in Q15
+  EXPECT_EQ(cdcr_set_target(&runtime, &target), CDCR_ERROR_INVALID_ARGUMENT);
+  target.quaternion[0] = std::nanf("");
+  EXPECT_EQ(cdcr_set_target(&runtime, &target), CDCR_ERROR_OUT_OF_RANGE);
+  target.quaternion[0] = 1.0f;
+  target.position_mm[0] = INFINITY;
+  EXPECT_EQ(cdcr_set_target(&runtime, &target), CDCR_ERROR_OUT_OF_RANGE);
+  target.position_mm[0] = 3e7f;
+  EXPECT_EQ(cdcr_set_target(&runtime, &target), CDCR_ERROR_OUT_OF_RANGE);
+  target.position_mm[0] = 0.0f;
+  target.mode = static_cast<cdcr_target_mode>(5);
+  EXPECT_EQ(cdcr_set_target(&runtime, &target), CDCR_ERROR_INVALID_ARGUMENT);
+  target.mode = CDCR_TARGET_POSITION;
+  target.quaternion[0] = 0.0f;  // not used for a position target
+  EXPECT_EQ(cdcr_set_target(&runtime, &target), CDCR_OK);
+
+  // The queue between two steps holds what a cycle carries, and says when full.
+  cdcr_result last = CDCR_OK;
+  int accepted = 0;
+  for (int k = 0; k < 100 && last == CDCR_OK; ++k) {
+    last = cdcr_set_segment_cable_lengths(&runtime, 0, four);
+    accepted += last == CDCR_OK;
+  }
+  EXPECT_EQ(last, CDCR_ERROR_QUEUE_FULL);
+  EXPECT_GE(accepted, 2 * CDCR_MAX_SEGMENTS);
+  EXPECT_EQ(cdcr_step(&runtime), CDCR_OK);
+  EXPECT_EQ(cdcr_set_cable_lengths(&runtime, eight, 8), CDCR_OK);
+
+  EXPECT_STREQ(cdcr_result_name(CDCR_ERROR_QUEUE_FULL), "queue full");
+  EXPECT_STREQ(cdcr_state_name(CDCR_STATE_DEGRADED), "DEGRADED");
+  EXPECT_STREQ(cdcr_fault_name(CDCR_FAULT_IMAGE_MISSING), "model image missing");
+}
+
+TEST(CApi, StorageHoldsTheRuntime) {
+  EXPECT_GT(cdcr_runtime_storage_size(), sizeof(Runtime));
+  EXPECT_LE(cdcr_runtime_storage_size(), std::size_t(CDCR_RUNTIME_STORAGE_BYTES));
+  EXPECT_EQ(sizeof(cdcr_runtime), std::size_t(CDCR_RUNTIME_STORAGE_BYTES));
+}
+
+}  // namespace
+}  // namespace cdcr::firmware
