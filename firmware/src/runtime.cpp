@@ -68,6 +68,7 @@ RuntimeState Runtime::init() {
     model::ImageCapacity capacity;
     capacity.max_training_points = kMaxTrainingPoints;
     capacity.max_segments = kMaxSegments;
+    capacity.max_variance_rank = kMaxVarianceRank;
     const model::ImageStatus parsed = model::parse_image(region.data, region.size_bytes, image_, capacity);
     if (parsed != model::ImageStatus::ok) {
       boot_fault_ = FaultCode::image_invalid;
@@ -80,6 +81,10 @@ RuntimeState Runtime::init() {
       geometry_ = fallback_geometry_;
       boot_fault_ = FaultCode::image_geometry_invalid;
       boot_fault_detail_ = FaultDetail(b);
+    } else if (const model::Status u = uncertainty_.bind(image_); u != model::Status::ok) {
+      geometry_ = fallback_geometry_;
+      boot_fault_ = FaultCode::image_geometry_invalid;
+      boot_fault_detail_ = FaultDetail(u);
     }
   }
   if (geometry_.validate() != model::Status::ok) {
@@ -98,10 +103,12 @@ RuntimeState Runtime::init() {
   // In DEGRADED the same solver solves the nominal model.
   solver_.configure(geometry_, mode_ == RuntimeState::run ? &solver_correction_ : nullptr, solver_options,
                     kIkWorkCosts);
-  // The forward path spends one unit per training point and the overhead;
-  // IK gets the rest.
-  const std::uint32_t forward_units =
-      kWorkCosts.cycle_overhead + (mode_ == RuntimeState::run ? correction_.training_points() : 0);
+  // The forward path spends one unit per training point, the variance's
+  // slice and the overhead; IK gets the rest.
+  const bool with_variance = mode_ == RuntimeState::run && uncertainty_.has_variance();
+  const std::uint32_t forward_units = kWorkCosts.cycle_overhead +
+                                      (mode_ == RuntimeState::run ? correction_.training_points() : 0) +
+                                      (with_variance ? kUncertaintyUnitsPerCycle : 0);
   ik_units_per_cycle_ = forward_units + kMinIkUnitsPerCycle < kCycleWorkUnits ? kCycleWorkUnits - forward_units
                                                                                : kMinIkUnitsPerCycle;
   enter(mode_);
@@ -144,6 +151,9 @@ model::Status Runtime::estimate_pose(const Cables& cables_mm, PoseEstimate& esti
     estimate.pose = result.compensated;
     estimate.joints = result.joints;
     estimate.compensated = true;
+    Scalar z[Correction::kMaxInputs];
+    correction_.kernel_coordinates(model::bend_from_joints(result.joints), z);
+    estimate.outside_range = uncertainty_.outside_range(z);
     return model::Status::ok;
   }
   Joints joints;
@@ -154,7 +164,19 @@ model::Status Runtime::estimate_pose(const Cables& cables_mm, PoseEstimate& esti
   estimate.pose = model::forward_kinematics_bend(model::bend_from_joints(joints), geometry_);
   estimate.joints = joints;
   estimate.compensated = false;
+  estimate.outside_range = false;
   return model::Status::ok;
+}
+
+model::PoseUncertainty<Scalar> Runtime::estimate_uncertainty(const PoseEstimate& estimate) const {
+  if (!estimate.compensated || !uncertainty_.bound()) return model::PoseUncertainty<Scalar>{};
+  Scalar z[Correction::kMaxInputs];
+  correction_.kernel_coordinates(model::bend_from_joints(estimate.joints), z);
+  return uncertainty_.evaluate(z, estimate.pose.position_mm);
+}
+
+bool Runtime::extrapolating() const {
+  return has_pose_ && (latest_pose_.outside_range || (has_uncertainty_ && latest_uncertainty_.extrapolating));
 }
 
 void Runtime::run_cycle(const hal::TimerTick& tick) {
@@ -167,6 +189,7 @@ void Runtime::run_cycle(const hal::TimerTick& tick) {
   for (int i = 0; i < kMaxRxFramesPerCycle && hal_.can.receive(frame) == hal::CanStatus::ok; ++i) handle_frame(frame);
 
   if (state_ != RuntimeState::boot) update_pose();
+  if (uncertainty_running_) continue_uncertainty();
   if (cycle_ % kStatusEveryCycles == 0) publish_status();
   // IK last: the pose, STATUS and the staleness check never wait for it.
   if (solving_) continue_solve();
@@ -252,6 +275,13 @@ void Runtime::update_pose() {
         enter(mode_);
       }
       publish_pose();
+      if (!uncertainty_running_ && latest_pose_.compensated && uncertainty_.has_variance()) {
+        Scalar z[Correction::kMaxInputs];
+        correction_.kernel_coordinates(model::bend_from_joints(latest_pose_.joints), z);
+        uncertainty_.begin_evaluation(z, latest_pose_.pose.position_mm, uncertainty_evaluation_);
+        uncertainty_running_ = true;
+        uncertainty_running_sequence_ = static_cast<std::uint8_t>(cycle_ & 0xFF);
+      }
     } else {
       statistics_.rejected_cable_sets += 1;
       record_event(FaultCode::cable_lengths_invalid, FaultDetail(s));
@@ -309,12 +339,33 @@ void Runtime::publish_pose() {
   protocol::encode(protocol::PosePositionXy{pose.position_mm.x(), pose.position_mm.y()}, frame);
   send(frame);
   protocol::encode(protocol::PosePositionZ{pose.position_mm.z(), latest_pose_.compensated,
-                                           static_cast<std::uint8_t>(cycle_ & 0xFF)},
+                                           static_cast<std::uint8_t>(cycle_ & 0xFF), extrapolating()},
                    frame);
   send(frame);
   protocol::encode(orientation_frame(pose.rotation), frame);
   send(frame);
   statistics_.poses_published += 1;
+}
+
+// A slice of the variance's work; when it ends, its radii go out.
+void Runtime::continue_uncertainty() {
+  uncertainty_.continue_evaluation(uncertainty_evaluation_, kUncertaintyUnitsPerCycle);
+  if (!uncertainty_.evaluation_finished(uncertainty_evaluation_)) return;
+  uncertainty_running_ = false;
+  latest_uncertainty_ = uncertainty_.evaluation_result(uncertainty_evaluation_);
+  has_uncertainty_ = true;
+  uncertainty_sequence_ = uncertainty_running_sequence_;
+  if (state_ == RuntimeState::fault) return;
+  protocol::PoseUncertainty message;
+  message.r95_position_mm = latest_uncertainty_.r95_mm;
+  message.r95_orientation_deg = latest_uncertainty_.r95_deg;
+  message.latent_share = latest_uncertainty_.latent_share;
+  message.extrapolating = latest_uncertainty_.extrapolating;
+  message.outside_range = latest_uncertainty_.outside_range;
+  message.sequence = uncertainty_sequence_;
+  hal::CanFrame frame;
+  protocol::encode(message, frame);
+  send(frame);
 }
 
 void Runtime::publish_status() {
@@ -323,6 +374,7 @@ void Runtime::publish_status() {
   const FaultDetail detail = active_fault_detail();
   protocol::Status status;
   status.state = state_;
+  status.extrapolating = extrapolating();
   status.fault = fault;
   status.overruns = statistics_.overruns;
   status.exec_max_us = to_us(statistics_.execution_max_ns);

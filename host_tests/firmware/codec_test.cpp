@@ -301,10 +301,47 @@ TEST(Frames, ReservedBitsMakeAFrameMalformed) {
   IkReport report;
   EXPECT_EQ(decode(frame_of(0x140, {1, 0x10, 0, 0, 0, 0, 0, 0}), report), DecodeStatus::reserved_bits_set);
   PosePositionZ pose;
-  EXPECT_EQ(decode(frame_of(0x131, {0, 0, 0, 0, 0x02, 0}), pose), DecodeStatus::reserved_bits_set);
+  EXPECT_EQ(decode(frame_of(0x131, {0, 0, 0, 0, 0x04, 0}), pose), DecodeStatus::reserved_bits_set);
   ASSERT_EQ(decode(frame_of(0x131, {0, 0, 0, 0, 0x01, 0}), pose), DecodeStatus::ok);
   EXPECT_TRUE(pose.compensated);
+  EXPECT_FALSE(pose.extrapolating);
+  ASSERT_EQ(decode(frame_of(0x131, {0, 0, 0, 0, 0x02, 0}), pose), DecodeStatus::ok);
+  EXPECT_TRUE(pose.extrapolating);
+  EXPECT_FALSE(pose.compensated);
+  PoseUncertainty uncertainty;
+  EXPECT_EQ(decode(frame_of(0x133, {0, 0, 0, 0, 0, 0x04, 0}), uncertainty), DecodeStatus::reserved_bits_set);
+  Status status;
+  EXPECT_EQ(decode(frame_of(0x150, {0x21, 0, 0, 0, 0, 0, 0, 0}), status), DecodeStatus::reserved_bits_set);
+  ASSERT_EQ(decode(frame_of(0x150, {0x11, 0, 0, 0, 0, 0, 0, 0}), status), DecodeStatus::ok);
+  EXPECT_EQ(status.state, RuntimeState::run);
+  EXPECT_TRUE(status.extrapolating);
   EXPECT_EQ(commit_sequence(frame_of(0x122, {0, 0})), 0);  // too short to hold one
+}
+
+TEST(Frames, PoseUncertaintyLayout) {
+  hal::CanFrame frame;
+  PoseUncertainty sent;
+  sent.r95_position_mm = 1.2345;
+  sent.r95_orientation_deg = 70.0;  // saturates at 65.535
+  sent.latent_share = 0.5;
+  sent.extrapolating = true;
+  sent.outside_range = false;
+  sent.sequence = 9;
+  encode(sent, frame);
+  EXPECT_EQ(frame.id, 0x133u);
+  // R95_POSITION 1235 = 0x04D3, R95_ORIENTATION 0xFFFF, LATENT_SHARE 100,
+  // FLAGS bit 0, SEQUENCE.
+  EXPECT_EQ(bytes_of(frame), (std::vector<std::uint8_t>{0xD3, 0x04, 0xFF, 0xFF, 100, 0x01, 9}));
+  PoseUncertainty received;
+  ASSERT_EQ(decode(frame, received), DecodeStatus::ok);
+  EXPECT_NEAR(received.r95_position_mm, 1.235, 1e-9);
+  EXPECT_NEAR(received.r95_orientation_deg, 65.535, 1e-9);
+  EXPECT_NEAR(received.latent_share, 0.5, 1e-9);
+  EXPECT_TRUE(received.extrapolating);
+  EXPECT_FALSE(received.outside_range);
+  EXPECT_EQ(received.sequence, 9);
+  // A share above 1 is out of range.
+  EXPECT_EQ(decode(frame_of(0x133, {0, 0, 0, 0, 201, 0, 0}), received), DecodeStatus::out_of_range);
 }
 
 TEST(Frames, IkReportLayout) {

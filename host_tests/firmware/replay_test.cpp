@@ -1,7 +1,9 @@
 // cdcr-runtime --replay runs the firmware's forward path; over the same image
 // and cables its poses agree with `cdcr eval`'s firmware poses
-// (training::firmware_poses).
+// (training::firmware_poses), and its radii and extrapolation flags with
+// eval's (training::firmware_estimates).
 
+#include <algorithm>
 #include <cmath>
 #include <cstdlib>
 #include <filesystem>
@@ -15,12 +17,20 @@
 #include "dataset/csv_dataset.hpp"
 #include "runtime_fixture.hpp"
 #include "train/evaluation.hpp"
+#include "train/predictive_variance.hpp"
 
 namespace cdcr::firmware {
 namespace {
 
 TEST(RuntimeReplay, MatchesTheEvaluationsFirmwarePoses) {
-  const std::vector<std::uint8_t> image = exporting::write_image(test_support::synthetic_trained_model());
+  training::TrainedModel trained = test_support::synthetic_trained_model();
+  // The variance factor holds one kernel for every output, as the trainer's.
+  trained.signal_variance.setConstant(trained.signal_variance[0]);
+  trained.noise_variance.setConstant(trained.noise_variance[0]);
+  trained.variance = training::fit_variance_factor(
+      trained, trained.inputs, training::variance_points(trained, trained.inputs, std::min(16, trained.training_points()), 1));
+  trained.variance.extrapolation_variance = 0.5;
+  const std::vector<std::uint8_t> image = exporting::write_image(trained);
   model::ImageView view;
   ASSERT_EQ(model::parse_image(image.data(), image.size(), view), model::ImageStatus::ok);
   model::RobotGeometry<double> geometry;
@@ -59,24 +69,41 @@ TEST(RuntimeReplay, MatchesTheEvaluationsFirmwarePoses) {
   const dataset::Dataset written = dataset::read_dataset_csv((dir / "cables.csv").string());
   const std::vector<model::Pose<double>> reference = training::firmware_poses(view, written.cables_mm);
 
+  const std::vector<training::FirmwareEstimate> estimates = training::firmware_estimates(view, written.cables_mm);
+
   std::ifstream in(dir / "poses.csv");
   std::string line;
   ASSERT_TRUE(std::getline(in, line));
-  EXPECT_EQ(line, "x,y,z,qw,qx,qy,qz");
+  EXPECT_EQ(line, "x,y,z,qw,qx,qy,qz,r95_mm,r95_deg,extrapolating");
   std::vector<model::Pose<double>> replayed;
+  int extrapolating = 0;
   while (std::getline(in, line)) {
-    double v[7];
-    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf", &v[0], &v[1], &v[2], &v[3], &v[4], &v[5], &v[6]),
-              7);
+    double v[9];
+    int flag = -1;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%lf,%d", &v[0], &v[1], &v[2], &v[3], &v[4],
+                          &v[5], &v[6], &v[7], &v[8], &flag),
+              10);
     model::Pose<double> pose;
     pose.position_mm = model::Vec3<double>(v[0], v[1], v[2]);
     pose.rotation = Eigen::Quaterniond(v[3], v[4], v[5], v[6]).normalized().toRotationMatrix();
+    const std::size_t row = replayed.size();
+    ASSERT_LT(row, estimates.size());
+    // The same float code on the same inputs: printed to 9 digits, the same.
+    EXPECT_FLOAT_EQ(static_cast<float>(v[7]), static_cast<float>(estimates[row].uncertainty.r95_mm)) << row;
+    EXPECT_FLOAT_EQ(static_cast<float>(v[8]), static_cast<float>(estimates[row].uncertainty.r95_deg)) << row;
+    EXPECT_GT(v[7], 0.0);
+    EXPECT_EQ(flag, estimates[row].uncertainty.extrapolating ? 1 : 0) << row;
+    extrapolating += flag;
     replayed.push_back(pose);
   }
   ASSERT_EQ(replayed.size(), reference.size());
   const training::Fidelity fidelity = training::compare_poses(reference, replayed);
   EXPECT_LT(fidelity.max_position_mm, 0.01);
   EXPECT_LT(fidelity.max_orientation_deg, 0.001);
+  // Joint angles up to 1.2 rad against a model fitted on a small region:
+  // some rows extrapolate, not all.
+  EXPECT_GT(extrapolating, 0);
+  EXPECT_LT(extrapolating, static_cast<int>(replayed.size()));
 }
 
 TEST(RuntimeReplay, CorruptImageIsOneLineErrorWithExitOne) {

@@ -975,3 +975,22 @@ TEST(FlashImageRuntime, FloatPredictionMatchesTrainerWithCompensatedFloatAccumul
 
 }  // namespace
 }  // namespace cdcr::model
+
+namespace cdcr::model {
+namespace {
+
+// A damaged rank whose block size would wrap a 32-bit count: both modes
+// refuse it, and the reporting mode reads nothing outside the image (the
+// fuzzer found the wrap; under ASan this test fails without the fix).
+TEST_F(FlashImage, AHugeVarianceRankIsRefusedWithoutReadingPastTheImage) {
+  for (const std::uint16_t rank : {std::uint16_t{65535}, std::uint16_t{65534}, std::uint16_t{4096}}) {
+    Bytes bad = image;
+    std::memcpy(bad.data() + image_field::variance_rank, &rank, 2);
+    reseal(bad);
+    EXPECT_NE(parse(bad, ImageCapacity{1024, 8, 65535}), ImageStatus::ok) << rank;
+    EXPECT_EQ(parse(bad), ImageStatus::over_capacity) << rank;
+  }
+}
+
+}  // namespace
+}  // namespace cdcr::model

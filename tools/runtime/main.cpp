@@ -74,7 +74,7 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
   }
   std::FILE* out = std::fopen(out_path.c_str(), "w");
   if (out == nullptr) throw InputError("cannot write " + out_path);
-  std::fprintf(out, "x,y,z,qw,qx,qy,qz\n");
+  std::fprintf(out, "x,y,z,qw,qx,qy,qz,r95_mm,r95_deg,extrapolating\n");
   for (Eigen::Index i = 0; i < data.cables_mm.rows(); ++i) {
     const fw::Cables cables = data.cables_mm.row(i).transpose().cast<float>();
     fw::PoseEstimate estimate;
@@ -86,8 +86,10 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
     Eigen::Quaterniond q(pose.rotation);
     q.normalize();
     if (q.w() < 0) q.coeffs() *= -1.0;
-    std::fprintf(out, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g\n", pose.position_mm.x(), pose.position_mm.y(),
-                 pose.position_mm.z(), q.w(), q.x(), q.y(), q.z());
+    const model::PoseUncertainty<fw::Scalar> uncertainty = runtime.estimate_uncertainty(estimate);
+    std::fprintf(out, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", pose.position_mm.x(), pose.position_mm.y(),
+                 pose.position_mm.z(), q.w(), q.x(), q.y(), q.z(), static_cast<double>(uncertainty.r95_mm),
+                 static_cast<double>(uncertainty.r95_deg), uncertainty.extrapolating ? 1 : 0);
   }
   if (std::fclose(out) != 0) throw InputError("cannot write " + out_path);
   return 0;

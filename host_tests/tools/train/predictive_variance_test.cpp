@@ -174,6 +174,22 @@ TEST(PredictiveVariance, TheBoardsFloatPathMatchesTheTrainer) {
     const model::PoseUncertainty<float> u = board.evaluate(zf, tip);
     EXPECT_NEAR(u.latent_share, share[i], 2e-4) << "query " << i;
 
+    // In slices of a few units, as the runtime spreads it over cycles: the
+    // same steps, so the same bits.
+    model::GpUncertainty<float>::Evaluation sliced;
+    board.begin_evaluation(zf, tip, sliced);
+    int slices = 0;
+    while (!board.evaluation_finished(sliced)) {
+      const std::uint32_t spent = board.continue_evaluation(sliced, 7);
+      ASSERT_GT(spent, 0u);
+      ASSERT_LE(spent, 7u);
+      ++slices;
+    }
+    EXPECT_GT(slices, 10);
+    const model::PoseUncertainty<float> from_slices = board.evaluation_result(sliced);
+    EXPECT_EQ(from_slices.latent_share, u.latent_share);
+    EXPECT_EQ(from_slices.r95_mm, u.r95_mm);
+
     double variances[6];
     for (int k = 0; k < 6; ++k) {
       variances[k] = m.output_scale[k] * m.output_scale[k] *

@@ -56,6 +56,12 @@ inline constexpr std::uint32_t kMinIkUnitsPerCycle =
     std::max({kIkWorkCosts.nominal_jacobian, kIkWorkCosts.nominal_step, kIkWorkCosts.outer_step, kWorkCosts.ik_finish,
               model::GpCorrection<float>::kChunkPoints * kWorkCosts.gradient_point});
 
+// Work units a cycle spends on the predictive variance of the latest pose
+// (model::GpUncertainty): an evaluation takes a few cycles (64 variance
+// points cost 384 units: 4 cycles), and its radii go out when it ends.
+inline constexpr std::uint32_t kUncertaintyUnitsPerCycle = 96;
+inline constexpr int kMaxVarianceRank = static_cast<int>(model::kMaxVarianceRank);
+
 // Bounds of one IK request: correction evaluations and nominal LM
 // iterations (see model::IkSolverOptions), and the cycles it may span
 // before it is reported unreachable.

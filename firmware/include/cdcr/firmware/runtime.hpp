@@ -28,6 +28,7 @@
 #include "cdcr/model/compensated_kinematics.hpp"
 #include "cdcr/model/flash_image.hpp"
 #include "cdcr/model/gp_correction.hpp"
+#include "cdcr/model/gp_uncertainty.hpp"
 #include "cdcr/model/inverse_kinematics.hpp"
 
 namespace cdcr::firmware {
@@ -46,6 +47,7 @@ using Geometry = model::RobotGeometry<Scalar, kMaxSegments>;
 using Cables = model::CableVector<Scalar, kMaxSegments>;
 using Joints = model::JointVector<Scalar, kMaxSegments>;
 using Correction = model::GpCorrection<Scalar, Accumulator, kMaxSegments>;
+using Uncertainty = model::GpUncertainty<Scalar, 2 * kMaxSegments>;
 using Pose = model::Pose<Scalar>;
 // The correction as the IK solver sees it: the GP's evaluation in slices.
 // Its functions are defined in runtime.cpp, beside the forward path, so the
@@ -86,6 +88,8 @@ struct PoseEstimate {
   Pose pose;
   Joints joints;
   bool compensated = false;
+  // Outside the input range the model was fitted on (never in DEGRADED).
+  bool outside_range = false;
 };
 
 // The outcome of the last committed target, as IK_REPORT carries it.
@@ -121,6 +125,10 @@ class Runtime {
   // The forward path run_cycle applies to the latest cable set: nominal or
   // compensated by state. Writes `estimate` only on success.
   model::Status estimate_pose(const Cables& cables_mm, PoseEstimate& estimate) const;
+  // The radii and extrapolation flag of an estimate, in one go (a cycle
+  // spreads the same steps over a few cycles); zero radii without a
+  // variance block or in DEGRADED.
+  model::PoseUncertainty<Scalar> estimate_uncertainty(const PoseEstimate& estimate) const;
 
   RuntimeState state() const { return state_; }
   // What STATUS reports: stale input in FAULT, else the last rejection since
@@ -151,6 +159,14 @@ class Runtime {
   const Cables& setpoints_mm() const { return setpoints_mm_; }
   bool has_pose() const { return has_pose_; }
   const PoseEstimate& latest_pose() const { return latest_pose_; }
+  // The last radii sent (POSE_UNCERTAINTY), for the pose of cycle
+  // latest_uncertainty_sequence().
+  bool has_uncertainty() const { return has_uncertainty_; }
+  const model::PoseUncertainty<Scalar>& latest_uncertainty() const { return latest_uncertainty_; }
+  std::uint8_t latest_uncertainty_sequence() const { return uncertainty_sequence_; }
+  // Whether the latest pose extrapolates: outside the fitted range, or the
+  // last radii said so.
+  bool extrapolating() const;
 
  private:
   void handle_frame(const hal::CanFrame& frame);
@@ -169,6 +185,7 @@ class Runtime {
   bool input_stale() const;
   void update_pose();
   void publish_pose();
+  void continue_uncertainty();
   void publish_setpoints();
   void publish_ik_report();
   void publish_status();
@@ -200,6 +217,15 @@ class Runtime {
 
   PoseEstimate latest_pose_;
   bool has_pose_ = false;
+
+  // The variance of a recent pose, a few cycles' work.
+  Uncertainty uncertainty_;
+  Uncertainty::Evaluation uncertainty_evaluation_;
+  bool uncertainty_running_ = false;
+  std::uint8_t uncertainty_running_sequence_ = 0;
+  model::PoseUncertainty<Scalar> latest_uncertainty_;
+  bool has_uncertainty_ = false;
+  std::uint8_t uncertainty_sequence_ = 0;
 
   // The parts of a target received before its commit frame.
   bool has_pending_position_ = false;

@@ -112,8 +112,10 @@ inline constexpr std::uint32_t points = 4;                  // R x D kernel coor
 
 constexpr std::uint32_t packed_triangle_floats(std::uint32_t rank) { return rank * (rank + 1) / 2; }
 
-constexpr std::uint32_t image_variance_floats(std::uint32_t rank, std::uint32_t input_dims) {
-  return rank == 0 ? 0 : image_variance_field::points + rank * input_dims + 2 * packed_triangle_floats(rank);
+// In 64 bits: a damaged header's rank (up to 65535) must not wrap the count.
+constexpr std::uint64_t image_variance_floats(std::uint32_t rank, std::uint32_t input_dims) {
+  const std::uint64_t r = rank;
+  return r == 0 ? 0 : image_variance_field::points + r * input_dims + r * (r + 1);
 }
 
 // Byte offsets of the header fields (all little-endian).
@@ -239,7 +241,8 @@ constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t 
   at = align_up(at + 4 * training_points * kImageOutputs, kImageBlockAlignment);
   if (variance_rank > 0) {
     layout.variance_offset = at;
-    at = align_up(at + 4 * image_variance_floats(variance_rank, input_dims), kImageBlockAlignment);
+    at = align_up(at + 4 * static_cast<std::uint32_t>(image_variance_floats(variance_rank, input_dims)),
+                  kImageBlockAlignment);
   }
   layout.metadata_offset = at;
   at = align_up(at + kImageMetadataSize, kImageBlockAlignment);
@@ -578,7 +581,7 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   const float* alpha = block(offsets[3], std::uint64_t{n} * kImageOutputs);
   const std::uint8_t* metadata =
       reinterpret_cast<const std::uint8_t*>(block(offsets[4], kImageMetadataSize / sizeof(float)));
-  const std::uint32_t variance_floats = image_variance_floats(rank, d);
+  const std::uint64_t variance_floats = image_variance_floats(rank, d);
   const float* variance = rank > 0 ? block(offsets[5], variance_floats) : nullptr;
 
   const struct {
@@ -589,7 +592,7 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
                  {Run::name("parameters"), parameters, parameter_floats},
                  {Run::name("inputs"), inputs, n * d},
                  {Run::name("alpha"), alpha, n * kImageOutputs},
-                 {Run::name("variance"), variance, variance_floats}};
+                 {Run::name("variance"), variance, static_cast<std::uint32_t>(variance_floats)}};
   for (const auto& values : payload) {
     if (values.values != nullptr && !expect_each(run, values.values, values.count, is_finite, Check::finite,
                                                  Status::non_finite_payload, values.name, Expect::finite)) {

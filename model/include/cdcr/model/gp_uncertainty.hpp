@@ -127,23 +127,97 @@ class GpUncertainty {
   bool has_variance() const { return rank_ > 0; }
   int rank() const { return rank_; }
 
-  // share(z) for kernel coordinates z (GpCorrection::kernel_coordinates).
-  S latent_share(const S* z) const {
-    S a[kMaxRank];
-    const float* u = points_;
-    for (int j = 0; j < rank_; ++j) {
-      S distance_sq = S(0);
-      for (int d = 0; d < dims_; ++d) {
-        const S difference = z[d] - S(u[d]);
-        distance_sq = multiply_add(difference, difference, distance_sq);
+  // The evaluation in slices, for a runtime that spreads it over cycles:
+  // its whole state lives here. Work is counted in units of about one
+  // kernel value (a GP mean point's instructions): a variance point's kernel
+  // is one unit, a row of a triangular solve 1 + i / kSolveMacsPerUnit.
+  static constexpr std::uint32_t kSolveMacsPerUnit = 16;
+
+  struct Evaluation {
+    S z[MaxInputs] = {};
+    Vec3<S> tip_mm = Vec3<S>::Zero();
+    S a[kMaxRank] = {};
+    S known = S(0);      // |L_u^-1 r|^2
+    S recovered = S(0);  // |L_c^-1 L_u^-1 r|^2
+    int stage = 0;       // 0: kernel values, 1: the solve with L_u, 2: with L_c, 3: done
+    int next = 0;        // the next point or row of the stage
+    const float* row = nullptr;
+    bool outside_range = false;
+  };
+
+  // The units a whole evaluation costs: what a caller that runs it in one
+  // cycle must budget.
+  std::uint32_t evaluation_units() const {
+    std::uint32_t units = static_cast<std::uint32_t>(rank_);
+    for (int i = 0; i < rank_; ++i) units += 2 * (1 + static_cast<std::uint32_t>(i) / kSolveMacsPerUnit);
+    return units;
+  }
+
+  void begin_evaluation(const S* z, const Vec3<S>& tip_mm, Evaluation& e) const {
+    for (int d = 0; d < dims_; ++d) e.z[d] = z[d];
+    e.tip_mm = tip_mm;
+    e.known = S(0);
+    e.recovered = S(0);
+    e.stage = rank_ > 0 ? 0 : 3;
+    e.next = 0;
+    e.row = inducing_factor_;
+    e.outside_range = outside_range(z);
+  }
+
+  bool evaluation_finished(const Evaluation& e) const { return e.stage == 3; }
+
+  // Goes on for at most max_units (and at least one step, so that any
+  // budget ends the evaluation); returns the units spent.
+  std::uint32_t continue_evaluation(Evaluation& e, std::uint32_t max_units) const {
+    std::uint32_t spent = 0;
+    while (e.stage < 3) {
+      if (e.stage == 0) {
+        if (spent > 0 && spent + 1 > max_units) break;
+        const float* u = points_ + static_cast<std::size_t>(e.next) * static_cast<std::size_t>(dims_);
+        S distance_sq = S(0);
+        for (int d = 0; d < dims_; ++d) {
+          const S difference = e.z[d] - S(u[d]);
+          distance_sq = multiply_add(difference, difference, distance_sq);
+        }
+        e.a[e.next] = gaussian(distance_sq);
+        spent += 1;
+      } else {
+        const std::uint32_t cost = 1 + static_cast<std::uint32_t>(e.next) / kSolveMacsPerUnit;
+        if (spent > 0 && spent + cost > max_units) break;
+        // Row i of x = L^-1 x, in place: x_i = (x_i - sum_j<i L_ij x_j) / L_ii.
+        const int i = e.next;
+        S sum = e.a[i];
+        for (int j = 0; j < i; ++j) sum = multiply_add(-S(e.row[j]), e.a[j], sum);
+        e.a[i] = sum / S(e.row[i]);
+        S& norm_sq = e.stage == 1 ? e.known : e.recovered;
+        norm_sq = multiply_add(e.a[i], e.a[i], norm_sq);
+        e.row += i + 1;
+        spent += cost;
       }
-      u += dims_;
-      a[j] = gaussian(distance_sq);
+      if (++e.next == rank_) {
+        e.next = 0;
+        e.stage += 1;
+        e.row = e.stage == 1 ? inducing_factor_ : posterior_factor_;
+      }
     }
-    const S known = solve_lower_in_place(inducing_factor_, a);
-    const S recovered = solve_lower_in_place(posterior_factor_, a);
-    const S share = S(1) - known + recovered;
-    return share < S(0) ? S(0) : (share > S(1) ? S(1) : share);
+    return spent;
+  }
+
+  PoseUncertainty<S> evaluation_result(const Evaluation& e) const {
+    PoseUncertainty<S> result;
+    result.outside_range = e.outside_range;
+    result.extrapolating = e.outside_range;
+    if (rank_ == 0) return result;
+    const S share = S(1) - e.known + e.recovered;
+    result.latent_share = share < S(0) ? S(0) : (share > S(1) ? S(1) : share);
+    result.extrapolating = result.extrapolating || result.latent_share > threshold_;
+    const S normalised = signal_ * result.latent_share + noise_;
+    S variances[kImageOutputs];
+    for (int k = 0; k < kImageOutputs; ++k) variances[k] = output_scale_sq_[k] * normalised;
+    gaussian_radii_95(variances, e.tip_mm, result.r95_mm, result.r95_deg);
+    result.r95_mm *= position_scale_;
+    result.r95_deg *= orientation_scale_;
+    return result;
   }
 
   bool outside_range(const S* z) const {
@@ -155,39 +229,16 @@ class GpUncertainty {
   }
 
   // The radii around the compensated pose whose tip is at tip_mm, and the
-  // extrapolation flag, for the query with kernel coordinates z.
+  // extrapolation flag, for the query with kernel coordinates z: the same
+  // steps as the slices, in one go.
   PoseUncertainty<S> evaluate(const S* z, const Vec3<S>& tip_mm) const {
-    PoseUncertainty<S> result;
-    result.outside_range = outside_range(z);
-    result.extrapolating = result.outside_range;
-    if (rank_ == 0) return result;
-    result.latent_share = latent_share(z);
-    result.extrapolating = result.extrapolating || result.latent_share > threshold_;
-    const S normalised = signal_ * result.latent_share + noise_;
-    S variances[kImageOutputs];
-    for (int k = 0; k < kImageOutputs; ++k) variances[k] = output_scale_sq_[k] * normalised;
-    gaussian_radii_95(variances, tip_mm, result.r95_mm, result.r95_deg);
-    result.r95_mm *= position_scale_;
-    result.r95_deg *= orientation_scale_;
-    return result;
+    Evaluation e;
+    begin_evaluation(z, tip_mm, e);
+    continue_evaluation(e, 0xFFFFFFFFu);
+    return evaluation_result(e);
   }
 
  private:
-  // x = L^-1 x for the packed lower triangle L (row i: i + 1 values, the
-  // diagonal last); returns |x|^2 after the solve.
-  S solve_lower_in_place(const float* factor, S* x) const {
-    S norm_sq = S(0);
-    const float* row = factor;
-    for (int i = 0; i < rank_; ++i) {
-      S sum = x[i];
-      for (int j = 0; j < i; ++j) sum = multiply_add(-S(row[j]), x[j], sum);
-      x[i] = sum / S(row[i]);
-      norm_sq = multiply_add(x[i], x[i], norm_sq);
-      row += i + 1;
-    }
-    return norm_sq;
-  }
-
   bool bound_ = false;
   int dims_ = 0;
   int rank_ = 0;

@@ -53,8 +53,17 @@ struct PosePositionXy {
 };
 struct PosePositionZ {
   double z_mm = 0;
-  bool compensated = false;  // FLAGS bit 0
+  bool compensated = false;    // FLAGS bit 0
   std::uint8_t sequence = 0;
+  bool extrapolating = false;  // FLAGS bit 1
+};
+struct PoseUncertainty {
+  double r95_position_mm = 0;     // saturates at 65.535 mm
+  double r95_orientation_deg = 0; // saturates at 65.535 deg
+  double latent_share = 0;        // 0..1
+  bool extrapolating = false;
+  bool outside_range = false;
+  std::uint8_t sequence = 0;      // the pose's
 };
 struct PoseOrientation {
   double qw = 1, qx = 0, qy = 0, qz = 0;
@@ -75,6 +84,7 @@ struct Status {
   std::int64_t overruns = 0;  // the u16 counters saturate
   std::int64_t exec_max_us = 0;
   std::int64_t exec_mean_us = 0;
+  bool extrapolating = false;  // the latest pose's (POSE_POSITION_Z FLAGS bit 1)
 };
 
 struct Stats {
@@ -242,7 +252,9 @@ inline std::uint8_t commit_sequence(const hal::CanFrame& frame) {
 inline void encode(const PosePositionZ& f, hal::CanFrame& frame) {
   using namespace pose_position_z;
   frame = empty_frame(kMessage);
-  set_data_word(frame, placed_saturating(kZ, f.z_mm) | placed_integer(kFlags, f.compensated ? kFlagCompensated : 0) |
+  set_data_word(frame, placed_saturating(kZ, f.z_mm) |
+                           placed_integer(kFlags, (f.compensated ? kFlagCompensated : 0) |
+                                                      (f.extrapolating ? kFlagExtrapolating : 0)) |
                            placed_integer(kSequence, f.sequence));
 }
 inline DecodeStatus decode(const hal::CanFrame& frame, PosePositionZ& f) {
@@ -250,9 +262,35 @@ inline DecodeStatus decode(const hal::CanFrame& frame, PosePositionZ& f) {
   if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
   const std::uint64_t word = data_word(frame);
   const std::int64_t flags = raw_in_word(word, kFlags);
-  if ((flags & ~kFlagCompensated) != 0) return DecodeStatus::reserved_bits_set;
+  if ((flags & ~(kFlagCompensated | kFlagExtrapolating)) != 0) return DecodeStatus::reserved_bits_set;
   f.z_mm = physical_in_word(word, kZ);
   f.compensated = (flags & kFlagCompensated) != 0;
+  f.extrapolating = (flags & kFlagExtrapolating) != 0;
+  f.sequence = static_cast<std::uint8_t>(raw_in_word(word, kSequence));
+  return DecodeStatus::ok;
+}
+
+inline void encode(const PoseUncertainty& f, hal::CanFrame& frame) {
+  using namespace pose_uncertainty;
+  frame = empty_frame(kMessage);
+  set_data_word(frame, placed_saturating(kR95Position, f.r95_position_mm) |
+                           placed_saturating(kR95Orientation, f.r95_orientation_deg) |
+                           placed_saturating(kLatentShare, f.latent_share) |
+                           placed_integer(kFlags, (f.extrapolating ? kFlagExtrapolating : 0) |
+                                                      (f.outside_range ? kFlagOutsideRange : 0)) |
+                           placed_integer(kSequence, f.sequence));
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, PoseUncertainty& f) {
+  using namespace pose_uncertainty;
+  if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
+  const std::uint64_t word = data_word(frame);
+  const std::int64_t flags = raw_in_word(word, kFlags);
+  if ((flags & ~(kFlagExtrapolating | kFlagOutsideRange)) != 0) return DecodeStatus::reserved_bits_set;
+  f.r95_position_mm = physical_in_word(word, kR95Position);
+  f.r95_orientation_deg = physical_in_word(word, kR95Orientation);
+  f.latent_share = physical_in_word(word, kLatentShare);
+  f.extrapolating = (flags & kFlagExtrapolating) != 0;
+  f.outside_range = (flags & kFlagOutsideRange) != 0;
   f.sequence = static_cast<std::uint8_t>(raw_in_word(word, kSequence));
   return DecodeStatus::ok;
 }
@@ -283,6 +321,7 @@ inline void encode(const Status& f, hal::CanFrame& frame) {
   using namespace status;
   frame = empty_frame(kMessage);
   set_data_word(frame, placed_integer(kState, static_cast<std::int64_t>(f.state)) |
+                           placed_integer(kExtrapolating, f.extrapolating ? 1 : 0) |
                            placed_integer(kFault, static_cast<std::int64_t>(f.fault)) |
                            placed_integer(kOverruns, f.overruns) | placed_integer(kExecMax, f.exec_max_us) |
                            placed_integer(kExecMean, f.exec_mean_us));
@@ -292,6 +331,7 @@ inline DecodeStatus decode(const hal::CanFrame& frame, Status& f) {
   if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
   const std::uint64_t word = data_word(frame);
   f.state = static_cast<RuntimeState>(raw_in_word(word, kState));
+  f.extrapolating = raw_in_word(word, kExtrapolating) != 0;
   f.fault = static_cast<FaultCode>(raw_in_word(word, kFault));
   f.overruns = raw_in_word(word, kOverruns);
   f.exec_max_us = raw_in_word(word, kExecMax);

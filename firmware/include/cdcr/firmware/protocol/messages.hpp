@@ -141,9 +141,11 @@ inline constexpr MessageSpec kMessage{
 // 0x131: tip z, flags, cycle sequence.
 namespace pose_position_z {
 inline constexpr SignalSpec kZ{"Z", 0, 32, true, kLengthScaleMm, 0, -21474836.48, 21474836.47, "mm"};
-// Bit 0: compensated by the GP model (RUN); the other bits are 0.
+// Bit 0: compensated by the GP model (RUN); bit 1: the model extrapolates
+// at this pose (see pose_uncertainty); the other bits are 0.
 inline constexpr SignalSpec kFlags{"FLAGS", 32, 8, false, 1, 0, 0, 255, ""};
 inline constexpr std::int64_t kFlagCompensated = 0x01;
+inline constexpr std::int64_t kFlagExtrapolating = 0x02;
 inline constexpr SignalSpec kSequence{"SEQUENCE", 40, 8, false, 1, 0, 0, 255, ""};
 inline constexpr const SignalSpec* kSignals[] = {&kZ, &kFlags, &kSequence};
 inline constexpr MessageSpec kMessage{"POSE_POSITION_Z", 0x131, 1, 6, "RUNTIME", signal_list(kSignals), kPoseFrames};
@@ -154,6 +156,25 @@ namespace pose_orientation {
 inline constexpr MessageSpec kMessage{
     "POSE_ORIENTATION", 0x132, 1, 8, "RUNTIME", signal_list(quaternion::kSignals), kPoseFrames};
 }
+
+// 0x133: how far the measured tip may lie from the compensated pose of the
+// cycle SEQUENCE (POSE_POSITION_Z's): radii holding it with 95 % probability,
+// the model's latent variance there as a share of its prior, and whether
+// the model extrapolates. Computed over a few cycles, sent when done.
+namespace pose_uncertainty {
+inline constexpr SignalSpec kR95Position{"R95_POSITION", 0, 16, false, 0.001, 0, 0, 65.535, "mm"};
+inline constexpr SignalSpec kR95Orientation{"R95_ORIENTATION", 16, 16, false, 0.001, 0, 0, 65.535, "deg"};
+inline constexpr SignalSpec kLatentShare{"LATENT_SHARE", 32, 8, false, 0.005, 0, 0, 1, ""};
+// Bit 0: extrapolating (outside the fitted input range, or latent share
+// above the image's threshold); bit 1: outside the fitted input range.
+inline constexpr SignalSpec kFlags{"FLAGS", 40, 8, false, 1, 0, 0, 255, ""};
+inline constexpr std::int64_t kFlagExtrapolating = 0x01;
+inline constexpr std::int64_t kFlagOutsideRange = 0x02;
+inline constexpr SignalSpec kSequence{"SEQUENCE", 48, 8, false, 1, 0, 0, 255, ""};
+inline constexpr const SignalSpec* kSignals[] = {&kR95Position, &kR95Orientation, &kLatentShare, &kFlags,
+                                                 &kSequence};
+inline constexpr MessageSpec kMessage{"POSE_UNCERTAINTY", 0x133, 1, 7, "RUNTIME", signal_list(kSignals), kPoseFrames};
+}  // namespace pose_uncertainty
 
 // 0x140: the outcome of a committed target. Bits 12..15 are reserved (0).
 namespace ik_report {
@@ -170,12 +191,15 @@ inline constexpr MessageSpec kMessage{"IK_REPORT", 0x140, 1, 8, "RUNTIME", signa
 
 // 0x150: heartbeat, every kStatusEveryCycles cycles.
 namespace status {
-inline constexpr SignalSpec kState{"STATE", 0, 8, false, 1, 0, 0, 3, "", value_table(values::kRuntimeState)};
+inline constexpr SignalSpec kState{"STATE", 0, 4, false, 1, 0, 0, 3, "", value_table(values::kRuntimeState)};
+// 1: the latest pose extrapolates (POSE_POSITION_Z FLAGS bit 1). Bits 5..7
+// are reserved (0).
+inline constexpr SignalSpec kExtrapolating{"EXTRAPOLATING", 4, 1, false, 1, 0, 0, 1, ""};
 inline constexpr SignalSpec kFault{"FAULT", 8, 8, false, 1, 0, 0, 255, "", value_table(values::kFaultCode)};
 inline constexpr SignalSpec kOverruns{"OVERRUNS", 16, 16, false, 1, 0, 0, 65535, ""};
 inline constexpr SignalSpec kExecMax{"EXEC_MAX", 32, 16, false, 1, 0, 0, 65535, "us"};
 inline constexpr SignalSpec kExecMean{"EXEC_MEAN", 48, 16, false, 1, 0, 0, 65535, "us"};
-inline constexpr const SignalSpec* kSignals[] = {&kState, &kFault, &kOverruns, &kExecMax, &kExecMean};
+inline constexpr const SignalSpec* kSignals[] = {&kState, &kExtrapolating, &kFault, &kOverruns, &kExecMax, &kExecMean};
 inline constexpr MessageSpec kMessage{"STATUS", 0x150, 1, 8, "RUNTIME", signal_list(kSignals), kStatusFrames};
 }  // namespace status
 
@@ -196,8 +220,8 @@ inline constexpr MessageSpec kMessage{"STATS", 0x151, 1, 8, "RUNTIME", signal_li
 inline constexpr const MessageSpec* kMessages[] = {
     &cable_feedback::kMessage,     &cable_setpoint::kMessage,   &target_orientation::kMessage,
     &target_position_xy::kMessage, &target_position_z::kMessage, &pose_position_xy::kMessage,
-    &pose_position_z::kMessage,    &pose_orientation::kMessage, &ik_report::kMessage,
-    &status::kMessage,             &stats::kMessage,
+    &pose_position_z::kMessage,    &pose_orientation::kMessage, &pose_uncertainty::kMessage,
+    &ik_report::kMessage,          &status::kMessage,           &stats::kMessage,
 };
 
 }  // namespace cdcr::firmware::protocol
