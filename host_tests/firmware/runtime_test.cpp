@@ -324,8 +324,8 @@ TEST(SimulatedPlatform, VirtualBusFiltersAndCountsOverruns) {
   frame.dlc = 8;
   EXPECT_EQ(bus.node(0).send(frame), hal::CanStatus::ok);
   frame.id = 0x100;
-  for (int i = 0; i < kRxQueueDepth + 3; ++i) bus.node(0).send(frame);
-  EXPECT_EQ(bus.node(1).pending(), std::size_t(kRxQueueDepth));
+  for (std::size_t i = 0; i < sim::VirtualCanNode::kRxQueueDepth + 3; ++i) bus.node(0).send(frame);
+  EXPECT_EQ(bus.node(1).pending(), sim::VirtualCanNode::kRxQueueDepth);
   EXPECT_EQ(bus.node(1).error_counters().rx_overruns, 3u);
   EXPECT_EQ(bus.node(0).pending(), 0u);  // a node does not hear itself
   frame.id = 0x800;

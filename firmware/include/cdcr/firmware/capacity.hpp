@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cstdint>
 
+#include "cdcr/hal/can_bus.hpp"
 #include "cdcr/model/arch/selected.hpp"
 #include "cdcr/model/gp_correction.hpp"
 #include "cdcr/model/ik_solver.hpp"
@@ -26,12 +27,8 @@ static_assert(kMaxTrainingPoints <= model::kMaxTrainingPoints, "the model's capa
 // next cycle, so a flood cannot stretch one cycle without bound.
 inline constexpr int kMaxRxFramesPerCycle = 64;
 
-// Depth of each receive queue of the simulated bus (a board's controller
-// FIFO plays this role).
-inline constexpr int kRxQueueDepth = 128;
-
-// Acceptance filters a controller must offer the runtime.
-inline constexpr int kMaxCanFilters = 4;
+// Acceptance filters a controller must offer the runtime (hal/can_bus.hpp).
+using hal::kMaxCanFilters;
 
 // The cycle budget, in work units (model/work_costs.hpp): one unit is one
 // training point of a GP mean evaluation on the board's core, and every other
