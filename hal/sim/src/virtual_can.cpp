@@ -1,4 +1,4 @@
-#include "sim/virtual_can.hpp"
+#include "cdcr/sim/virtual_can.hpp"
 
 namespace cdcr::sim {
 
