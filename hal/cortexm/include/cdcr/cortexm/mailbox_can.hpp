@@ -35,7 +35,9 @@ class MailboxCan final : public hal::CanBus {
     return received_.pop(frame) ? hal::CanStatus::ok : hal::CanStatus::empty;
   }
 
-  bool set_filters(const hal::CanFilter* filters, std::size_t count) override { return filters_.assign(filters, count); }
+  bool set_filters(const hal::CanFilter* filters, std::size_t count) override {
+    return filters_.assign(filters, count);
+  }
 
   hal::CanErrorCounters error_counters() const override { return counters_; }
 

@@ -22,7 +22,9 @@ class VirtualCanNode final : public hal::CanBus {
 
   hal::CanStatus send(const hal::CanFrame& frame) override;
   hal::CanStatus receive(hal::CanFrame& frame) override;
-  bool set_filters(const hal::CanFilter* filters, std::size_t count) override { return filters_.assign(filters, count); }
+  bool set_filters(const hal::CanFilter* filters, std::size_t count) override {
+    return filters_.assign(filters, count);
+  }
   hal::CanErrorCounters error_counters() const override { return counters_; }
 
   std::size_t pending() const { return queue_.size(); }
