@@ -45,11 +45,11 @@
 
 #include <cdcr/sim/lockstep_timer.hpp>
 #include <cdcr/sim/memory_model_storage.hpp>
-#include <cdcr/sim/simulated_platform.hpp>
 #include <cdcr/sim/virtual_can.hpp>
 
 #include "export/binary_file.hpp"
 #include "linux/posix_time.hpp"
+#include "sim/simulated_platform.hpp"
 #include "sim/simulated_robot.hpp"
 #include "sim/workspace_sampler.hpp"
 

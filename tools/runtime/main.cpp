@@ -21,7 +21,6 @@
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/model/compensation.hpp>
 #include <cdcr/sim/lockstep_timer.hpp>
-#include <cdcr/sim/simulated_platform.hpp>
 #include <cdcr/sim/virtual_can.hpp>
 
 #include "dataset/csv_dataset.hpp"
@@ -33,6 +32,7 @@
 #endif
 #include "export/binary_file.hpp"
 #include "sim/simulated_drives.hpp"
+#include "sim/simulated_platform.hpp"
 #include "sim/simulated_robot.hpp"
 
 namespace {

@@ -6,10 +6,9 @@
 
 #include <cdcr/hal/console.hpp>
 #include <cdcr/hal/hal.hpp>
-
-#include "cdcr/sim/lockstep_timer.hpp"
-#include "cdcr/sim/memory_model_storage.hpp"
-#include "cdcr/sim/virtual_can.hpp"
+#include <cdcr/sim/lockstep_timer.hpp>
+#include <cdcr/sim/memory_model_storage.hpp>
+#include <cdcr/sim/virtual_can.hpp>
 
 namespace cdcr::sim {
 
