@@ -77,7 +77,7 @@ bool SocketCanBus::open(const std::string& interface_name, std::string& error) {
 }
 
 hal::CanStatus SocketCanBus::send(const hal::CanFrame& frame) {
-  if (frame.id > kStandardIdMask || frame.dlc > 8) {
+  if (!hal::is_valid(frame)) {
     counters_.tx_dropped += 1;
     return hal::CanStatus::invalid_frame;
   }

@@ -19,7 +19,7 @@ namespace protocol = firmware::protocol;
 TEST(RuntimeNoAllocation, TenThousandCyclesAfterInit) {
   test_support::SimulatedPlatform platform(test_support::small_image());
   // The recording console keeps std::strings; a board's UART does not allocate.
-  sim::StderrConsole silent_console(false);
+  hal::NullConsole silent_console;
   const hal::Hal hal{platform.clock, platform.timer, platform.bus.node(0), platform.storage, silent_console};
   Runtime runtime(hal, Geometry::uniform(2, 120.0f, 67.0f));
   ASSERT_EQ(runtime.init(), RuntimeState::run);

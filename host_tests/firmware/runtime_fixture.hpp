@@ -5,12 +5,13 @@
 #include <vector>
 
 #include <cdcr/firmware/runtime.hpp>
+#include <cdcr/sim/lockstep_timer.hpp>
+#include <cdcr/sim/memory_model_storage.hpp>
+#include <cdcr/sim/virtual_can.hpp>
 
 #include "export/image_writer.hpp"
-#include "sim/host_backends.hpp"
-#include "sim/lockstep_timer.hpp"
+#include "recording_console.hpp"
 #include "sim/simulated_drives.hpp"
-#include "sim/virtual_can.hpp"
 #include "synthetic_trained_model.hpp"
 
 namespace cdcr::test_support {
@@ -38,7 +39,7 @@ struct SimulatedPlatform {
   sim::LockstepClock clock;
   sim::LockstepTimer timer{clock};
   sim::MemoryModelStorage storage;
-  sim::RecordingConsole console;
+  test_support::RecordingConsole console;
   hal::Hal hal{clock, timer, bus.node(0), storage, console};
   hal::CanBus& drives_node = bus.node(1);
   hal::CanBus& host_node = bus.node(2);

@@ -302,38 +302,5 @@ TEST_F(RuntimeTest, TrackingTargetsAreSolvedLikeSingleOnes) {
   }
 }
 
-TEST(SimulatedPlatform, LockstepTimerReportsMissedReleases) {
-  sim::LockstepClock clock;
-  sim::LockstepTimer timer(clock);
-  timer.start(1000);
-  EXPECT_EQ(timer.wait_next().release_ns, 1000);
-  EXPECT_EQ(clock.now_ns(), 1000);
-  clock.advance_by(2500);  // work ran into the third period
-  const hal::TimerTick tick = timer.wait_next();
-  EXPECT_EQ(tick.missed_releases, 2u);
-  EXPECT_EQ(tick.release_ns, 4000);
-  EXPECT_EQ(timer.overruns(), 2u);
-}
-
-TEST(SimulatedPlatform, VirtualBusFiltersAndCountsOverruns) {
-  sim::VirtualCanBus bus;
-  const hal::CanFilter only_0x100{0x100, 0x7FF};
-  ASSERT_TRUE(bus.node(1).set_filters(&only_0x100, 1));
-  hal::CanFrame frame;
-  frame.id = 0x101;
-  frame.dlc = 8;
-  EXPECT_EQ(bus.node(0).send(frame), hal::CanStatus::ok);
-  frame.id = 0x100;
-  for (int i = 0; i < kRxQueueDepth + 3; ++i) bus.node(0).send(frame);
-  EXPECT_EQ(bus.node(1).pending(), std::size_t(kRxQueueDepth));
-  EXPECT_EQ(bus.node(1).error_counters().rx_overruns, 3u);
-  EXPECT_EQ(bus.node(0).pending(), 0u);  // a node does not hear itself
-  frame.id = 0x800;
-  EXPECT_EQ(bus.node(0).send(frame), hal::CanStatus::invalid_frame);
-  hal::CanFrame received;
-  EXPECT_EQ(bus.node(1).receive(received), hal::CanStatus::ok);
-  EXPECT_EQ(received.id, 0x100u);
-}
-
 }  // namespace
 }  // namespace cdcr::firmware

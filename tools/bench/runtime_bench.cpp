@@ -43,13 +43,14 @@
 
 #include <cdcr/firmware/runtime.hpp>
 
+#include <cdcr/sim/lockstep_timer.hpp>
+#include <cdcr/sim/memory_model_storage.hpp>
+#include <cdcr/sim/virtual_can.hpp>
+
 #include "export/binary_file.hpp"
 #include "linux/posix_time.hpp"
-#include "sim/host_backends.hpp"
-#include "sim/lockstep_timer.hpp"
 #include "sim/simulated_platform.hpp"
 #include "sim/simulated_robot.hpp"
-#include "sim/virtual_can.hpp"
 #include "sim/workspace_sampler.hpp"
 
 namespace {

@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include <cdcr/model/inverse_kinematics.hpp>
+#include <cdcr/model/units.hpp>
 
 #include "cli_errors.hpp"
 #include "ik_target.hpp"
@@ -18,8 +19,6 @@
 
 namespace cdcr::cli {
 namespace {
-
-constexpr double kDegreesPerRadian = 57.295779513082320876798;
 
 struct Target {
   model::Pose<double> pose;
@@ -156,7 +155,7 @@ CommandOutput run_ik(const IkCommandOptions& options) {
     throw InputError(fmt::format("inverse kinematics failed: {}", model::to_string(result.status)));
   }
 
-  const double orientation_error_deg = result.orientation_error_rad * kDegreesPerRadian;
+  const double orientation_error_deg = result.orientation_error_rad * model::kDegreesPerRadian;
   CommandOutput output;
   output.text = options.json ? format_json(result, orientation_error_deg) : format_text(result, orientation_error_deg);
   if (!result.converged()) output.failure = describe_miss(result, target.orientation_given, orientation_error_deg);

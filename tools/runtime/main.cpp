@@ -20,6 +20,8 @@
 
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/model/compensation.hpp>
+#include <cdcr/sim/lockstep_timer.hpp>
+#include <cdcr/sim/virtual_can.hpp>
 
 #include "dataset/csv_dataset.hpp"
 #if CDCR_HAVE_LINUX_PLATFORM
@@ -29,12 +31,9 @@
 #include "linux/stdio_console.hpp"
 #endif
 #include "export/binary_file.hpp"
-#include "sim/host_backends.hpp"
-#include "sim/lockstep_timer.hpp"
-#include "sim/simulated_platform.hpp"
 #include "sim/simulated_drives.hpp"
+#include "sim/simulated_platform.hpp"
 #include "sim/simulated_robot.hpp"
-#include "sim/virtual_can.hpp"
 
 namespace {
 

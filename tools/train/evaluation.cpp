@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cdcr/model/compensated_kinematics.hpp"
+#include "cdcr/model/pose_error_summary.hpp"
 
 namespace cdcr::training {
 
@@ -17,18 +18,8 @@ MeanErrors mean_errors(const std::vector<model::Pose<double>>& reference, const 
 
 Fidelity compare_poses(const std::vector<model::Pose<double>>& reference, const std::vector<model::Pose<double>>& poses) {
   if (reference.size() != poses.size() || reference.empty()) throw std::invalid_argument("pose lists differ in size");
-  Fidelity f;
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    const model::PoseError<double> e = model::pose_error(reference[i], poses[i]);
-    const double orientation_deg = e.orientation_rad * kDegreesPerRadian;
-    f.mean_position_mm += e.position_mm;
-    f.mean_orientation_deg += orientation_deg;
-    f.max_position_mm = std::max(f.max_position_mm, e.position_mm);
-    f.max_orientation_deg = std::max(f.max_orientation_deg, orientation_deg);
-  }
-  f.mean_position_mm /= static_cast<double>(poses.size());
-  f.mean_orientation_deg /= static_cast<double>(poses.size());
-  return f;
+  const model::PoseErrorSummary s = model::summarize_pose_errors(reference.data(), poses.data(), poses.size());
+  return Fidelity{s.max_position_mm, s.mean_position_mm, s.max_orientation_deg, s.mean_orientation_deg};
 }
 
 std::vector<model::Pose<double>> compensated_poses(const TrainingSet& set, const Eigen::MatrixXd& error_twists) {

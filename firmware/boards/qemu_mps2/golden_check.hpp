@@ -6,6 +6,7 @@
 
 #include <cdcr/firmware/protocol.hpp>
 #include <cdcr/model/compensation.hpp>
+#include <cdcr/model/units.hpp>
 
 #include "board.hpp"
 #include "qemu_golden.hpp"
@@ -31,12 +32,11 @@ struct PoseDeviation {
 // The board's float pose against the host's double one, measured in double
 // (eq. 20, as the accuracy figures are).
 inline PoseDeviation deviation(const model::Pose<float>& pose, const model::Pose<double>& expected) {
-  constexpr double kDegPerRad = 57.295779513082320876;
   model::Pose<double> widened;
   widened.position_mm = pose.position_mm.cast<double>();
   widened.rotation = pose.rotation.cast<double>();
   const model::PoseError<double> error = model::pose_error(widened, expected);
-  return {error.position_mm, error.orientation_rad * kDegPerRad};
+  return {error.position_mm, error.orientation_rad * model::kDegreesPerRadian};
 }
 
 // One cable feedback frame per segment, as the drives send them.

@@ -1,10 +1,13 @@
 #pragma once
 // Every capacity of the runtime, fixed at compile time: storage is sized for
-// these and nothing is allocated after init. A board build may lower them.
+// these and nothing is allocated after init. Those the model and the HAL
+// size their own storage by are theirs (model/limits.hpp,
+// hal/can_bus.hpp), named here for the runtime; the rest are the runtime's.
 
 #include <algorithm>
 #include <cstdint>
 
+#include "cdcr/hal/can_bus.hpp"
 #include "cdcr/model/arch/selected.hpp"
 #include "cdcr/model/gp_correction.hpp"
 #include "cdcr/model/ik_solver.hpp"
@@ -15,23 +18,18 @@ namespace cdcr::firmware {
 
 // Segments the runtime can drive (one cable feedback and one setpoint frame
 // each; the CAN identifiers reserve room for 8).
-inline constexpr int kMaxSegments = 8;
-static_assert(kMaxSegments <= model::kMaxSegments, "the model's storage must hold every segment");
+using model::kMaxSegments;
+static_assert(kMaxSegments <= 8, "the CAN identifiers reserve room for 8 segments");
 
 // GP training points an image may hold; bounds the per-cycle correction cost.
-inline constexpr std::uint32_t kMaxTrainingPoints = 1024;
-static_assert(kMaxTrainingPoints <= model::kMaxTrainingPoints, "the model's capacity must cover the runtime's");
+using model::kMaxTrainingPoints;
 
 // Frames the runtime drains from the bus per cycle; the rest wait for the
 // next cycle, so a flood cannot stretch one cycle without bound.
 inline constexpr int kMaxRxFramesPerCycle = 64;
 
-// Depth of each receive queue of the simulated bus (a board's controller
-// FIFO plays this role).
-inline constexpr int kRxQueueDepth = 128;
-
-// Acceptance filters a controller must offer the runtime.
-inline constexpr int kMaxCanFilters = 4;
+// Acceptance filters a controller must offer the runtime (hal/can_bus.hpp).
+using hal::kMaxCanFilters;
 
 // The cycle budget, in work units (model/work_costs.hpp): one unit is one
 // training point of a GP mean evaluation on the board's core, and every other

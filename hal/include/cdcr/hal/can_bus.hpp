@@ -12,6 +12,14 @@ struct CanFrame {
   std::uint8_t data[8] = {};
 };
 
+inline constexpr std::uint32_t kMaxStandardId = 0x7FF;
+inline constexpr std::uint8_t kMaxDataBytes = 8;
+
+// What send() accepts; anything else is refused as invalid_frame.
+inline constexpr bool is_valid(const CanFrame& frame) {
+  return frame.id <= kMaxStandardId && frame.dlc <= kMaxDataBytes;
+}
+
 enum class CanStatus : std::uint8_t {
   ok = 0,
   empty,          // receive: nothing pending
@@ -26,6 +34,10 @@ struct CanFilter {
   std::uint32_t id = 0;
   std::uint32_t mask = 0;
 };
+
+// Acceptance filters every CanBus must take in one set_filters() call: the
+// runtime sets no more than these.
+inline constexpr std::size_t kMaxCanFilters = 4;
 
 struct CanErrorCounters {
   std::uint32_t tx_dropped = 0;   // frames refused by send()

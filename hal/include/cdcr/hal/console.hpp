@@ -15,4 +15,11 @@ class Console {
   Console& operator=(const Console&) = default;
 };
 
+// Drops every line: for a platform with nowhere to write them (the simulated
+// board, whose host program reports on its own).
+class NullConsole final : public Console {
+ public:
+  void write_line(const char*) override {}
+};
+
 }  // namespace cdcr::hal

@@ -32,10 +32,9 @@
 #include "cdcr/model/limits.hpp"
 #include "cdcr/model/status.hpp"
 #include "cdcr/model/types.hpp"
+#include "cdcr/model/units.hpp"
 
 namespace cdcr::model {
-
-inline constexpr double kDegreesPerRadian = 57.295779513082320876798;
 
 template <typename S>
 struct PoseUncertainty {

@@ -6,20 +6,21 @@
 // board with a real controller implements hal::CanBus on its peripheral
 // instead (see the README).
 
-#include <array>
 #include <cstddef>
 #include <cstdint>
 
 #include <cdcr/hal/can_bus.hpp>
+#include <cdcr/hal/can_filter_bank.hpp>
+#include <cdcr/hal/can_frame_ring.hpp>
 
 namespace cdcr::cortexm {
 
-template <std::size_t QueueDepth = 32, std::size_t MaxFilters = 4>
+template <std::size_t QueueDepth = 32, std::size_t MaxFilters = hal::kMaxCanFilters>
 class MailboxCan final : public hal::CanBus {
  public:
   // The runtime's side.
   hal::CanStatus send(const hal::CanFrame& frame) override {
-    if (frame.id > 0x7FF || frame.dlc > 8) {
+    if (!hal::is_valid(frame)) {
       counters_.tx_dropped += 1;
       return hal::CanStatus::invalid_frame;
     }
@@ -35,57 +36,23 @@ class MailboxCan final : public hal::CanBus {
   }
 
   bool set_filters(const hal::CanFilter* filters, std::size_t count) override {
-    if (count > MaxFilters) return false;
-    for (std::size_t i = 0; i < count; ++i) filters_[i] = filters[i];
-    filter_count_ = count;
-    return true;
+    return filters_.assign(filters, count);
   }
 
   hal::CanErrorCounters error_counters() const override { return counters_; }
 
   // The other node's side: a frame from the bus, subject to the filters.
   void deliver(const hal::CanFrame& frame) {
-    if (!accepts(frame.id)) return;
+    if (!filters_.accepts(frame.id)) return;
     if (!received_.push(frame)) counters_.rx_overruns += 1;
   }
   // The oldest frame the runtime sent, if any.
   bool take_transmitted(hal::CanFrame& frame) { return transmitted_.pop(frame); }
 
  private:
-  class Ring {
-   public:
-    bool push(const hal::CanFrame& frame) {
-      if (count_ == QueueDepth) return false;
-      frames_[(head_ + count_) % QueueDepth] = frame;
-      ++count_;
-      return true;
-    }
-    bool pop(hal::CanFrame& frame) {
-      if (count_ == 0) return false;
-      frame = frames_[head_];
-      head_ = (head_ + 1) % QueueDepth;
-      --count_;
-      return true;
-    }
-
-   private:
-    std::array<hal::CanFrame, QueueDepth> frames_{};
-    std::size_t head_ = 0;
-    std::size_t count_ = 0;
-  };
-
-  bool accepts(std::uint32_t id) const {
-    if (filter_count_ == 0) return true;
-    for (std::size_t i = 0; i < filter_count_; ++i) {
-      if ((id & filters_[i].mask) == (filters_[i].id & filters_[i].mask)) return true;
-    }
-    return false;
-  }
-
-  Ring received_;
-  Ring transmitted_;
-  std::array<hal::CanFilter, MaxFilters> filters_{};
-  std::size_t filter_count_ = 0;
+  hal::CanFrameRing<QueueDepth> received_;
+  hal::CanFrameRing<QueueDepth> transmitted_;
+  hal::CanFilterBank<MaxFilters> filters_;
   hal::CanErrorCounters counters_{};
 };
 

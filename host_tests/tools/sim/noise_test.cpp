@@ -7,6 +7,7 @@
 #include <gtest/gtest.h>
 
 #include <cdcr/model/chain.hpp>
+#include <cdcr/model/units.hpp>
 
 #include "sim/data_collection.hpp"
 
@@ -15,8 +16,8 @@ namespace {
 
 using Geometry = model::RobotGeometry<double>;
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kDegreesPerRadian = 180.0 / kPi;
+using model::kDegreesPerRadian;
+using model::kPi;
 const Geometry kPrototype = Geometry::prototype();
 constexpr int kSamples = 5000;
 

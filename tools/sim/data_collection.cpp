@@ -4,12 +4,10 @@
 #include <string>
 
 #include <cdcr/model/chain.hpp>
-#include <cdcr/model/compensation.hpp>
+#include <cdcr/model/pose_error_summary.hpp>
 
 namespace cdcr::sim {
 namespace {
-
-constexpr double kDegreesPerRadian = 57.295779513082320876798;
 
 model::Pose<double> nominal_pose(const model::CableVector<double>& cables_mm,
                                  const model::RobotGeometry<double>& geometry) {
@@ -50,16 +48,8 @@ std::vector<CollectedSample> collect(SimulatedRobot& robot, int samples) {
 MeanPoseError mean_pose_error(const std::vector<model::Pose<double>>& reference,
                               const std::vector<model::Pose<double>>& poses) {
   if (reference.size() != poses.size()) throw std::invalid_argument("pose lists differ in length");
-  MeanPoseError mean;
-  if (poses.empty()) return mean;
-  for (std::size_t i = 0; i < poses.size(); ++i) {
-    const model::PoseError<double> e = model::pose_error(reference[i], poses[i]);
-    mean.position_mm += e.position_mm;
-    mean.orientation_deg += e.orientation_rad * kDegreesPerRadian;
-  }
-  mean.position_mm /= static_cast<double>(poses.size());
-  mean.orientation_deg /= static_cast<double>(poses.size());
-  return mean;
+  const model::PoseErrorSummary s = model::summarize_pose_errors(reference.data(), poses.data(), poses.size());
+  return MeanPoseError{s.mean_position_mm, s.mean_orientation_deg};
 }
 
 CollectionSummary summarize(const std::vector<CollectedSample>& samples) {

@@ -12,6 +12,7 @@
 
 #include <cdcr/model/chain.hpp>
 #include <cdcr/model/compensation.hpp>
+#include <cdcr/model/units.hpp>
 
 #include "sim/simulated_robot.hpp"
 #include "sim/workspace_sampler.hpp"
@@ -24,7 +25,7 @@ using Pose = model::Pose<double>;
 using Cables = model::CableVector<double>;
 using Joints = model::JointVector<double>;
 
-constexpr double kPi = 3.14159265358979323846;
+using model::kPi;
 const Geometry kPrototype = Geometry::prototype();
 
 Pose nominal_pose(const Cables& cables, const Geometry& geometry = kPrototype) {

@@ -35,9 +35,9 @@
 
 #include <Eigen/Core>
 
-namespace cdcr::sim {
+#include <cdcr/model/units.hpp>
 
-inline constexpr double kRadiansPerDegree = 0.017453292519943295769;
+namespace cdcr::sim {
 
 // Drawn once per seed: a given seed is a given physical robot. Each value is
 // a zero-mean normal with the sigma below (per axis for vectors).
@@ -47,17 +47,17 @@ struct GeometricErrorConfig {
   double anchor_radius_sigma_mm = 0.5;
   // The cable pattern rotated about the segment's z axis: alpha reads off by
   // this angle.
-  double anchor_angle_sigma_rad = 2.0 * kRadiansPerDegree;
+  double anchor_angle_sigma_rad = 2.0 * model::kRadiansPerDegree;
   // Rigid transform between consecutive segments (assembly of the disks).
-  double segment_twist_sigma_rad = 1.0 * kRadiansPerDegree;   // about z
-  double segment_tilt_sigma_rad = 0.5 * kRadiansPerDegree;    // about x and y
+  double segment_twist_sigma_rad = 1.0 * model::kRadiansPerDegree;   // about z
+  double segment_tilt_sigma_rad = 0.5 * model::kRadiansPerDegree;    // about x and y
   double segment_offset_sigma_mm = 0.5;
   // The robot's base in the measurement's base frame (base markers vs. the
   // actual first disk).
-  double base_rotation_sigma_rad = 0.5 * kRadiansPerDegree;
+  double base_rotation_sigma_rad = 0.5 * model::kRadiansPerDegree;
   double base_offset_sigma_mm = 2.0;
   // The end-platform marker frame vs. the last disk's frame.
-  double platform_rotation_sigma_rad = 1.5 * kRadiansPerDegree;
+  double platform_rotation_sigma_rad = 1.5 * model::kRadiansPerDegree;
   double platform_offset_sigma_mm = 1.0;
 };
 
@@ -125,7 +125,7 @@ struct RepeatabilityConfig {
 struct MocapNoiseConfig {
   bool enabled = true;
   double position_sigma_mm = 0.5;
-  double rotation_sigma_rad = 0.2 * kRadiansPerDegree;
+  double rotation_sigma_rad = 0.2 * model::kRadiansPerDegree;
 };
 
 struct SimulatorConfig {

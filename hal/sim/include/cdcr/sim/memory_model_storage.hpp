@@ -1,14 +1,12 @@
 #pragma once
-// Host stand-ins for the remaining HAL interfaces: a model region backed by
-// memory (an image file read into a buffer) and a console on stderr.
+// The simulated board's model region: an image held in memory (a file read
+// into a buffer), aligned as a flash section is.
 
-#include <cstdint>
 #include <algorithm>
-#include <cstdio>
-#include <string>
+#include <cstddef>
+#include <cstdint>
 #include <vector>
 
-#include <cdcr/hal/console.hpp>
 #include <cdcr/hal/model_storage.hpp>
 
 namespace cdcr::sim {
@@ -33,24 +31,6 @@ class MemoryModelStorage final : public hal::ModelStorage {
  private:
   std::vector<std::uint64_t> words_;
   std::size_t size_bytes_ = 0;
-};
-
-class StderrConsole final : public hal::Console {
- public:
-  explicit StderrConsole(bool enabled = true) : enabled_(enabled) {}
-  void write_line(const char* line) override {
-    if (enabled_) std::fprintf(stderr, "%s\n", line);
-  }
-
- private:
-  bool enabled_;
-};
-
-// Keeps the lines for tests to inspect (host only: it allocates).
-class RecordingConsole final : public hal::Console {
- public:
-  void write_line(const char* line) override { lines.emplace_back(line); }
-  std::vector<std::string> lines;
 };
 
 }  // namespace cdcr::sim

@@ -6,8 +6,9 @@
 #include <array>
 #include <cstddef>
 
-#include <cdcr/firmware/capacity.hpp>
 #include <cdcr/hal/can_bus.hpp>
+#include <cdcr/hal/can_filter_bank.hpp>
+#include <cdcr/hal/can_frame_ring.hpp>
 
 namespace cdcr::sim {
 
@@ -15,26 +16,28 @@ class VirtualCanBus;
 
 class VirtualCanNode final : public hal::CanBus {
  public:
+  // Depth of each node's receive queue (a board's controller FIFO plays
+  // this role); beyond it frames are lost and counted as overruns.
+  static constexpr std::size_t kRxQueueDepth = 128;
+
   hal::CanStatus send(const hal::CanFrame& frame) override;
   hal::CanStatus receive(hal::CanFrame& frame) override;
-  bool set_filters(const hal::CanFilter* filters, std::size_t count) override;
+  bool set_filters(const hal::CanFilter* filters, std::size_t count) override {
+    return filters_.assign(filters, count);
+  }
   hal::CanErrorCounters error_counters() const override { return counters_; }
 
-  std::size_t pending() const { return count_; }
+  std::size_t pending() const { return queue_.size(); }
   // Simulates a node dropping off the bus: its sends fail with bus_off.
   void set_bus_off(bool bus_off) { bus_off_ = bus_off; }
 
  private:
   friend class VirtualCanBus;
-  bool accepts(std::uint32_t id) const;
   void deliver(const hal::CanFrame& frame);
 
   VirtualCanBus* bus_ = nullptr;
-  std::array<hal::CanFrame, firmware::kRxQueueDepth> queue_{};
-  std::size_t head_ = 0;
-  std::size_t count_ = 0;
-  std::array<hal::CanFilter, firmware::kMaxCanFilters> filters_{};
-  std::size_t filter_count_ = 0;
+  hal::CanFrameRing<kRxQueueDepth> queue_;
+  hal::CanFilterBank<> filters_;
   hal::CanErrorCounters counters_{};
   bool bus_off_ = false;
 };

@@ -4,11 +4,11 @@
 // wired into the Hal the firmware takes. Host programs that run the firmware
 // on the simulated robot start from this.
 
+#include <cdcr/hal/console.hpp>
 #include <cdcr/hal/hal.hpp>
-
-#include "sim/host_backends.hpp"
-#include "sim/lockstep_timer.hpp"
-#include "sim/virtual_can.hpp"
+#include <cdcr/sim/lockstep_timer.hpp>
+#include <cdcr/sim/memory_model_storage.hpp>
+#include <cdcr/sim/virtual_can.hpp>
 
 namespace cdcr::sim {
 
@@ -17,7 +17,7 @@ struct SimulatedPlatform {
   LockstepClock clock;
   LockstepTimer timer{clock};
   MemoryModelStorage storage;
-  StderrConsole console{false};
+  hal::NullConsole console;
   hal::Hal hal{clock, timer, bus.node(0), storage, console};
 };
 

@@ -4,10 +4,10 @@
 #include <stdexcept>
 #include <string>
 
+#include <cdcr/model/units.hpp>
+
 namespace cdcr::sim {
 namespace {
-
-constexpr double kPi = 3.14159265358979323846;
 
 void require(bool condition, const std::string& message) {
   if (!condition) throw std::invalid_argument(message);
@@ -31,7 +31,8 @@ SimulatorConfig SimulatorConfig::nominal_only() {
 }
 
 void SimulatorConfig::validate() const {
-  require(std::isfinite(workspace_theta_max_rad) && workspace_theta_max_rad > 0.0 && workspace_theta_max_rad <= kPi,
+  require(std::isfinite(workspace_theta_max_rad) && workspace_theta_max_rad > 0.0 &&
+              workspace_theta_max_rad <= model::kPi,
           "workspace theta_max must be in (0, pi] rad");
 
   require(std::isfinite(structure.backbone_bending_stiffness_n_mm2) && structure.backbone_bending_stiffness_n_mm2 > 0.0,

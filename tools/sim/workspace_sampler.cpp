@@ -5,13 +5,9 @@
 #include <string>
 
 #include <cdcr/model/chain.hpp>
+#include <cdcr/model/units.hpp>
 
 namespace cdcr::sim {
-namespace {
-
-constexpr double kPi = 3.14159265358979323846;
-
-}  // namespace
 
 WorkspaceSampler::WorkspaceSampler(const model::RobotGeometry<double>& nominal, double theta_max_rad,
                                    std::uint64_t seed)
@@ -34,7 +30,7 @@ WorkspaceSample WorkspaceSampler::next() {
   WorkspaceSample sample;
   sample.joints.resize(2 * n);
   for (int i = 0; i < n; ++i) {
-    sample.joints[2 * i] = random_.uniform(-kPi, kPi);
+    sample.joints[2 * i] = random_.uniform(-model::kPi, model::kPi);
     sample.joints[2 * i + 1] = random_.uniform(0.0, theta_max_rad_);
   }
   if (const model::Status status = model::cables_from_joints(sample.joints, nominal_, sample.cables_mm);

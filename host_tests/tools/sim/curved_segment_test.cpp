@@ -4,13 +4,13 @@
 // curvature law it claims.
 
 #include <algorithm>
-#include <algorithm>
 #include <cmath>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include <cdcr/model/segment.hpp>
+#include <cdcr/model/units.hpp>
 
 #include "sim/curved_segment.hpp"
 
@@ -20,7 +20,7 @@ namespace {
 using Vec2 = model::Vec2<double>;
 using Pose = model::Pose<double>;
 
-constexpr double kPi = 3.14159265358979323846;
+using model::kPi;
 constexpr double kLengthMm = 120.0;
 
 std::vector<Vec2> test_bends() {
