@@ -340,6 +340,11 @@ cdcr_result cdcr_get_pose(const cdcr_runtime* runtime, cdcr_pose* pose) {
   for (int i = 0; i < 2 * pose->segment_count; ++i) pose->joints[i] = estimate.joints[i];
   pose->compensated = estimate.compensated ? 1 : 0;
   pose->count = rt.statistics().poses_published;
+  pose->extrapolating = rt.extrapolating() ? 1 : 0;
+  if (rt.has_uncertainty()) {
+    pose->r95_mm = rt.latest_uncertainty().r95_mm;
+    pose->r95_deg = rt.latest_uncertainty().r95_deg;
+  }
   return CDCR_OK;
 }
 

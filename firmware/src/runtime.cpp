@@ -103,14 +103,20 @@ RuntimeState Runtime::init() {
   // In DEGRADED the same solver solves the nominal model.
   solver_.configure(geometry_, mode_ == RuntimeState::run ? &solver_correction_ : nullptr, solver_options,
                     kIkWorkCosts);
-  // The forward path spends one unit per training point, the variance's
-  // slice and the overhead; IK gets the rest.
+  // The forward path spends one unit per training point and the overhead,
+  // a cycle with a slice of the variance that too; IK gets the rest.
   const bool with_variance = mode_ == RuntimeState::run && uncertainty_.has_variance();
-  const std::uint32_t forward_units = kWorkCosts.cycle_overhead +
-                                      (mode_ == RuntimeState::run ? correction_.training_points() : 0) +
-                                      (with_variance ? kUncertaintyUnitsPerCycle : 0);
-  ik_units_per_cycle_ = forward_units + kMinIkUnitsPerCycle < kCycleWorkUnits ? kCycleWorkUnits - forward_units
-                                                                               : kMinIkUnitsPerCycle;
+  const std::uint32_t forward_units =
+      kWorkCosts.cycle_overhead + (mode_ == RuntimeState::run ? correction_.training_points() : 0);
+  const auto ik_share = [](std::uint32_t used) {
+    return used + kMinIkUnitsPerCycle < kCycleWorkUnits ? kCycleWorkUnits - used : kMinIkUnitsPerCycle;
+  };
+  ik_units_alone_ = ik_share(forward_units);
+  ik_units_beside_variance_ = ik_share(forward_units + (with_variance ? kUncertaintyUnitsPerCycle : 0));
+  ik_units_per_cycle_ = ik_units_beside_variance_;
+  // A large model leaves no room for a slice beside IK's smallest step:
+  // then the variance waits while a target is solved.
+  variance_beside_ik_ = forward_units + kUncertaintyUnitsPerCycle + kMinIkUnitsPerCycle <= kCycleWorkUnits;
   enter(mode_);
   if (boot_fault_ != FaultCode::none) {
     LogLine line;
@@ -189,7 +195,13 @@ void Runtime::run_cycle(const hal::TimerTick& tick) {
   for (int i = 0; i < kMaxRxFramesPerCycle && hal_.can.receive(frame) == hal::CanStatus::ok; ++i) handle_frame(frame);
 
   if (state_ != RuntimeState::boot) update_pose();
-  if (uncertainty_running_) continue_uncertainty();
+  // While a target is solved, the variance gets a slice every few cycles
+  // only: IK's latency is what a user waits on.
+  const bool variance_slice =
+      uncertainty_running_ &&
+      (!solving_ || (variance_beside_ik_ && cycle_ % kUncertaintyEveryCyclesWhileSolving == 0));
+  if (variance_slice) continue_uncertainty();
+  ik_units_per_cycle_ = variance_slice ? ik_units_beside_variance_ : ik_units_alone_;
   if (cycle_ % kStatusEveryCycles == 0) publish_status();
   // IK last: the pose, STATUS and the staleness check never wait for it.
   if (solving_) continue_solve();

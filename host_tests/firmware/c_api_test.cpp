@@ -16,6 +16,7 @@
 
 #include "c_api_check.h"
 #include "export/image_writer.hpp"
+#include "train/predictive_variance.hpp"
 #include "synthetic_trained_model.hpp"
 
 namespace cdcr::firmware {
@@ -102,6 +103,40 @@ TEST(CApi, PoseFromCableLengthsIsTheRuntimes) {
   const Eigen::Quaternionf q(pose.quaternion[0], pose.quaternion[1], pose.quaternion[2], pose.quaternion[3]);
   EXPECT_GE(pose.quaternion[0], 0.0f);
   EXPECT_LT((q.toRotationMatrix() - expected.pose.rotation).cwiseAbs().maxCoeff(), 1e-5f);
+}
+
+// The radii the runtime computes over a few cycles reach the C side: those
+// of the pose, as the same code gives them in one go.
+TEST(CApi, PoseCarriesTheRadiiOfTheImagesVariance) {
+  test_support::SyntheticModelOptions options;
+  options.segments = 2;
+  options.training_points = 40;
+  training::TrainedModel m = test_support::synthetic_trained_model(options);
+  m.signal_variance.setConstant(m.signal_variance[0]);
+  m.noise_variance.setConstant(m.noise_variance[0]);
+  m.variance = training::fit_variance_factor(m, m.inputs, training::variance_points(m, m.inputs, 12, 1));
+  const std::vector<std::uint8_t> image = exporting::write_image(m);
+  QuietHal platform(image);
+  Runtime runtime(platform.hal(), Geometry::prototype());
+  ASSERT_EQ(runtime.init(), RuntimeState::run);
+  const std::vector<float> lengths = bent_cables(runtime.geometry());
+
+  cdcr_pose pose{};
+  cdcr_status status{};
+  ASSERT_EQ(c_api_check_pose(image.data(), std::uint32_t(image.size()), nullptr, lengths.data(), lengths.size(), 12,
+                             &pose, &status),
+            0);
+  Cables cables(lengths.size());
+  for (std::size_t i = 0; i < lengths.size(); ++i) {
+    cables[i] = Scalar(protocol::cable_length_as_transmitted(lengths[i]));
+  }
+  PoseEstimate expected;
+  ASSERT_EQ(runtime.estimate_pose(cables, expected), model::Status::ok);
+  const model::PoseUncertainty<Scalar> radii = runtime.estimate_uncertainty(expected);
+  ASSERT_GT(radii.r95_mm, 0.0f);
+  EXPECT_EQ(pose.r95_mm, radii.r95_mm);
+  EXPECT_EQ(pose.r95_deg, radii.r95_deg);
+  EXPECT_EQ(pose.extrapolating, radii.extrapolating || expected.outside_range ? 1 : 0);
 }
 
 // The paper's Table 1, case 2 (L = 120 mm, r = 70 mm): without an image the

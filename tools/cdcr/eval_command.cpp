@@ -7,7 +7,9 @@
 #include <fmt/format.h>
 
 #include "cdcr/model/compensated_kinematics.hpp"
+#include "cdcr/model/units.hpp"
 #include "cli_errors.hpp"
+#include "export/binary_file.hpp"
 #include "dataset_input.hpp"
 #include "image_input.hpp"
 #include "json_output.hpp"
@@ -20,8 +22,28 @@ namespace {
 struct EvalCommandOptions {
   std::string model_path;
   std::string data_path;
+  std::string rows_path;
   bool json = false;
 };
+
+// One line per sample: its bend angles, errors, radii and flags, for plots
+// and for checks that need the rows (written atomically).
+void write_rows(const std::string& path, const training::TrainingSet& set,
+                const std::vector<training::FirmwareEstimate>& estimates) {
+  const int segments = static_cast<int>(set.bends.cols()) / 2;
+  std::string text;
+  for (int s = 0; s < segments; ++s) text += fmt::format("theta_{},", s + 1);
+  text += "position_error_mm,orientation_error_deg,r95_mm,r95_deg,latent_share,outside_range,extrapolating\n";
+  for (int i = 0; i < set.size(); ++i) {
+    for (int s = 0; s < segments; ++s) text += fmt::format("{:.6g},", set.bends.row(i).segment<2>(2 * s).norm());
+    const model::PoseError<double> e = model::pose_error(set.measured[i], estimates[i].pose);
+    const model::PoseUncertainty<double>& u = estimates[i].uncertainty;
+    text += fmt::format("{:.6g},{:.6g},{:.6g},{:.6g},{:.6g},{},{}\n", e.position_mm,
+                        e.orientation_rad * model::kDegreesPerRadian, u.r95_mm, u.r95_deg, u.latent_share,
+                        u.outside_range ? 1 : 0, u.extrapolating ? 1 : 0);
+  }
+  exporting::write_binary_file(path, text.data(), text.size());
+}
 
 CommandOutput run_eval(const EvalCommandOptions& o) {
   const LoadedImage image = load_image(o.model_path);
@@ -48,6 +70,8 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
   const training::MeanErrors after = training::mean_errors(set.measured, compensated);
   const bool has_variance = image.view.variance_rank > 0;
   const training::CoverageCheck coverage = training::check_coverage(set.measured, estimates);
+
+  if (!o.rows_path.empty()) write_rows(o.rows_path, set, estimates);
 
   CommandOutput output;
   if (o.json) {
@@ -94,6 +118,8 @@ void register_eval_command(CLI::App& app, CommandOutput& output) {
   CLI::App* command = app.add_subcommand("eval", "Mean tip errors before and after compensation by a model image");
   command->add_option("--model", o->model_path, "Flash image written by cdcr train")->required();
   command->add_option("--data", o->data_path, "Dataset CSV with measured poses")->required();
+  command->add_option("--rows", o->rows_path,
+                      "Also write one CSV line per sample: bend angles, errors, r95 radii, latent share and flags");
   command->add_flag("--json", o->json, "Print one JSON object");
   command->callback([o, &output] { output = run_eval(*o); });
 }

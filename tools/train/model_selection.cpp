@@ -44,7 +44,9 @@ ModelSelection select_model(int rows, int input_dims, int segments, ModelChoice 
   const int capacity = static_cast<int>(limits.capacity_points);
   const int by_flash =
       points_within_flash(input_dims, segments, limits.variance_rank, limits.flash_budget_bytes, capacity);
-  const int by_cycle = static_cast<int>(limits.forward_cycle.points_within(limits.forward_cycle_instructions));
+  const bool with_variance = limits.variance_rank > 0;
+  const int by_cycle =
+      static_cast<int>(limits.forward_cycle.points_within(limits.forward_cycle_instructions, with_variance));
   const int largest = std::min({capacity, by_flash, by_cycle});
   // The tightest of the three limits, in words.
   std::string limit;
@@ -93,7 +95,7 @@ ModelSelection select_model(int rows, int input_dims, int segments, ModelChoice 
     }
   }
   s.image_bytes = image_bytes(s.points, input_dims, segments, limits.variance_rank);
-  s.forward_cycle_instructions = limits.forward_cycle.for_points(static_cast<std::uint32_t>(s.points));
+  s.forward_cycle_instructions = limits.forward_cycle.for_points(static_cast<std::uint32_t>(s.points), with_variance);
   return s;
 }
 

@@ -123,16 +123,23 @@ RadiusCalibration calibrate_radii(const TrainedModel& model, const TrainingSet& 
   const Eigen::MatrixXd y = (sample.error_twists.rowwise() - model.output_mean.transpose()).array().rowwise() /
                             model.output_scale.transpose().array();
   const Eigen::MatrixXd alpha = inverse * y;
+  // The radii are those the board computes, from the image's factor where
+  // the model has one: the scales then correct the factor's approximation
+  // too (with few variance points its variance is larger than the exact
+  // GP's where the data are dense).
+  const bool with_factor = model.variance.rank() > 0;
+  const Eigen::VectorXd share = with_factor ? latent_share(model.variance, z) : Eigen::VectorXd();
   std::vector<double> position_ratio, orientation_ratio;
   for (Eigen::Index i = 0; i < z.rows(); ++i) {
     // Leave-one-out: residual alpha_i / [K^-1]_ii, variance 1 / [K^-1]_ii
     // (the noise included), both in normalised units.
-    const double precision = inverse(i, i) / model.signal_variance[0];
+    const double loo_variance = model.signal_variance[0] / inverse(i, i);
+    const double variance = with_factor ? model.signal_variance[0] * share[i] + model.noise_variance[0] : loo_variance;
     double variances[model::kImageOutputs];
     Vector6d residual;
     for (int c = 0; c < model::kImageOutputs; ++c) {
       residual[c] = model.output_scale[c] * alpha(i, c) / inverse(i, i);
-      variances[c] = model.output_scale[c] * model.output_scale[c] / precision;
+      variances[c] = model.output_scale[c] * model.output_scale[c] * variance;
     }
     const Eigen::Vector3d tip = sample.measured[static_cast<std::size_t>(i)].position_mm;
     double r_mm = 0.0;

@@ -41,7 +41,8 @@ Eigen::VectorXd exact_latent_share(const TrainedModel& model, const Eigen::Matri
 // The scales that make the radii hold `coverage` of the rows: the exact
 // GP's leave-one-out residuals of the error twist on `set` (at most
 // max_rows of its rows, drawn at random), mapped to the tip as the board
-// maps the variance, against the radii of their leave-one-out variances.
+// maps the variance, against the radii the board computes there (from the
+// model's variance factor; without one, from the leave-one-out variances).
 // The position radius needs it most: the motion-capture orientation noise
 // enters v and omega together (v = p x omega), and the outputs' independent
 // GPs cannot see that its effect on the tip cancels.

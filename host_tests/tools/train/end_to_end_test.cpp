@@ -72,8 +72,36 @@ TEST(TrainEndToEnd, TheRadiusHoldsAbout95PercentOfAnIndependentTestSet) {
   EXPECT_LE(position, 0.98) << run.out;
   EXPECT_GE(orientation, 0.90) << run.out;
   EXPECT_LE(orientation, 0.98) << run.out;
-  // The same rows the model was trained on do not extrapolate.
+  // Rows from the workspace the model was trained on (every theta <= 0.2)
+  // are flagged at most 5 % of the time.
   EXPECT_LE(result.at("extrapolating").get<int>(), 20) << run.out;
+
+  // Rows with a segment bent beyond 1.5 times that range are flagged at
+  // least 95 % of the time.
+  const std::string far = "'" + dir + "coverage_far.csv'";
+  const std::string rows_path = dir + "coverage_far_rows.csv";
+  ASSERT_EQ(run_cdcr("simulate --samples 300 --seed 1 --session 2 --workspace-theta-max 0.45 --out " + far).exit_code,
+            0);
+  run = run_cdcr("eval --model " + image + " --data " + far + " --rows '" + rows_path + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  std::ifstream rows(rows_path);
+  std::string line;
+  ASSERT_TRUE(std::getline(rows, line));
+  ASSERT_EQ(line.rfind("theta_1,theta_2,theta_3,theta_4,position_error_mm", 0), 0u) << line;
+  int beyond = 0;
+  int beyond_flagged = 0;
+  while (std::getline(rows, line)) {
+    std::vector<double> values;
+    std::stringstream fields(line);
+    for (std::string field; std::getline(fields, field, ',');) values.push_back(std::stod(field));
+    ASSERT_EQ(values.size(), 11u) << line;
+    const double largest_theta = *std::max_element(values.begin(), values.begin() + 4);
+    if (largest_theta <= 0.3) continue;
+    ++beyond;
+    beyond_flagged += values[10] != 0.0 ? 1 : 0;
+  }
+  ASSERT_GT(beyond, 100);
+  EXPECT_GE(beyond_flagged, 0.95 * beyond) << beyond_flagged << " of " << beyond;
 }
 
 // Held-out rows measure the model, then join the exported fit.

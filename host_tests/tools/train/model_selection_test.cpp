@@ -27,7 +27,7 @@ TEST(ModelSelection, ExactWhileEveryRowFits) {
   EXPECT_EQ(s.points, 700);
   EXPECT_EQ(s.fitted_rows, 700);
   EXPECT_EQ(s.image_bytes, image_bytes(700));
-  EXPECT_EQ(s.forward_cycle_instructions, cdcr::model::kCortexM7ForwardCycle.for_points(700));
+  EXPECT_EQ(s.forward_cycle_instructions, cdcr::model::kCortexM7ForwardCycle.for_points(700, false));
   const auto at_capacity = select_model(1024, kInputs, kSegments, ModelChoice::automatic, 0);
   EXPECT_EQ(at_capacity.kind, ModelKind::exact);
 }

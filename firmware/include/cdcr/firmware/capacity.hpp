@@ -56,8 +56,12 @@ inline constexpr std::uint32_t kMinIkUnitsPerCycle =
 
 // Work units a cycle spends on the predictive variance of the latest pose
 // (model::GpUncertainty): an evaluation takes a few cycles (64 variance
-// points cost 384 units: 4 cycles), and its radii go out when it ends.
-inline constexpr std::uint32_t kUncertaintyUnitsPerCycle = 96;
+// points cost 832 units: 5 cycles), and its radii go out when it ends.
+inline constexpr std::uint32_t kUncertaintyUnitsPerCycle = 192;
+// While an IK request runs, the variance gets its slice in every this many
+// cycles only, so that IK keeps nearly its whole share (radii then come
+// about every 40 cycles instead of every 5).
+inline constexpr int kUncertaintyEveryCyclesWhileSolving = 8;
 inline constexpr int kMaxVarianceRank = static_cast<int>(model::kMaxVarianceRank);
 
 // Bounds of one IK request: correction evaluations and nominal LM

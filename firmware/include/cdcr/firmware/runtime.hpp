@@ -146,7 +146,9 @@ class Runtime {
   // The correction the image bound (unbound in DEGRADED).
   const Correction& correction() const { return correction_; }
   const IkReport& last_ik_report() const { return last_ik_report_; }
-  // A target being solved, and the IK work units a cycle may spend on it.
+  // A target being solved, and the IK work units a cycle may spend on it
+  // (the last cycle's; after init, a cycle's that also runs a slice of the
+  // variance, the smaller).
   bool ik_running() const { return solving_; }
   std::uint32_t ik_units_per_cycle() const { return ik_units_per_cycle_; }
   // Units the IK solver spent in the last cycle.
@@ -246,6 +248,9 @@ class Runtime {
   model::IkSolveState solving_end_ = model::IkSolveState::running;
   Joints published_best_bend_;
   std::uint32_t ik_units_per_cycle_ = kMinIkUnitsPerCycle;
+  std::uint32_t ik_units_alone_ = kMinIkUnitsPerCycle;             // in a cycle without a variance slice
+  std::uint32_t ik_units_beside_variance_ = kMinIkUnitsPerCycle;  // in a cycle with one
+  bool variance_beside_ik_ = false;  // a slice fits beside IK's smallest step
   std::uint32_t ik_units_last_cycle_ = 0;
   std::uint32_t setpoints_published_ = 0;
   bool has_setpoints_ = false;

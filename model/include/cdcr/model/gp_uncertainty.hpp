@@ -127,10 +127,14 @@ class GpUncertainty {
   int rank() const { return rank_; }
 
   // The evaluation in slices, for a runtime that spreads it over cycles:
-  // its whole state lives here. Work is counted in units of about one
-  // kernel value (a GP mean point's instructions): a variance point's kernel
-  // is one unit, a row of a triangular solve 1 + i / kSolveMacsPerUnit.
-  static constexpr std::uint32_t kSolveMacsPerUnit = 16;
+  // its whole state lives here. Work is counted in the cycle's units (a GP
+  // mean point's instructions, model/work_costs.hpp): a variance point's
+  // kernel value costs kKernelUnits, row i of a triangular solve
+  // kKernelUnits + i / kSolveMacsPerUnit; measured on the Cortex-M7 and M4F
+  // under QEMU (about 100 instructions for each pair of units charged
+  // before, at one unit per kernel and 16 multiply-adds per unit).
+  static constexpr std::uint32_t kKernelUnits = 2;
+  static constexpr std::uint32_t kSolveMacsPerUnit = 8;
 
   struct Evaluation {
     S z[MaxInputs] = {};
@@ -147,8 +151,8 @@ class GpUncertainty {
   // The units a whole evaluation costs: what a caller that runs it in one
   // cycle must budget.
   std::uint32_t evaluation_units() const {
-    std::uint32_t units = static_cast<std::uint32_t>(rank_);
-    for (int i = 0; i < rank_; ++i) units += 2 * (1 + static_cast<std::uint32_t>(i) / kSolveMacsPerUnit);
+    std::uint32_t units = kKernelUnits * static_cast<std::uint32_t>(rank_);
+    for (int i = 0; i < rank_; ++i) units += 2 * (kKernelUnits + static_cast<std::uint32_t>(i) / kSolveMacsPerUnit);
     return units;
   }
 
@@ -171,7 +175,7 @@ class GpUncertainty {
     std::uint32_t spent = 0;
     while (e.stage < 3) {
       if (e.stage == 0) {
-        if (spent > 0 && spent + 1 > max_units) break;
+        if (spent > 0 && spent + kKernelUnits > max_units) break;
         const float* u = points_ + static_cast<std::size_t>(e.next) * static_cast<std::size_t>(dims_);
         S distance_sq = S(0);
         for (int d = 0; d < dims_; ++d) {
@@ -179,9 +183,9 @@ class GpUncertainty {
           distance_sq = multiply_add(difference, difference, distance_sq);
         }
         e.a[e.next] = gaussian(distance_sq);
-        spent += 1;
+        spent += kKernelUnits;
       } else {
-        const std::uint32_t cost = 1 + static_cast<std::uint32_t>(e.next) / kSolveMacsPerUnit;
+        const std::uint32_t cost = kKernelUnits + static_cast<std::uint32_t>(e.next) / kSolveMacsPerUnit;
         if (spent > 0 && spent + cost > max_units) break;
         // Row i of x = L^-1 x, in place: x_i = (x_i - sum_j<i L_ij x_j) / L_ii.
         const int i = e.next;
