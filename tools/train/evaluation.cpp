@@ -51,54 +51,20 @@ const char* to_string(FirmwareAccumulator accumulator) {
 
 namespace {
 
+// The firmware's path with the given accumulator: pose, radii and flags.
 template <typename Accumulator>
-std::vector<model::Pose<double>> firmware_poses_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
+std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
   model::RobotGeometry<float> geometry;
   if (const model::Status s = model::geometry_from_image(image, geometry); s != model::Status::ok) {
     throw std::invalid_argument(std::string("image geometry: ") + model::to_string(s));
   }
   model::GpCorrection<float, Accumulator> correction;
+  model::GpUncertainty<float> uncertainty;
   if (const model::Status s = correction.bind(image); s != model::Status::ok) {
     throw std::invalid_argument(std::string("image: ") + model::to_string(s));
   }
-  std::vector<model::Pose<double>> poses;
-  poses.reserve(static_cast<std::size_t>(cables_mm.rows()));
-  for (Eigen::Index i = 0; i < cables_mm.rows(); ++i) {
-    const model::CableVector<float> cables = cables_mm.row(i).transpose().cast<float>();
-    model::ForwardResult<float> result;
-    if (const model::Status s = model::compensated_forward(cables, geometry, correction, result);
-        s != model::Status::ok) {
-      throw std::invalid_argument("sample " + std::to_string(i + 1) + ": " + model::to_string(s));
-    }
-    poses.push_back(result.compensated.cast<double>());
-  }
-  return poses;
-}
-
-}  // namespace
-
-std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
-                                                FirmwareAccumulator accumulator) {
-  switch (accumulator) {
-    case FirmwareAccumulator::compensated_float32:
-      return firmware_poses_with<model::CompensatedFloat>(image, cables_mm);
-    case FirmwareAccumulator::float32:
-      return firmware_poses_with<float>(image, cables_mm);
-    case FirmwareAccumulator::float64:
-      break;
-  }
-  return firmware_poses_with<double>(image, cables_mm);
-}
-
-std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
-  model::RobotGeometry<float> geometry;
-  if (const model::Status s = model::geometry_from_image(image, geometry); s != model::Status::ok) {
-    throw std::invalid_argument(std::string("image geometry: ") + model::to_string(s));
-  }
-  model::GpCorrection<float, double> correction;
-  model::GpUncertainty<float> uncertainty;
-  if (correction.bind(image) != model::Status::ok || uncertainty.bind(image) != model::Status::ok) {
-    throw std::invalid_argument("image: cannot bind its correction");
+  if (const model::Status s = uncertainty.bind(image); s != model::Status::ok) {
+    throw std::invalid_argument(std::string("image: ") + model::to_string(s));
   }
   std::vector<FirmwareEstimate> estimates;
   estimates.reserve(static_cast<std::size_t>(cables_mm.rows()));
@@ -122,6 +88,32 @@ std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, 
     estimates.push_back(e);
   }
   return estimates;
+}
+
+template <typename Accumulator>
+std::vector<model::Pose<double>> firmware_poses_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
+  std::vector<model::Pose<double>> poses;
+  for (const FirmwareEstimate& e : estimates_with<Accumulator>(image, cables_mm)) poses.push_back(e.pose);
+  return poses;
+}
+
+}  // namespace
+
+std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
+                                                FirmwareAccumulator accumulator) {
+  switch (accumulator) {
+    case FirmwareAccumulator::compensated_float32:
+      return firmware_poses_with<model::CompensatedFloat>(image, cables_mm);
+    case FirmwareAccumulator::float32:
+      return firmware_poses_with<float>(image, cables_mm);
+    case FirmwareAccumulator::float64:
+      break;
+  }
+  return firmware_poses_with<double>(image, cables_mm);
+}
+
+std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
+  return estimates_with<double>(image, cables_mm);
 }
 
 CoverageCheck check_coverage(const std::vector<model::Pose<double>>& measured,
