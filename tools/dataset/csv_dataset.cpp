@@ -68,7 +68,7 @@ Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
   while (cables < static_cast<int>(fields.size()) && !fields[cables].empty() && fields[cables][0] == 'l') ++cables;
   // The payload column has one place: right after the cable columns.
   for (int i = 0; i < static_cast<int>(fields.size()); ++i) {
-    if (fields[i] == kPayloadColumn && (i != cables || cables == 0)) {
+    if (fields[i] == kPayloadColumn && (i != cables || cables == 0 || cables % 4 != 0)) {
       throw DatasetError(line_number, "header column " + std::to_string(i + 1) + " is '" + kPayloadColumn +
                                           "', which belongs right after the cable columns and before x,y,z,...");
     }

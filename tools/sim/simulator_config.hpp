@@ -113,11 +113,12 @@ struct GravityConfig {
   double segment_mass_kg = 0.25;   // backbone, disks and passing cables
   double platform_mass_kg = 0.2;   // end platform and markers
 };
-// With the defaults, every kilogram of payload on the straight horizontal
-// prototype sags the tip by about 80 mm more (and tilts it by about 13 deg):
-// a tip force F bends segment i by F l_i / K, l_i the lever arm from its base
+// A tip force F bends segment i by F l_i / K, l_i the lever arm from its base
 // to the tip, and the bends of the proximal segments swing the whole distal
-// robot.
+// robot: with the defaults, the first kilogram of payload sags the tip of the
+// straight horizontal prototype by 75 mm more and tilts it by 14 deg (63 to
+// 81 mm over the paper's workspace), a little less for each further one as
+// the sag shortens the lever arms.
 
 // A payload carried by the end platform, known per sample (a dataset column):
 // a tool, a gripped object. It is drawn per sample, uniform in

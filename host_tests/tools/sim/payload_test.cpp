@@ -172,13 +172,16 @@ TEST(SimulatorPayload, SmallPayloadsFollowTheCantileverWithATipLoad) {
 }
 
 // The default robot, mounted horizontally (gravity -x in the base frame),
-// anywhere in its workspace: more payload, more sag along gravity, a steeper
-// end disk, and smoothly so.
+// anywhere in its workspace: more payload, more sag along gravity, and
+// smoothly so; in the paper's workspace, also a steeper end disk.
 TEST(SimulatorPayload, MorePayloadSagsTheTipFurtherAlongGravity) {
   SimulatedRobot robot(kPrototype, SimulatorConfig{});
   const Vec3 down(-1.0, 0.0, 0.0);
   for (const double theta_max : {0.2, 0.7}) {
+    const bool paper_workspace = theta_max == 0.2;
+    int configuration = 0;
     for (const Cables& cables : workspace_cables(theta_max, 20)) {
+      SCOPED_TRACE(testing::Message() << "theta_max " << theta_max << ", configuration " << configuration++);
       const Pose unloaded = robot.true_pose(cables);
       double previous_sag = 0.0, previous_tilt = std::asin(unloaded.rotation.col(2).dot(down));
       std::vector<double> sag;
@@ -188,8 +191,12 @@ TEST(SimulatorPayload, MorePayloadSagsTheTipFurtherAlongGravity) {
         const double along = moved.dot(down);
         const double tilt = std::asin(pose.rotation.col(2).dot(down));
         EXPECT_GT(along, previous_sag) << step;
-        EXPECT_GT(tilt, previous_tilt) << step;
-        EXPECT_GT(along, 0.8 * moved.norm()) << step;  // mostly downwards
+        // The end disk turns towards the ground; far out in the wide
+        // workspace it can face the ground already and turn past it.
+        if (paper_workspace) EXPECT_GT(tilt, previous_tilt) << step;
+        // Within the paper's workspace mostly downwards; a robot bent far
+        // sideways also swings about its base (the lever arms turn with it).
+        EXPECT_GT(along, (paper_workspace ? 0.8 : 0.3) * moved.norm()) << step;
         previous_sag = along;
         previous_tilt = tilt;
         sag.push_back(along);
@@ -197,8 +204,8 @@ TEST(SimulatorPayload, MorePayloadSagsTheTipFurtherAlongGravity) {
       // 1 kg moves the tip by tens of millimetres, many times the noise
       // floor (about 2.2 mm), and the response is close to linear: the
       // second differences over 0.1 kg are a small part of the first.
-      EXPECT_GT(sag[9], 40.0);
-      EXPECT_LT(sag[9], 120.0);
+      EXPECT_GT(sag[9], paper_workspace ? 50.0 : 10.0);
+      EXPECT_LT(sag[9], 85.0);
       for (std::size_t k = 1; k + 1 < sag.size(); ++k) {
         const double first = sag[k + 1] - sag[k];
         const double second = sag[k + 1] - 2.0 * sag[k] + sag[k - 1];
