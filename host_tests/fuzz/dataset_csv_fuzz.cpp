@@ -37,7 +37,9 @@ void check_accepted(const Dataset& data, std::string_view text, PoseColumns pose
   require(back.segment_count == data.segment_count && back.has_poses == data.has_poses);
   require(back.has_payload == data.has_payload && back.payload_kg.size() == data.payload_kg.size());
   for (Eigen::Index i = 0; i < data.payload_kg.size(); ++i) {
-    require(back.payload_kg[i] == data.payload_kg[i] && std::signbit(back.payload_kg[i]) == std::signbit(data.payload_kg[i]));
+    const double a = data.payload_kg[i];
+    const double b = back.payload_kg[i];
+    require(a == b && std::signbit(a) == std::signbit(b));
   }
   require(back.cables_mm.rows() == data.cables_mm.rows());
   for (Eigen::Index i = 0; i < data.cables_mm.size(); ++i) {
