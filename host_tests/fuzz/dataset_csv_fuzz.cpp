@@ -25,6 +25,8 @@ void check_accepted(const Dataset& data, std::string_view text, PoseColumns pose
   require(data.content_hash == fnv1a64(text));
   require(poses == PoseColumns::optional || data.has_poses);
   require(data.poses.size() == (data.has_poses ? static_cast<std::size_t>(data.sample_count()) : 0u));
+  require(data.payload_kg.size() == (data.has_payload ? data.sample_count() : 0));
+  require(data.payload_kg.allFinite() && (data.payload_kg.array() >= 0.0).all());
   for (const auto& pose : data.poses) {
     require(pose.all_finite());
     const double orthonormality = (pose.rotation.transpose() * pose.rotation - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
@@ -33,6 +35,12 @@ void check_accepted(const Dataset& data, std::string_view text, PoseColumns pose
 
   const Dataset back = parse_dataset_csv(format_dataset_csv(data, "fuzz"), poses);
   require(back.segment_count == data.segment_count && back.has_poses == data.has_poses);
+  require(back.has_payload == data.has_payload && back.payload_kg.size() == data.payload_kg.size());
+  for (Eigen::Index i = 0; i < data.payload_kg.size(); ++i) {
+    const double a = data.payload_kg[i];
+    const double b = back.payload_kg[i];
+    require(a == b && std::signbit(a) == std::signbit(b));
+  }
   require(back.cables_mm.rows() == data.cables_mm.rows());
   for (Eigen::Index i = 0; i < data.cables_mm.size(); ++i) {
     const double a = data.cables_mm.data()[i];

@@ -52,13 +52,16 @@ void write(const std::filesystem::path& path, const std::vector<std::uint8_t>& b
   write(path, std::string(bytes.begin(), bytes.end()));
 }
 
-cdcr::dataset::Dataset small_dataset(int segments, int rows, bool poses) {
+cdcr::dataset::Dataset small_dataset(int segments, int rows, bool poses, bool payload = false) {
   cdcr::dataset::Dataset data;
   data.segment_count = segments;
   data.has_poses = poses;
+  data.has_payload = payload;
   data.cables_mm.resize(rows, 4 * segments);
+  if (payload) data.payload_kg.resize(rows);
   for (int r = 0; r < rows; ++r) {
     for (int c = 0; c < 4 * segments; ++c) data.cables_mm(r, c) = 120.0 + 0.37 * (r + 1) * (c - 1.5);
+    if (payload) data.payload_kg[r] = 0.25 * r;
     if (poses) {
       cdcr::model::Pose<double> pose;
       pose.rotation = Eigen::AngleAxisd(0.1 * (r + 1), Eigen::Vector3d(1, -2, 0.5).normalized()).toRotationMatrix();
@@ -125,6 +128,9 @@ int main(int argc, char** argv) {
 
   write(root / "csv" / "cables.csv", cdcr::dataset::format_dataset_csv(small_dataset(2, 3, false)));
   write(root / "csv" / "poses.csv", cdcr::dataset::format_dataset_csv(small_dataset(1, 2, true), "measured"));
+  write(root / "csv" / "payload_poses.csv",
+        cdcr::dataset::format_dataset_csv(small_dataset(2, 3, true, true), "measured with a payload"));
+  write(root / "csv" / "payload_cables.csv", cdcr::dataset::format_dataset_csv(small_dataset(1, 2, false, true)));
   write(root / "csv" / "crlf_bom_comments.csv",
         std::string("\xEF\xBB\xBF# exported\r\n\r\nl1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy,qz\r\n"
                     "120,+121.5,119, 118 ,1e1,-0,240,1,0,0,0\r\n# end\r\n"));

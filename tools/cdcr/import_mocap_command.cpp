@@ -31,7 +31,8 @@ void register_import_mocap_command(CLI::App& app, CommandOutput& output) {
       "import-mocap",
       "Build a dataset from commanded cable lengths and a Qualisys (QTM) 6DOF TSV export: row i of the cable "
       "file is paired with captured frame i, and the pose written is T_base^-1 * T_end (eq. 21)");
-  command->add_option("--cables", options->cables_path, "Dataset CSV with the commanded cable lengths (pose columns, if any, are ignored)")
+  command->add_option("--cables", options->cables_path, "Dataset CSV with the commanded cable lengths and, optionally, the payload (pose columns, if any, "
+                      "are ignored)")
       ->type_name("FILE")
       ->required();
   command->add_option("--mocap", options->mocap_path, "QTM 6DOF export (.tsv): X Y Z in mm, Rot[0..8] column-major")

@@ -15,6 +15,7 @@
 #include "cli_errors.hpp"
 #include "dataset/csv_dataset.hpp"
 #include "json_output.hpp"
+#include "number_list.hpp"
 #include "sim/data_collection.hpp"
 
 namespace cdcr::cli {
@@ -37,6 +38,21 @@ std::uint64_t parse_seed(const std::string& text) {
         fmt::format("--seed must not exceed {} (got {})", std::numeric_limits<std::uint64_t>::max(), text));
   }
   return seed;
+}
+
+sim::PayloadConfig parse_payload_range(const std::string& text) {
+  const std::vector<double> range = parse_number_list(text, "--payload-range");
+  require_count(range, 2, "--payload-range", "LO,HI in kg");
+  require_finite(range, "--payload-range");
+  if (range[0] < 0.0) throw InputError(fmt::format("--payload-range: LO must not be negative (got {} kg)", range[0]));
+  if (range[0] > range[1]) {
+    throw InputError(fmt::format("--payload-range: LO must not exceed HI (got {} > {} kg)", range[0], range[1]));
+  }
+  sim::PayloadConfig payload;
+  payload.enabled = true;
+  payload.min_kg = range[0];
+  payload.max_kg = range[1];
+  return payload;
 }
 
 sim::SimulatorConfig make_config(const SimulateCommandOptions& options, const model::RobotGeometry<double>& geometry,
@@ -74,20 +90,33 @@ sim::SimulatorConfig make_config(const SimulateCommandOptions& options, const mo
   config.repeatability.bend_sigma_rad *= options.noise_scale;
   config.mocap_noise.position_sigma_mm *= options.noise_scale;
   config.mocap_noise.rotation_sigma_rad *= options.noise_scale;
+  if (options.payload_range_kg) config.payload = parse_payload_range(*options.payload_range_kg);
   return config;
 }
 
-dataset::Dataset to_dataset(const std::vector<sim::CollectedSample>& samples, int segment_count) {
+dataset::Dataset to_dataset(const std::vector<sim::CollectedSample>& samples, int segment_count, bool payload) {
   dataset::Dataset data;
   data.segment_count = segment_count;
   data.has_poses = true;
+  data.has_payload = payload;
   data.cables_mm.resize(static_cast<Eigen::Index>(samples.size()), 4 * segment_count);
+  if (payload) data.payload_kg.resize(static_cast<Eigen::Index>(samples.size()));
   data.poses.reserve(samples.size());
   for (std::size_t i = 0; i < samples.size(); ++i) {
     data.cables_mm.row(static_cast<Eigen::Index>(i)) = samples[i].cables_mm.transpose();
+    if (payload) data.payload_kg[static_cast<Eigen::Index>(i)] = samples[i].payload_kg;
     data.poses.push_back(samples[i].measurement.measured_pose);
   }
   return data;
+}
+
+std::string payload_comment(const sim::SimulatorConfig& config) {
+  if (!config.payload.enabled) return {};
+  return fmt::format("payload: uniform in [{}, {}] kg per sample (column payload_kg), {}\n", config.payload.min_kg,
+                     config.payload.max_kg,
+                     config.gravity.enabled
+                         ? fmt::format("on top of the {} kg end platform", config.gravity.platform_mass_kg)
+                         : std::string("weightless: gravity is off"));
 }
 
 std::string dataset_comment(const model::RobotGeometry<double>& geometry,
@@ -102,6 +131,7 @@ std::string dataset_comment(const model::RobotGeometry<double>& geometry,
              on_off(config.geometric.enabled), on_off(config.curvature.enabled), on_off(config.compliance.enabled),
              on_off(config.gravity.enabled), on_off(config.repeatability.enabled),
              on_off(config.mocap_noise.enabled)) +
+         payload_comment(config) +
          fmt::format("initial mean error (nominal model vs measured): {:.6g} mm, {:.6g} deg\n",
                      summary.initial.position_mm, summary.initial.orientation_deg) +
          fmt::format("noise floor (true vs measured pose): {:.6g} mm, {:.6g} deg", summary.noise_floor.position_mm,
@@ -136,6 +166,10 @@ void register_simulate_command(CLI::App& app, CommandOutput& output) {
   command->add_option("--noise-scale", options->noise_scale,
                       "Scale of the per-sample noise (repeatability and motion capture); 0.25 is a low-noise robot")
       ->capture_default_str();
+  command->add_option("--payload-range", options->payload_range_kg,
+                      "Payload on the end platform, drawn per sample uniform in [LO, HI] kg; writes the payload_kg "
+                      "column")
+      ->type_name("LO,HI");
   command->add_flag("--json", options->json, "Print one JSON object instead of the summary");
   command->callback([options, &output] { output = run_simulate(*options); });
 }
@@ -161,8 +195,8 @@ CommandOutput run_simulate(const SimulateCommandOptions& options) {
 
   if (options.out_path) {
     try {
-      dataset::write_dataset_csv(*options.out_path, to_dataset(samples, geometry.segment_count),
-                                 dataset_comment(geometry, config, summary));
+      const dataset::Dataset data = to_dataset(samples, geometry.segment_count, config.payload.enabled);
+      dataset::write_dataset_csv(*options.out_path, data, dataset_comment(geometry, config, summary));
     } catch (const dataset::DatasetError& error) {
       throw InputError(error.what());
     }
@@ -176,11 +210,17 @@ CommandOutput run_simulate(const SimulateCommandOptions& options) {
                          {"orientation_deg", summary.initial.orientation_deg}};
     result["noise_floor"] = {{"position_mm", summary.noise_floor.position_mm},
                              {"orientation_deg", summary.noise_floor.orientation_deg}};
+    if (config.payload.enabled) result["payload_kg"] = {{"min", config.payload.min_kg}, {"max", config.payload.max_kg}};
     output.text = result.dump() + "\n";
   } else {
-    output.text = fmt::format("samples: {}\ninitial mean error: {:.3f} mm, {:.3f} deg\nnoise floor: {:.3f} mm, {:.3f} deg\n",
-                              summary.samples, summary.initial.position_mm, summary.initial.orientation_deg,
-                              summary.noise_floor.position_mm, summary.noise_floor.orientation_deg);
+    output.text = fmt::format("samples: {}\n", summary.samples);
+    if (config.payload.enabled) {
+      output.text +=
+          fmt::format("payload: {} to {} kg, uniform per sample\n", config.payload.min_kg, config.payload.max_kg);
+    }
+    output.text += fmt::format("initial mean error: {:.3f} mm, {:.3f} deg\nnoise floor: {:.3f} mm, {:.3f} deg\n",
+                               summary.initial.position_mm, summary.initial.orientation_deg,
+                               summary.noise_floor.position_mm, summary.noise_floor.orientation_deg);
     if (options.out_path) output.text += fmt::format("dataset: {}\n", *options.out_path);
   }
   return output;

@@ -36,6 +36,7 @@ struct SimulateCommandOptions {
   bool no_repeatability = false;
   bool no_mocap_noise = false;
   double noise_scale = 1.0;
+  std::optional<std::string> payload_range_kg;  // "LO,HI"; unset: no payload, no payload column
   bool json = false;
 };
 

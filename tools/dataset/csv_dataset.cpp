@@ -19,6 +19,7 @@ using detail::kUtf8ByteOrderMark;
 using detail::split_fields;
 using detail::trim_blanks;
 
+constexpr const char* kPayloadColumn = "payload_kg";
 constexpr const char* kPoseColumns[] = {"x", "y", "z", "qw", "qx", "qy", "qz"};
 constexpr int kPoseColumnCount = 7;
 constexpr double kQuaternionNormTolerance = 1e-3;
@@ -44,7 +45,16 @@ double parse_number(std::string_view field, int line, const std::string& column)
 struct Header {
   int line = 0;
   int segment_count = 0;
+  bool has_payload = false;
   bool has_poses = false;
+
+  int cable_columns() const { return 4 * segment_count; }
+  int columns() const { return cable_columns() + (has_payload ? 1 : 0) + (has_poses ? kPoseColumnCount : 0); }
+  std::string column_name(int index) const {
+    if (index < cable_columns()) return cable_column_name(index / 4, index % 4);
+    if (has_payload && index == cable_columns()) return kPayloadColumn;
+    return kPoseColumns[index - cable_columns() - (has_payload ? 1 : 0)];
+  }
 };
 
 Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
@@ -56,6 +66,13 @@ Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
   }
   int cables = 0;
   while (cables < static_cast<int>(fields.size()) && !fields[cables].empty() && fields[cables][0] == 'l') ++cables;
+  // The payload column has one place: right after the cable columns.
+  for (int i = 0; i < static_cast<int>(fields.size()); ++i) {
+    if (fields[i] == kPayloadColumn && (i != cables || cables == 0 || cables % 4 != 0)) {
+      throw DatasetError(line_number, "header column " + std::to_string(i + 1) + " is '" + kPayloadColumn +
+                                          "', which belongs right after the cable columns and before x,y,z,...");
+    }
+  }
   if (cables == 0 || cables % 4 != 0) {
     throw DatasetError(line_number, "header must start with cable columns l1_1,l1_2,l1_3,l1_4,... (a multiple of 4), found " +
                                         std::to_string(cables));
@@ -75,24 +92,27 @@ Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
                                           ", expected '" + expected + "'");
     }
   }
-  const int rest = static_cast<int>(fields.size()) - cables;
+  h.has_payload = cables < static_cast<int>(fields.size()) && fields[cables] == kPayloadColumn;
+  const int first_pose = cables + (h.has_payload ? 1 : 0);
+  const int rest = static_cast<int>(fields.size()) - first_pose;
   if (rest == 0) {
     if (poses == PoseColumns::required) {
-      throw DatasetError(line_number, "missing pose columns x,y,z,qw,qx,qy,qz after the cable columns");
+      throw DatasetError(line_number, std::string("missing pose columns x,y,z,qw,qx,qy,qz after the ") +
+                                          (h.has_payload ? "payload column" : "cable columns"));
     }
     return h;
   }
   for (int i = 0; i < kPoseColumnCount; ++i) {
-    if (cables + i >= static_cast<int>(fields.size())) {
+    if (first_pose + i >= static_cast<int>(fields.size())) {
       throw DatasetError(line_number, std::string("missing column '") + kPoseColumns[i] + "'");
     }
-    if (fields[cables + i] != kPoseColumns[i]) {
-      throw DatasetError(line_number, "header column " + std::to_string(cables + i + 1) + " is " +
-                                          quoted(fields[cables + i]) + ", expected '" + kPoseColumns[i] + "'");
+    if (fields[first_pose + i] != kPoseColumns[i]) {
+      throw DatasetError(line_number, "header column " + std::to_string(first_pose + i + 1) + " is " +
+                                          quoted(fields[first_pose + i]) + ", expected '" + kPoseColumns[i] + "'");
     }
   }
   if (rest > kPoseColumnCount) {
-    throw DatasetError(line_number, "unexpected column " + quoted(fields[cables + kPoseColumnCount]));
+    throw DatasetError(line_number, "unexpected column " + quoted(fields[first_pose + kPoseColumnCount]));
   }
   h.has_poses = true;
   return h;
@@ -163,15 +183,19 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses) {
       continue;
     }
     const std::vector<std::string_view> fields = split_fields(line, ',');
-    const int cables = 4 * header.segment_count;
-    const int expected = cables + (header.has_poses ? kPoseColumnCount : 0);
+    const int expected = header.columns();
     if (static_cast<int>(fields.size()) != expected) {
       throw DatasetError(line_number, "expected " + std::to_string(expected) + " fields, found " +
                                           std::to_string(fields.size()));
     }
-    for (int i = 0; i < expected; ++i) {
-      const std::string column = i < cables ? cable_column_name(i / 4, i % 4) : kPoseColumns[i - cables];
-      values.push_back(parse_number(fields[i], line_number, column));
+    for (int i = 0; i < expected; ++i) values.push_back(parse_number(fields[i], line_number, header.column_name(i)));
+    if (header.has_payload) {
+      const std::size_t payload = values.size() - static_cast<std::size_t>(expected - header.cable_columns());
+      if (values[payload] < 0.0) {
+        throw DatasetError(line_number, std::string("column ") + kPayloadColumn + ": " +
+                                            quoted(fields[header.cable_columns()]) +
+                                            " is negative; a payload is a mass, zero or more kg");
+      }
     }
     if (header.has_poses) {
       data.poses.push_back(pose_from_fields(values.data() + values.size() - kPoseColumnCount, line_number));
@@ -179,13 +203,15 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses) {
   }
   if (!have_header) throw DatasetError(0, "no header line (expected l1_1,l1_2,...): the file is empty or only comments");
   data.segment_count = header.segment_count;
+  data.has_payload = header.has_payload;
   data.has_poses = header.has_poses;
-  const int columns = 4 * header.segment_count + (header.has_poses ? kPoseColumnCount : 0);
+  const int columns = header.columns();
   const auto rows = static_cast<Eigen::Index>(values.size() / static_cast<std::size_t>(columns));
   if (rows == 0) throw DatasetError(header.line, "no data rows after the header");
   const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> all(values.data(), rows,
                                                                                                      columns);
-  data.cables_mm = all.leftCols(4 * header.segment_count);
+  data.cables_mm = all.leftCols(header.cable_columns());
+  if (header.has_payload) data.payload_kg = all.col(header.cable_columns());
   return data;
 }
 
@@ -211,6 +237,15 @@ std::string format_dataset_csv(const Dataset& data, const std::string& comment) 
     throw std::invalid_argument("dataset has " + std::to_string(data.poses.size()) + " poses for " +
                                 std::to_string(data.sample_count()) + " samples");
   }
+  if (data.has_payload) {
+    if (data.payload_kg.size() != data.sample_count()) {
+      throw std::invalid_argument("dataset has " + std::to_string(data.payload_kg.size()) + " payloads for " +
+                                  std::to_string(data.sample_count()) + " samples");
+    }
+    if (!data.payload_kg.allFinite() || (data.payload_kg.array() < 0.0).any()) {
+      throw std::invalid_argument("dataset has a payload that is NaN, Inf or negative");
+    }
+  }
   std::ostringstream out;
   out << std::setprecision(std::numeric_limits<double>::max_digits10);
   if (!comment.empty()) {
@@ -218,12 +253,14 @@ std::string format_dataset_csv(const Dataset& data, const std::string& comment) 
     for (std::string line; std::getline(lines, line);) out << "# " << line << '\n';
   }
   for (int i = 0; i < 4 * data.segment_count; ++i) out << (i ? "," : "") << cable_column_name(i / 4, i % 4);
+  if (data.has_payload) out << ',' << kPayloadColumn;
   if (data.has_poses) {
     for (const char* c : kPoseColumns) out << ',' << c;
   }
   out << '\n';
   for (int r = 0; r < data.sample_count(); ++r) {
     for (Eigen::Index c = 0; c < data.cables_mm.cols(); ++c) out << (c ? "," : "") << data.cables_mm(r, c);
+    if (data.has_payload) out << ',' << data.payload_kg[r];
     if (data.has_poses) {
       const model::Pose<double>& pose = data.poses[static_cast<std::size_t>(r)];
       Eigen::Quaterniond q(pose.rotation);

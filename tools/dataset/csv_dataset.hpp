@@ -1,12 +1,13 @@
 #pragma once
 // Reading and writing the dataset CSV (layout in the README, "Dataset format").
 //
-//   l1_1,l1_2,l1_3,l1_4,...,ln_4[,x,y,z,qw,qx,qy,qz]
+//   l1_1,l1_2,l1_3,l1_4,...,ln_4[,payload_kg][,x,y,z,qw,qx,qy,qz]
 //
 // Cable columns first (li_j: cable j of segment i, mm), then optionally the
-// measured end-platform pose in the base frame (mm; unit quaternion,
-// Hamilton, w first). Lines starting with '#' are comments; blank lines are
-// ignored; LF and CRLF line endings are both accepted.
+// payload the end platform carried (kg, finite and not negative), then
+// optionally the measured end-platform pose in the base frame (mm; unit
+// quaternion, Hamilton, w first). Lines starting with '#' are comments; blank
+// lines are ignored; LF and CRLF line endings are both accepted.
 
 #include <cstdint>
 #include <stdexcept>
@@ -45,9 +46,10 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses = PoseColumns
 // Reads a file (errors are prefixed with the path).
 Dataset read_dataset_csv(const std::string& path, PoseColumns poses = PoseColumns::optional);
 
-// Writes with full round-trip precision (max_digits10); poses are written when
-// has_poses. Each line of `comment` becomes a '#' line before the header.
-// Throws std::invalid_argument if the dataset's shapes disagree.
+// Writes with full round-trip precision (max_digits10); the payload is written
+// when has_payload, poses when has_poses. Each line of `comment` becomes a '#'
+// line before the header. Throws std::invalid_argument if the dataset's shapes
+// disagree or a payload is one the reader would reject.
 std::string format_dataset_csv(const Dataset& data, const std::string& comment = {});
 void write_dataset_csv(const std::string& path, const Dataset& data, const std::string& comment = {});
 

@@ -1,7 +1,7 @@
 #pragma once
-// A dataset of the robot: commanded cable lengths and, when measured, the
-// end-platform pose in the base frame. The CSV layout is documented in the
-// README ("Dataset format").
+// A dataset of the robot: commanded cable lengths, optionally the payload the
+// end platform carried, and, when measured, the end-platform pose in the base
+// frame. The CSV layout is documented in the README ("Dataset format").
 
 #include <cstdint>
 #include <string>
@@ -17,6 +17,8 @@ namespace cdcr::dataset {
 struct Dataset {
   int segment_count = 0;
   Eigen::MatrixXd cables_mm;                   // samples x 4n, columns l1_1, l1_2, ..., ln_4
+  Eigen::VectorXd payload_kg;                  // one per sample when has_payload: finite, not negative
+  bool has_payload = false;
   std::vector<model::Pose<double>> poses;      // one per sample when has_poses
   bool has_poses = false;
   std::uint64_t content_hash = 0;              // 64-bit FNV-1a of the file's bytes

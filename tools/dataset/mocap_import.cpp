@@ -280,6 +280,8 @@ MocapImport import_mocap(const Dataset& commanded, const MocapCapture& capture, 
   result.data.segment_count = commanded.segment_count;
   result.data.has_poses = true;
   result.data.cables_mm = commanded.cables_mm(kept_rows, Eigen::all);
+  result.data.has_payload = commanded.has_payload;
+  if (commanded.has_payload) result.data.payload_kg = commanded.payload_kg(kept_rows);
   return result;
 }
 

@@ -77,7 +77,7 @@ struct MocapImportOptions {
 };
 
 struct MocapImport {
-  Dataset data;                      // cables of the kept rows, with their poses
+  Dataset data;                      // cables (and payloads, if any) of the kept rows, with their poses
   std::vector<long> skipped_frames;  // QTM frame numbers dropped because a body was lost
 };
 

@@ -6,6 +6,8 @@
 #include <cdcr/model/chain.hpp>
 #include <cdcr/model/pose_error_summary.hpp>
 
+#include "sim/random_stream.hpp"
+
 namespace cdcr::sim {
 namespace {
 
@@ -25,6 +27,8 @@ model::Pose<double> nominal_pose(const model::CableVector<double>& cables_mm,
 
 std::vector<CollectedSample> collect(SimulatedRobot& robot, WorkspaceSampler& sampler, int samples) {
   if (samples < 0) throw std::invalid_argument("the sample count must not be negative");
+  const PayloadConfig& payload = robot.config().payload;
+  RandomStream payloads(robot.config().session_seed(), StreamId::payload);
   std::vector<CollectedSample> result;
   result.reserve(static_cast<std::size_t>(samples));
   for (int i = 0; i < samples; ++i) {
@@ -33,7 +37,8 @@ std::vector<CollectedSample> collect(SimulatedRobot& robot, WorkspaceSampler& sa
     sample.joints = command.joints;
     sample.cables_mm = command.cables_mm;
     sample.nominal_pose = nominal_pose(command.cables_mm, robot.nominal_geometry());
-    sample.measurement = robot.measure(command.cables_mm);
+    if (payload.enabled) sample.payload_kg = payloads.uniform(payload.min_kg, payload.max_kg);
+    sample.measurement = robot.measure(command.cables_mm, sample.payload_kg);
     result.push_back(sample);
   }
   return result;

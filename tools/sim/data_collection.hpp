@@ -1,7 +1,9 @@
 #pragma once
 // The paper's data collection (Section V-B) on the simulated robot: random
 // workspace configurations, each commanded once and measured once, with the
-// initial error of the nominal model and the simulator's noise floor.
+// initial error of the nominal model and the simulator's noise floor. With
+// the payload enabled (SimulatorConfig::payload), each sample also carries a
+// payload drawn from its own stream.
 
 #include <vector>
 
@@ -17,6 +19,7 @@ struct CollectedSample {
   model::JointVector<double> joints;     // as sampled
   model::CableVector<double> cables_mm;  // as commanded
   model::Pose<double> nominal_pose;      // nominal FK of the commanded cables
+  double payload_kg = 0.0;               // carried while measured, known (not noise)
   Measurement measurement;
 };
 
@@ -31,7 +34,8 @@ struct CollectionSummary {
   MeanPoseError noise_floor;  // true pose vs. measured pose: what no model can remove
 };
 
-// `samples` configurations from the sampler, measured on the robot.
+// `samples` configurations from the sampler, measured on the robot; the
+// payloads come from the robot's session seed and payload range.
 std::vector<CollectedSample> collect(SimulatedRobot& robot, WorkspaceSampler& sampler, int samples);
 
 // The default protocol: a sampler with the robot's seed and workspace limit.

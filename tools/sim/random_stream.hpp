@@ -11,12 +11,14 @@
 namespace cdcr::sim {
 
 // Independent streams derived from one user seed: the physical robot, the
-// workspace sampler and the per-sample noise never share draws, so switching
-// one source off leaves the others' values untouched.
+// workspace sampler, the per-sample noise and the per-sample payload never
+// share draws, so switching one source off leaves the others' values
+// untouched.
 enum class StreamId : std::uint64_t {
   robot = 1,
   workspace = 2,
   noise = 3,
+  payload = 4,
 };
 
 class RandomStream {

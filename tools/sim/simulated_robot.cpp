@@ -79,13 +79,14 @@ SimulatedRobot::Shape SimulatedRobot::shape(const model::JointVector<double>& be
 
 // b_i = b_i,unloaded + M_i(b) / K_i. The sag moves the masses and so changes
 // the moments; a fixed-point iteration converges as long as the structure is
-// far from buckling (|dM/db| << K).
-model::JointVector<double> SimulatedRobot::gravity_equilibrium(const model::JointVector<double>& unloaded) const {
+// far from buckling (|dM/db| << K). The tip mass (end platform and payload)
+// hangs at the end disk.
+model::JointVector<double> SimulatedRobot::gravity_equilibrium(const model::JointVector<double>& unloaded,
+                                                               double tip_mass_kg) const {
   const GravityConfig& g = config_.gravity;
   // Newtons per kg; the lever arms are in mm, so the moments come out in N mm.
   const Vec3 weight_per_kg = g.acceleration_m_per_s2 * g.direction.normalized();
   const double segment_mass = g.segment_mass_kg;
-  const double payload_mass = g.payload_mass_kg;
   const int n = nominal_.segment_count;
 
   model::JointVector<double> bends = unloaded;
@@ -95,7 +96,7 @@ model::JointVector<double> SimulatedRobot::gravity_equilibrium(const model::Join
     double change = 0.0;
     for (int i = 0; i < n; ++i) {
       const Vec3 pivot = s.segment_bases[i].position_mm;
-      Vec3 moment = (payload_mass * (s.end_disk.position_mm - pivot)).cross(weight_per_kg);
+      Vec3 moment = (tip_mass_kg * (s.end_disk.position_mm - pivot)).cross(weight_per_kg);
       for (int j = i; j < n; ++j) moment += (segment_mass * (s.segment_midpoints_mm[j] - pivot)).cross(weight_per_kg);
       const Vec3 local = s.segment_bases[i].rotation.transpose() * moment;
       // A rotation vector (kx, ky, 0) is the bend (u, w) = (ky, -kx).
@@ -109,7 +110,8 @@ model::JointVector<double> SimulatedRobot::gravity_equilibrium(const model::Join
   throw std::runtime_error("gravity sag does not converge: the structure is too soft for its load");
 }
 
-model::JointVector<double> SimulatedRobot::achieved_bends(const model::CableVector<double>& cables_mm) const {
+model::JointVector<double> SimulatedRobot::achieved_bends(const model::CableVector<double>& cables_mm,
+                                                          double payload_kg) const {
   const int n = nominal_.segment_count;
   if (cables_mm.size() != 4 * n) {
     throw std::invalid_argument("expected " + std::to_string(4 * n) + " cable lengths, got " +
@@ -117,6 +119,9 @@ model::JointVector<double> SimulatedRobot::achieved_bends(const model::CableVect
   }
   if (!cables_mm.allFinite()) throw std::invalid_argument("cable lengths must be finite");
   if (!(cables_mm.minCoeff() > 0.0)) throw std::invalid_argument("cable lengths must be positive");
+  if (!(std::isfinite(payload_kg) && payload_kg >= 0.0)) {
+    throw std::invalid_argument("payload must be finite and not negative (got " + std::to_string(payload_kg) + " kg)");
+  }
 
   model::JointVector<double> bends(2 * n);
   for (int i = 0; i < n; ++i) {
@@ -124,7 +129,7 @@ model::JointVector<double> SimulatedRobot::achieved_bends(const model::CableVect
     if (config_.compliance.enabled) bend *= bend_retained_[i];
     bends.segment<2>(2 * i) = bend;
   }
-  if (config_.gravity.enabled) bends = gravity_equilibrium(bends);
+  if (config_.gravity.enabled) bends = gravity_equilibrium(bends, config_.gravity.platform_mass_kg + payload_kg);
   return bends;
 }
 
@@ -132,12 +137,12 @@ Pose SimulatedRobot::pose_from_bends(const model::JointVector<double>& bends) co
   return shape(bends).end_disk * deviations_.platform_mount;
 }
 
-Pose SimulatedRobot::true_pose(const model::CableVector<double>& cables_mm) const {
-  return pose_from_bends(achieved_bends(cables_mm));
+Pose SimulatedRobot::true_pose(const model::CableVector<double>& cables_mm, double payload_kg) const {
+  return pose_from_bends(achieved_bends(cables_mm, payload_kg));
 }
 
-Measurement SimulatedRobot::measure(const model::CableVector<double>& cables_mm) {
-  const model::JointVector<double> bends = achieved_bends(cables_mm);
+Measurement SimulatedRobot::measure(const model::CableVector<double>& cables_mm, double payload_kg) {
+  const model::JointVector<double> bends = achieved_bends(cables_mm, payload_kg);
   Measurement m;
   m.true_pose = pose_from_bends(bends);
 

@@ -10,7 +10,8 @@
 //      radius, and the cable pattern's angular offset rotates it (geometric);
 //   2. cable stretch scales the bend down by 2 k r^2 / K (compliance);
 //   3. gravity adds M_i / K, M_i the moment of everything distal to the
-//      segment's base, solved to equilibrium (gravity);
+//      segment's base (the payload at the tip included), solved to
+//      equilibrium (gravity);
 //   4. the segment takes the shape of a linearly varying curvature over its
 //      TRUE backbone length (curvature; an arc when off);
 //   5. the segments are chained with the mounts between them, the base mount
@@ -20,7 +21,11 @@
 //
 // A given seed is a given physical robot: its imperfections are drawn once,
 // at construction. The per-sample noise has its own random stream, so
-// true_pose() is a deterministic function of the cables.
+// true_pose() is a deterministic function of the cables and the payload.
+//
+// payload_kg is the mass the end platform carries beyond its own (see
+// PayloadConfig): finite and not negative (std::invalid_argument otherwise).
+// Zero is the robot without a payload, bit for bit.
 
 #include <array>
 
@@ -53,18 +58,18 @@ class SimulatedRobot {
   // base frame, systematic sources only. The cables must number 4n, be finite
   // and positive (std::invalid_argument otherwise); cable differences beyond
   // what the true anchor radius allows saturate at a half-turn bend.
-  model::JointVector<double> achieved_bends(const model::CableVector<double>& cables_mm) const;
+  model::JointVector<double> achieved_bends(const model::CableVector<double>& cables_mm, double payload_kg = 0.0) const;
 
   // Pose of the end-platform marker frame in the base frame for the given
   // achieved bends.
   model::Pose<double> pose_from_bends(const model::JointVector<double>& bends) const;
 
-  model::Pose<double> true_pose(const model::CableVector<double>& cables_mm) const;
+  model::Pose<double> true_pose(const model::CableVector<double>& cables_mm, double payload_kg = 0.0) const;
 
   // One sample: draws the per-sample noise from the noise stream (whether or
   // not the noise sources are enabled, so each source's draws do not depend
   // on the other's switch).
-  Measurement measure(const model::CableVector<double>& cables_mm);
+  Measurement measure(const model::CableVector<double>& cables_mm, double payload_kg = 0.0);
 
  private:
   struct Shape {
@@ -76,7 +81,8 @@ class SimulatedRobot {
   model::Vec2<double> kinematic_bend(int segment, const model::Vec4<double>& cables_mm) const;
   model::Pose<double> segment_shape(int segment, const model::Vec2<double>& bend, double fraction) const;
   Shape shape(const model::JointVector<double>& bends) const;
-  model::JointVector<double> gravity_equilibrium(const model::JointVector<double>& unloaded_bends) const;
+  model::JointVector<double> gravity_equilibrium(const model::JointVector<double>& unloaded_bends,
+                                                 double tip_mass_kg) const;
 
   model::RobotGeometry<double> nominal_;
   SimulatorConfig config_;

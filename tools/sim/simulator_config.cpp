@@ -61,8 +61,11 @@ void SimulatorConfig::validate() const {
           "gravitational acceleration must be finite and not negative");
   require(std::isfinite(gravity.segment_mass_kg) && gravity.segment_mass_kg >= 0.0,
           "segment mass must be finite and not negative");
-  require(std::isfinite(gravity.payload_mass_kg) && gravity.payload_mass_kg >= 0.0,
-          "payload mass must be finite and not negative");
+  require(std::isfinite(gravity.platform_mass_kg) && gravity.platform_mass_kg >= 0.0,
+          "platform mass must be finite and not negative");
+  require(std::isfinite(payload.min_kg) && std::isfinite(payload.max_kg) && payload.min_kg >= 0.0 &&
+              payload.min_kg <= payload.max_kg,
+          "payload range must satisfy 0 <= min <= max (kg), both finite");
 
   require_sigma(repeatability.bend_sigma_rad, "repeatability sigma");
   require_sigma(mocap_noise.position_sigma_mm, "mocap position sigma");

@@ -13,8 +13,9 @@
 //                     segment instead of being constant.
 //   3. compliance     the cables stretch under the tension that holds the
 //                     bend, so every segment bends less than commanded.
-//   4. gravity        the weight of the distal segments and the payload bends
-//                     every segment further towards the ground.
+//   4. gravity        the weight of the distal segments, of the end platform
+//                     and of the payload it carries bends every segment
+//                     further towards the ground.
 // Per-sample noise (no model can learn it):
 //   5. repeatability  friction and backlash: a random perturbation of the
 //                     achieved bend of every segment.
@@ -99,16 +100,36 @@ struct ComplianceConfig {
   bool enabled = true;
 };
 
-// The moment M of the payload and of every distal segment's weight (lumped at
+// The moment M of the tip load and of every distal segment's weight (lumped at
 // its arc midpoint) about the base of segment i bends that segment by M / K
-// further, in the direction of gravity. The sag moves the masses, so the
-// equilibrium is found by fixed-point iteration.
+// further, in the direction of gravity. The tip load, lumped at the end disk,
+// is the end platform's own mass plus the payload of the sample (see
+// PayloadConfig). The sag moves the masses, so the equilibrium is found by
+// fixed-point iteration.
 struct GravityConfig {
   bool enabled = true;
   Eigen::Vector3d direction{-1.0, 0.0, 0.0};  // in the base frame; normalised on use
   double acceleration_m_per_s2 = 9.81;
-  double segment_mass_kg = 0.25;  // backbone, disks and passing cables
-  double payload_mass_kg = 0.2;   // end platform and markers
+  double segment_mass_kg = 0.25;   // backbone, disks and passing cables
+  double platform_mass_kg = 0.2;   // end platform and markers
+};
+// A tip force F bends segment i by F l_i / K, l_i the lever arm from its base
+// to the tip, and the bends of the proximal segments swing the whole distal
+// robot: with the defaults, the first kilogram of payload sags the tip of the
+// straight horizontal prototype by 75 mm more and tilts it by 14 deg (63 to
+// 81 mm over the paper's workspace), a little less for each further one as
+// the sag shortens the lever arms.
+
+// A payload carried by the end platform, known per sample (a dataset column):
+// a tool, a gripped object. It is drawn per sample, uniform in
+// [min_kg, max_kg], from a stream of its own, so the configurations and the
+// noise are those of the same session without it. It loads the tip through
+// gravity: with gravity off it weighs nothing. Off, every sample carries none
+// and the dataset has no payload column.
+struct PayloadConfig {
+  bool enabled = false;
+  double min_kg = 0.0;
+  double max_kg = 0.0;
 };
 
 // Each component of each segment's achieved bend vector
@@ -150,6 +171,7 @@ struct SimulatorConfig {
   CurvatureConfig curvature;
   ComplianceConfig compliance;
   GravityConfig gravity;
+  PayloadConfig payload;
   RepeatabilityConfig repeatability;
   MocapNoiseConfig mocap_noise;
 

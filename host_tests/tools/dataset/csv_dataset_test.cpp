@@ -70,6 +70,38 @@ TEST(DatasetCsv, ParsesPosesAsHamiltonQuaternionWFirst) {
   EXPECT_LT((data.poses[0].rotation - q.toRotationMatrix()).cwiseAbs().maxCoeff(), 1e-15);
 }
 
+TEST(DatasetCsv, ParsesThePayloadColumnBetweenCablesAndPoses) {
+  const Dataset data = parse_dataset_csv(
+      "l1_1,l1_2,l1_3,l1_4,payload_kg,x,y,z,qw,qx,qy,qz\n"
+      "120,121,122,123,0.75,1.5,-2,240,1,0,0,0\n"
+      "119,120,121,122,0,0,0,241,1,0,0,0\n"
+      "118,119,120,121,+2e-1,0,0,242,1,0,0,0\n",
+      PoseColumns::required);
+  ASSERT_TRUE(data.has_payload);
+  ASSERT_TRUE(data.has_poses);
+  ASSERT_EQ(data.sample_count(), 3);
+  ASSERT_EQ(data.payload_kg.size(), 3);
+  EXPECT_EQ(data.payload_kg[0], 0.75);
+  EXPECT_EQ(data.payload_kg[1], 0.0);
+  EXPECT_EQ(data.payload_kg[2], 0.2);
+  // The payload is neither a cable nor part of the pose.
+  ASSERT_EQ(data.cables_mm.cols(), 4);
+  EXPECT_EQ(data.cables_mm(0, 3), 123.0);
+  EXPECT_EQ(data.poses[0].position_mm, Eigen::Vector3d(1.5, -2, 240));
+  EXPECT_EQ(data.poses[2].position_mm, Eigen::Vector3d(0, 0, 242));
+
+  // Without poses (replay input), and without the column (no payload).
+  const Dataset cables = parse_dataset_csv("l1_1,l1_2,l1_3,l1_4,payload_kg\n120,121,122,123,1.25\n");
+  ASSERT_TRUE(cables.has_payload);
+  EXPECT_FALSE(cables.has_poses);
+  ASSERT_EQ(cables.payload_kg.size(), 1);
+  EXPECT_EQ(cables.payload_kg[0], 1.25);
+  EXPECT_EQ(cables.cables_mm.row(0), Eigen::RowVector4d(120, 121, 122, 123));
+  const Dataset none = parse_dataset_csv(std::string(kPoseHeader) + "120,121,122,123,1,2,3,1,0,0,0\n");
+  EXPECT_FALSE(none.has_payload);
+  EXPECT_EQ(none.payload_kg.size(), 0);
+}
+
 TEST(DatasetCsv, SkipsCommentsAndBlankLinesButCountsThem) {
   const std::string text =
       "# measured 2020-03-01\n"
@@ -210,10 +242,54 @@ INSTANTIATE_TEST_SUITE_P(
                "no header line (expected l1_1,l1_2,...): the file is empty or only comments"}),
     [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
 
+const std::string kPayload = "l1_1,l1_2,l1_3,l1_4,payload_kg\n";
+const std::string kPayloadPoses = "l1_1,l1_2,l1_3,l1_4,payload_kg,x,y,z,qw,qx,qy,qz\n";
+
+INSTANTIATE_TEST_SUITE_P(
+    Payload, DatasetCsvRejects,
+    testing::Values(
+        BadCsv{"nan", kPayload + "1,2,3,4,0.5\n1,2,3,4,nan\n", 3, "line 3: column payload_kg: 'nan' is NaN or Inf"},
+        BadCsv{"inf", kPayloadPoses + "1,2,3,4,inf,0,0,0,1,0,0,0\n", 2,
+               "line 2: column payload_kg: 'inf' is NaN or Inf"},
+        BadCsv{"negative", kPayload + "1,2,3,4,0\n1,2,3,4,-0.5\n", 3,
+               "line 3: column payload_kg: '-0.5' is negative; a payload is a mass, zero or more kg"},
+        BadCsv{"negative_with_poses", kPayloadPoses + "1,2,3,4,-1e-9,0,0,0,1,0,0,0\n", 2,
+               "line 2: column payload_kg: '-1e-9' is negative; a payload is a mass, zero or more kg"},
+        BadCsv{"empty", kPayload + "1,2,3,4,\n", 2, "line 2: column payload_kg: empty field"},
+        BadCsv{"text", kPayload + "1,2,3,4,1kg\n", 2, "line 2: column payload_kg: '1kg' is not a number"},
+        BadCsv{"missing_field", kPayloadPoses + "1,2,3,4,0,0,0,1,0,0,0\n", 2, "line 2: expected 12 fields, found 11"},
+        BadCsv{"after_the_poses", "l1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy,qz,payload_kg\n1,2,3,4,0,0,0,1,0,0,0,1\n", 1,
+               "line 1: header column 12 is 'payload_kg', which belongs right after the cable columns and before "
+               "x,y,z,..."},
+        BadCsv{"among_the_poses", "l1_1,l1_2,l1_3,l1_4,x,y,z,payload_kg,qw,qx,qy,qz\n", 1,
+               "line 1: header column 8 is 'payload_kg', which belongs right after the cable columns and before "
+               "x,y,z,..."},
+        BadCsv{"among_the_cables", "l1_1,l1_2,payload_kg,l1_3,l1_4,x,y,z,qw,qx,qy,qz\n", 1,
+               "line 1: header column 3 is 'payload_kg', which belongs right after the cable columns and before "
+               "x,y,z,..."},
+        BadCsv{"first", "payload_kg,l1_1,l1_2,l1_3,l1_4\n", 1,
+               "line 1: header column 1 is 'payload_kg', which belongs right after the cable columns and before "
+               "x,y,z,..."},
+        BadCsv{"twice", "l1_1,l1_2,l1_3,l1_4,payload_kg,payload_kg,x,y,z,qw,qx,qy,qz\n", 1,
+               "line 1: header column 6 is 'payload_kg', which belongs right after the cable columns and before "
+               "x,y,z,..."},
+        BadCsv{"misnamed", "l1_1,l1_2,l1_3,l1_4,payload,x,y,z,qw,qx,qy,qz\n", 1,
+               "line 1: header column 5 is 'payload', expected 'x'"}),
+    [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
+
 TEST(DatasetCsv, RequiredPoseColumns) {
   const DatasetError e = rejection(kCables + "1,2,3,4\n", PoseColumns::required);
   EXPECT_EQ(e.line(), 1);
   EXPECT_STREQ(e.what(), "line 1: missing pose columns x,y,z,qw,qx,qy,qz after the cable columns");
+  const DatasetError p = rejection(kPayload + "1,2,3,4,0.5\n", PoseColumns::required);
+  EXPECT_EQ(p.line(), 1);
+  EXPECT_STREQ(p.what(), "line 1: missing pose columns x,y,z,qw,qx,qy,qz after the payload column");
+}
+
+TEST(DatasetCsv, AcceptsAZeroPayloadOfEitherSign) {
+  const Dataset data = parse_dataset_csv(kPayload + "1,2,3,4,-0\n1,2,3,4,0\n");
+  EXPECT_EQ(data.payload_kg[0], 0.0);
+  EXPECT_EQ(data.payload_kg[1], 0.0);
 }
 
 TEST(DatasetCsv, RenormalisesQuaternionsWithinTheTolerance) {
@@ -234,16 +310,20 @@ TEST(DatasetCsv, RenormalisesQuaternionsWithinTheTolerance) {
   }
 }
 
-Dataset random_dataset(int segments, int samples, bool poses, unsigned seed) {
+Dataset random_dataset(int segments, int samples, bool poses, unsigned seed, bool payload = false) {
   std::mt19937_64 rng(seed);
   std::uniform_real_distribution<double> length(60.0, 180.0);
+  std::uniform_real_distribution<double> mass(0.0, 2.0);
   std::normal_distribution<double> gauss(0.0, 1.0);
   Dataset data;
   data.segment_count = segments;
   data.has_poses = poses;
+  data.has_payload = payload;
   data.cables_mm.resize(samples, 4 * segments);
+  if (payload) data.payload_kg.resize(samples);
   for (int r = 0; r < samples; ++r) {
     for (int c = 0; c < 4 * segments; ++c) data.cables_mm(r, c) = length(rng);
+    if (payload) data.payload_kg[r] = mass(rng);
     if (poses) {
       Eigen::Quaterniond q(gauss(rng), gauss(rng), gauss(rng), gauss(rng));
       q.normalize();
@@ -260,6 +340,11 @@ Dataset random_dataset(int segments, int samples, bool poses, unsigned seed) {
   data.cables_mm(samples - 1, 1) = 1e-300;
   data.cables_mm(samples - 1, 2) = 123456789012345.67;
   data.cables_mm(samples - 1, 3) = std::nextafter(120.0, 200.0);
+  if (payload) {
+    data.payload_kg[0] = 0.1 + 0.2;
+    data.payload_kg[1] = 0.0;
+    data.payload_kg[samples - 1] = 1e-300;
+  }
   return data;
 }
 
@@ -285,6 +370,35 @@ TEST(DatasetCsv, FormatThenParseIsExact) {
       // The quaternion text is exact; the matrix is rebuilt from it.
       EXPECT_LE((back.poses[i].rotation - data.poses[i].rotation).cwiseAbs().maxCoeff(), 1e-15);
     }
+  }
+}
+
+TEST(DatasetCsv, FormatThenParseKeepsThePayloadExactly) {
+  for (const bool poses : {false, true}) {
+    const Dataset data = random_dataset(2, 30, poses, poses ? 11 : 12, true);
+    const std::string text = format_dataset_csv(data);
+    const std::string header = poses ? "l1_1,l1_2,l1_3,l1_4,l2_1,l2_2,l2_3,l2_4,payload_kg,x,y,z,qw,qx,qy,qz\n"
+                                     : "l1_1,l1_2,l1_3,l1_4,l2_1,l2_2,l2_3,l2_4,payload_kg\n";
+    EXPECT_EQ(text.rfind(header, 0), 0u) << text.substr(0, 80);
+    const Dataset back = parse_dataset_csv(text);
+    ASSERT_TRUE(back.has_payload);
+    ASSERT_EQ(back.has_poses, poses);
+    ASSERT_EQ(back.payload_kg.size(), 30);
+    for (int r = 0; r < 30; ++r) EXPECT_EQ(back.payload_kg[r], data.payload_kg[r]) << r;
+    EXPECT_EQ(back.cables_mm, data.cables_mm);
+    for (std::size_t i = 0; i < data.poses.size(); ++i) EXPECT_EQ(back.poses[i].position_mm, data.poses[i].position_mm);
+  }
+}
+
+TEST(DatasetCsv, FormatRejectsPayloadsTheReaderWould) {
+  Dataset data = random_dataset(1, 3, true, 2, true);
+  EXPECT_NO_THROW(format_dataset_csv(data));
+  data.payload_kg.resize(2);
+  EXPECT_THROW(format_dataset_csv(data), std::invalid_argument);
+  for (const double bad : {-0.1, std::numeric_limits<double>::quiet_NaN(), std::numeric_limits<double>::infinity()}) {
+    data = random_dataset(1, 3, true, 2, true);
+    data.payload_kg[1] = bad;
+    EXPECT_THROW(format_dataset_csv(data), std::invalid_argument) << bad;
   }
 }
 

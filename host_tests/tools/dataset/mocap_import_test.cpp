@@ -349,6 +349,27 @@ TEST(MocapImport, SkipsLostFramesWithTheirCableRows) {
                "no frame has both bodies tracked");
 }
 
+// The payload each commanded row carried stays with its row.
+TEST(MocapImport, KeepsThePayloadOfTheKeptRows) {
+  const KnownCapture k = capture_with_lost_frames(6, {2}, {4});
+  Dataset commanded = commanded_cables(6);
+  commanded.has_payload = true;
+  commanded.payload_kg.resize(6);
+  commanded.payload_kg << 0.0, 0.1, 0.2, 0.3, 0.4, 0.5;
+  const MocapImport result = cdcr::dataset::import_mocap(
+      commanded, cdcr::dataset::parse_qtm_6d_tsv(qtm_tsv({k.base, k.end})), bodies("Base", "End platform", LostFrames::skip));
+  ASSERT_TRUE(result.data.has_payload);
+  ASSERT_EQ(result.data.payload_kg.size(), 4);
+  EXPECT_EQ(result.data.payload_kg, Eigen::Vector4d(0.0, 0.1, 0.3, 0.5));
+  const Dataset back = cdcr::dataset::parse_dataset_csv(cdcr::dataset::format_dataset_csv(result.data));
+  EXPECT_EQ(back.payload_kg, result.data.payload_kg);
+
+  const MocapImport without = cdcr::dataset::import_mocap(
+      commanded_cables(6), cdcr::dataset::parse_qtm_6d_tsv(qtm_tsv({k.base, k.end})),
+      bodies("Base", "End platform", LostFrames::skip));
+  EXPECT_FALSE(without.data.has_payload);
+}
+
 // ---------------------------------------------------------------------------
 // Refusals.
 

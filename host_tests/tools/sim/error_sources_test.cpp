@@ -314,13 +314,13 @@ TEST(SimulatedRobot, GravitySagsAHorizontalRobotTowardsTheGround) {
   EXPECT_LT(std::abs(sag_up), std::abs(sag_straight));
 }
 
-// The equilibrium itself, for one segment carrying only a payload at its end
+// The equilibrium itself, for one segment carrying only an end platform at its end
 // disk: b - b_commanded = M / K with M = m g x_tip in the bending plane.
 TEST(SimulatedRobot, GravityEquilibriumBalancesTheMoment) {
   const Geometry one = Geometry::uniform(1, 120.0, 67.0);
   SimulatorConfig config = gravity_only({0.0, 0.0, -1.0});
   config.gravity.segment_mass_kg = 0.0;
-  config.gravity.payload_mass_kg = 0.5;
+  config.gravity.platform_mass_kg = 0.5;
   SimulatedRobot robot(one, config);
   Joints commanded(2);
   commanded << 0.3, 0.25;

@@ -22,13 +22,18 @@ TEST(RandomStream, SameSeedSameSequence) {
 
 TEST(RandomStream, SeedsAndStreamsDiffer) {
   RandomStream robot(1, StreamId::robot);
+  RandomStream workspace(1, StreamId::workspace);
   RandomStream noise(1, StreamId::noise);
+  RandomStream payload(1, StreamId::payload);
   RandomStream other_seed(2, StreamId::robot);
   int equal_streams = 0;
   int equal_seeds = 0;
   for (int i = 0; i < 100; ++i) {
     const double r = robot.uniform();
-    equal_streams += r == noise.uniform();
+    const double w = workspace.uniform();
+    const double n = noise.uniform();
+    const double p = payload.uniform();
+    equal_streams += (r == w) + (r == n) + (r == p) + (w == n) + (w == p) + (n == p);
     equal_seeds += r == other_seed.uniform();
   }
   EXPECT_EQ(equal_streams, 0);
