@@ -157,9 +157,8 @@ model::Status Runtime::estimate_pose(const Cables& cables_mm, PoseEstimate& esti
     estimate.pose = result.compensated;
     estimate.joints = result.joints;
     estimate.compensated = true;
-    Scalar z[Correction::kMaxInputs];
-    correction_.kernel_coordinates(model::bend_from_joints(result.joints), z);
-    estimate.outside_range = uncertainty_.outside_range(z);
+    correction_.kernel_coordinates(model::bend_from_joints(result.joints), estimate.kernel_coordinates);
+    estimate.outside_range = uncertainty_.outside_range(estimate.kernel_coordinates);
     return model::Status::ok;
   }
   Joints joints;
@@ -176,9 +175,7 @@ model::Status Runtime::estimate_pose(const Cables& cables_mm, PoseEstimate& esti
 
 model::PoseUncertainty<Scalar> Runtime::estimate_uncertainty(const PoseEstimate& estimate) const {
   if (!estimate.compensated || !uncertainty_.bound()) return model::PoseUncertainty<Scalar>{};
-  Scalar z[Correction::kMaxInputs];
-  correction_.kernel_coordinates(model::bend_from_joints(estimate.joints), z);
-  return uncertainty_.evaluate(z, estimate.pose.position_mm);
+  return uncertainty_.evaluate(estimate.kernel_coordinates, estimate.pose.position_mm);
 }
 
 bool Runtime::extrapolating() const {
@@ -288,9 +285,8 @@ void Runtime::update_pose() {
       }
       publish_pose();
       if (!uncertainty_running_ && latest_pose_.compensated && uncertainty_.has_variance()) {
-        Scalar z[Correction::kMaxInputs];
-        correction_.kernel_coordinates(model::bend_from_joints(latest_pose_.joints), z);
-        uncertainty_.begin_evaluation(z, latest_pose_.pose.position_mm, uncertainty_evaluation_);
+        uncertainty_.begin_evaluation(latest_pose_.kernel_coordinates, latest_pose_.pose.position_mm,
+                                      uncertainty_evaluation_);
         uncertainty_running_ = true;
         uncertainty_running_sequence_ = static_cast<std::uint8_t>(cycle_ & 0xFF);
       }

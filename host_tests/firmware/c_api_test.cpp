@@ -34,6 +34,15 @@ std::vector<std::uint8_t> small_image(int segments = 2) {
   return exporting::write_image(m);
 }
 
+// What the runtime makes of the lengths a drive sends in a frame.
+Cables as_transmitted(const std::vector<float>& lengths) {
+  Cables cables(lengths.size());
+  for (std::size_t i = 0; i < lengths.size(); ++i) {
+    cables[i] = Scalar(protocol::cable_length_as_transmitted(lengths[i]));
+  }
+  return cables;
+}
+
 // A HAL with nothing on it but the image, for the C++ runtime beside the C one.
 struct QuietHal final : hal::MonotonicClock, hal::PeriodicTimer, hal::CanBus, hal::ModelStorage, hal::Console {
   explicit QuietHal(const std::vector<std::uint8_t>& image) : image(image) {}
@@ -83,11 +92,7 @@ TEST(CApi, PoseFromCableLengthsIsTheRuntimes) {
   EXPECT_EQ(status.fault, CDCR_FAULT_NONE);
   EXPECT_EQ(status.cycles, 3u);
 
-  // What the runtime makes of the lengths a drive sends in a frame.
-  Cables cables(lengths.size());
-  for (std::size_t i = 0; i < lengths.size(); ++i) {
-    cables[i] = Scalar(protocol::cable_length_as_transmitted(lengths[i]));
-  }
+  const Cables cables = as_transmitted(lengths);
   PoseEstimate expected;
   ASSERT_EQ(runtime.estimate_pose(cables, expected), model::Status::ok);
   ASSERT_TRUE(expected.compensated);
@@ -126,10 +131,7 @@ TEST(CApi, PoseCarriesTheRadiiOfTheImagesVariance) {
   ASSERT_EQ(c_api_check_pose(image.data(), std::uint32_t(image.size()), nullptr, lengths.data(), lengths.size(), 12,
                              &pose, &status),
             0);
-  Cables cables(lengths.size());
-  for (std::size_t i = 0; i < lengths.size(); ++i) {
-    cables[i] = Scalar(protocol::cable_length_as_transmitted(lengths[i]));
-  }
+  const Cables cables = as_transmitted(lengths);
   PoseEstimate expected;
   ASSERT_EQ(runtime.estimate_pose(cables, expected), model::Status::ok);
   const model::PoseUncertainty<Scalar> radii = runtime.estimate_uncertainty(expected);

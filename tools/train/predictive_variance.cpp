@@ -9,18 +9,20 @@
 #include <Eigen/Cholesky>
 
 #include "cdcr/model/gp_uncertainty.hpp"
+#include "gaussian_process.hpp"
 #include "trainer.hpp"
 
 namespace cdcr::training {
 
 namespace {
 
-// exp(-|a_i - b_j|^2 / 2).
+// exp(-|a_i - b_j|^2 / 2): the trainer's kernel in kernel coordinates,
+// where every length scale and the amplitude are 1.
 Eigen::MatrixXd unit_kernel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) {
-  Eigen::MatrixXd distance = -2.0 * a * b.transpose();
-  distance.colwise() += a.rowwise().squaredNorm();
-  distance.rowwise() += b.rowwise().squaredNorm().transpose();
-  return (-0.5 * distance.cwiseMax(0.0)).array().exp().matrix();
+  KernelHyperparameters unit;
+  unit.length_scales = Eigen::VectorXd::Ones(a.cols());
+  unit.signal_variance = 1.0;
+  return kernel_matrix(a, b, unit);
 }
 
 // The shared kernel's signal over noise; the image's variance block needs

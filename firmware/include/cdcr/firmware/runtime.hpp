@@ -90,6 +90,9 @@ struct PoseEstimate {
   bool compensated = false;
   // Outside the input range the model was fitted on (never in DEGRADED).
   bool outside_range = false;
+  // The query in the GP's kernel coordinates (compensated only), for the
+  // variance of this pose.
+  Scalar kernel_coordinates[Correction::kMaxInputs] = {};
 };
 
 // The outcome of the last committed target, as IK_REPORT carries it.
