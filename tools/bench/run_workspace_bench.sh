@@ -5,7 +5,11 @@
 #   paper      the default workspace (bends up to 0.2 rad), 700 rows, 400 test rows;
 #   low-noise  the same with the per-sample noise at a quarter (--noise-scale 0.25);
 #   wide       bends up to 0.7 rad, 4,000 rows, 200 test rows.
-# Each with the design geometry and with --calibrate.
+# Each with the design geometry and with --calibrate. Then paper and wide
+# again from the same robot built without geometric errors
+# (`--no-geometric`: no length, radius or anchor-angle errors, no segment,
+# base or platform mounts): the most any identification of the geometry could
+# buy, were it perfect.
 # "float32 max" is the largest difference between the image's float32 path
 # (double accumulators, as on the M7 and the host) and the double-precision
 # trainer on the held-out rows.
@@ -55,9 +59,14 @@ train_case() {  # data name, result name, cdcr train options...
 simulate_case paper 700 400
 simulate_case low-noise 700 400 --noise-scale 0.25
 simulate_case wide 4000 200 --workspace-theta-max 0.7
+simulate_case paper-exact-geometry 700 400 --no-geometric
+simulate_case wide-exact-geometry 4000 200 --workspace-theta-max 0.7 --no-geometric
 for name in paper low-noise wide; do
   train_case "$name" "$name"
   train_case "$name" "$name-calibrated" --calibrate
+done
+for name in paper-exact-geometry wide-exact-geometry; do
+  train_case "$name" "$name"
 done
 
 if [[ $skip_sklearn == 0 ]]; then
@@ -88,9 +97,12 @@ def load(name):
 print("| data | rows | geometry | model | image bytes | M7 forward cycle | train s "
       "| test position mm (floor, ratio) | test orientation deg (floor, ratio) | float32 max mm |")
 print("|---|---:|---|---|---:|---:|---:|---:|---:|---:|")
-for name in ("paper", "low-noise", "wide"):
+cases = [(name, ((name, "design"), (f"{name}-calibrated", "calibrated"))) for name in ("paper", "low-noise", "wide")]
+cases += [(f"{name}-exact-geometry", ((f"{name}-exact-geometry", "design; robot without geometric errors"),))
+          for name in ("paper", "wide")]
+for name, results in cases:
     floor = load(f"{name}-test-simulate.json")["noise_floor"]
-    for result, geometry in ((name, "design"), (f"{name}-calibrated", "calibrated")):
+    for result, geometry in results:
         trained = load(f"{result}-train.json")
         evaluated = load(f"{result}-eval.json")
         model = trained["model"]
