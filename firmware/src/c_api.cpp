@@ -219,6 +219,8 @@ static_assert(int(CDCR_STATE_FAULT) == int(firmware::RuntimeState::fault), "stat
 static_assert(int(CDCR_FAULT_CAN_FILTERS_REFUSED) == int(firmware::FaultCode::can_filters_refused),
               "fault codes as in fault.hpp");
 static_assert(int(CDCR_IK_IN_PROGRESS) == int(protocol::IkOutcome::in_progress), "outcomes as in messages.hpp");
+static_assert(int(CDCR_IK_REFUSED_EXTRAPOLATING) == int(protocol::IkOutcome::refused_extrapolating),
+              "outcomes as in messages.hpp");
 static_assert(int(CDCR_TARGET_POSE) == int(protocol::TargetMode::pose), "modes as in messages.hpp");
 static_assert(CDCR_MAX_SEGMENTS == firmware::kMaxSegments, "segment capacity as in capacity.hpp");
 
@@ -311,6 +313,7 @@ cdcr_result cdcr_set_target(cdcr_runtime* runtime, const cdcr_target* target) {
   commit.z_mm = target->position_mm[2];
   commit.mode = pose ? protocol::TargetMode::pose : protocol::TargetMode::position;
   commit.tracking = target->tracking != 0;
+  commit.refuse_extrapolating = target->refuse_extrapolating != 0;
   commit.sequence = target->sequence;
   protocol::encode(commit, frame);
   c->bus.queue(frame);

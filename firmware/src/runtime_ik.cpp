@@ -31,6 +31,8 @@ void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& c
   solving_sequence_ = commit.sequence;
   solving_mode_ = commit.mode;
   solving_tracking_ = commit.tracking;
+  solving_refuses_extrapolation_ = commit.refuse_extrapolating;
+  checking_solution_ = false;
   solving_cycles_ = 0;
   // A streamed target that takes over the work may still send the point
   // already sent only once.
@@ -55,6 +57,10 @@ void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& c
 void Runtime::continue_solve() {
   if (state_ != RuntimeState::run && state_ != RuntimeState::degraded) return;
   ++solving_cycles_;
+  if (checking_solution_) {
+    continue_solution_check();
+    return;
+  }
   if (solving_end_ != model::IkSolveState::running) {
     ik_units_last_cycle_ = kWorkCosts.ik_finish;
     finish_solve(solving_end_);
@@ -96,7 +102,9 @@ void Runtime::continue_solve() {
 // between evaluations the linearised solve's point, when it is closer.
 // Returns whether setpoints went out.
 bool Runtime::publish_tracking_point(Solver& solver) {
-  if (!solver.has_best()) return false;
+  // A point not yet checked for extrapolation is not sent when the target
+  // refuses extrapolating solutions.
+  if (!solver.has_best() || solving_refuses_extrapolation_) return false;
   const bool linearised =
       solver.has_linearised_point() && solver.linearised_position_error_mm() < solver.best_position_error_mm();
   const Joints& bend = linearised ? solver.linearised_bend() : solver.best_bend();
@@ -144,8 +152,15 @@ void Runtime::finish_solve(model::IkSolveState end) {
                 solver.best_orientation_error_rad() <= kIkAcceptedOrientationErrorRad));
     joints = solver.best_joints();
   }(solver_);
+  solving_end_ = end;
+  if (reached && solving_refuses_extrapolation_ && begin_solution_check(joints)) return;
+  conclude_solve(reached, joints);
+}
+
+// The request's end: setpoints and a converged report, or setpoints held.
+void Runtime::conclude_solve(bool reached, const Joints& joints) {
   fill_ik_report(protocol::IkOutcome::converged);
-  if (end != model::IkSolveState::converged && end != model::IkSolveState::failed) {
+  if (solving_end_ != model::IkSolveState::converged && solving_end_ != model::IkSolveState::failed) {
     last_ik_report_.model_status = model::Status::ik_not_converged;
   }
   if (reached && set_setpoints(joints)) {
@@ -156,12 +171,51 @@ void Runtime::finish_solve(model::IkSolveState end) {
     record_event(FaultCode::target_unreachable, FaultDetail(last_ik_report_.model_status));
   }
   solving_ = false;
+  checking_solution_ = false;
   publish_ik_report();
+}
+
+// A solution for a target that refuses extrapolation: outside the fitted
+// input range it is refused at once; with a variance block its variance is
+// computed over the next cycles' IK slices (continue_solution_check).
+// Returns false when there is nothing to check (DEGRADED: no model to
+// extrapolate; RUN without a variance block and within range) and the
+// request ends as any other.
+bool Runtime::begin_solution_check(const Joints& joints) {
+  if (mode_ != RuntimeState::run || !uncertainty_.bound()) return false;
+  Scalar coordinates[Correction::kMaxInputs];
+  correction_.kernel_coordinates(model::bend_from_joints(joints), coordinates);
+  if (uncertainty_.outside_range(coordinates)) {
+    end_solve(protocol::IkOutcome::refused_extrapolating);
+    return true;
+  }
+  if (!uncertainty_.has_variance()) return false;
+  model::Vec3<Scalar> tip = model::Vec3<Scalar>::Zero();  // only the flag is used, not the radii
+  uncertainty_.begin_evaluation(coordinates, tip, solution_check_);
+  checked_joints_ = joints;
+  checking_solution_ = true;
+  return true;
+}
+
+void Runtime::continue_solution_check() {
+  std::uint32_t spent = 0;
+  if (!uncertainty_.evaluation_finished(solution_check_)) {
+    spent = uncertainty_.continue_evaluation(solution_check_, ik_units_per_cycle_);
+  }
+  ik_units_last_cycle_ = spent;
+  if (!uncertainty_.evaluation_finished(solution_check_) || spent + kWorkCosts.ik_finish > ik_units_per_cycle_) return;
+  ik_units_last_cycle_ += kWorkCosts.ik_finish;
+  if (uncertainty_.evaluation_result(solution_check_).extrapolating) {
+    end_solve(protocol::IkOutcome::refused_extrapolating);
+  } else {
+    conclude_solve(true, checked_joints_);
+  }
 }
 
 void Runtime::end_solve(protocol::IkOutcome outcome) {
   fill_ik_report(outcome);
   solving_ = false;
+  checking_solution_ = false;
   publish_ik_report();
 }
 

@@ -23,13 +23,20 @@ namespace cdcr::firmware {
 namespace {
 
 // Corrections of a few tenths of a millimetre, as a trained model makes.
-std::vector<std::uint8_t> small_image(int segments = 2) {
+// With fitted_range_offset, the image's fitted input range is moved that
+// far (in every input) from where its points are, so every query is outside.
+std::vector<std::uint8_t> small_image(int segments = 2, double fitted_range_offset = 0.0) {
   test_support::SyntheticModelOptions options;
   options.segments = segments;
   training::TrainedModel m = test_support::synthetic_trained_model(options);
   for (int k = 0; k < 6; ++k) {
     m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
     m.output_scale[k] *= k < 3 ? 0.1 : 0.001;
+  }
+  if (fitted_range_offset != 0.0) {
+    m.set_input_range(m.inputs);
+    m.input_min.array() += fitted_range_offset;
+    m.input_max.array() += fitted_range_offset;
   }
   return exporting::write_image(m);
 }
@@ -228,6 +235,40 @@ TEST_F(CApiRuntime, TargetIsSolvedToSetpoints) {
                                     reached.position_mm[1] - target.position_mm[1],
                                     reached.position_mm[2] - target.position_mm[2]);
   EXPECT_LT(distance, 0.1f);
+}
+
+// A target that refuses extrapolation, on a model whose fitted range holds
+// none of the robot's poses: refused, setpoints held.
+TEST_F(CApiRuntime, ATargetRefusingExtrapolationIsRefusedOutsideTheFittedRange) {
+  for (const int refuse : {0, 1}) {
+    SCOPED_TRACE(refuse);
+    init(small_image(2, 5.0));
+    std::vector<float> lengths = bent_cables(Geometry::uniform(2, 120.0f, 67.0f), 0.1);
+    step_with(lengths, 2);
+    cdcr_pose start{};
+    ASSERT_EQ(cdcr_get_pose(&runtime, &start), CDCR_OK);
+    EXPECT_EQ(start.extrapolating, 1);
+    cdcr_target target{};
+    target.position_mm[0] = start.position_mm[0] + 4.0f;
+    target.position_mm[1] = start.position_mm[1] - 3.0f;
+    target.position_mm[2] = start.position_mm[2] - 1.0f;
+    target.mode = CDCR_TARGET_POSITION;
+    target.sequence = 7;
+    target.refuse_extrapolating = refuse;
+    ASSERT_EQ(cdcr_set_target(&runtime, &target), CDCR_OK);
+    int steps = 0;
+    do {
+      step_with(lengths);
+    } while (status().ik_running && ++steps < 300);
+    cdcr_setpoints setpoints{};
+    if (refuse) {
+      EXPECT_EQ(status().ik_outcome, CDCR_IK_REFUSED_EXTRAPOLATING);
+      EXPECT_EQ(cdcr_get_setpoints(&runtime, &setpoints), CDCR_ERROR_NO_DATA);
+    } else {
+      EXPECT_EQ(status().ik_outcome, CDCR_IK_CONVERGED);
+      EXPECT_EQ(cdcr_get_setpoints(&runtime, &setpoints), CDCR_OK);
+    }
+  }
 }
 
 TEST_F(CApiRuntime, SilentDrivesAreAFaultWithNoPose) {

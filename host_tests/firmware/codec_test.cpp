@@ -75,7 +75,7 @@ TEST(SignalCodec, RangesFollowTheDeclaredPhysicalRange) {
   EXPECT_EQ(raw_maximum(quaternion::kQw), 32767);
   EXPECT_EQ(raw_minimum(position_xy::kX), -2147483648LL);
   EXPECT_EQ(raw_maximum(position_xy::kX), 2147483647LL);
-  EXPECT_EQ(raw_maximum(ik_report::kOutcome), 6);
+  EXPECT_EQ(raw_maximum(ik_report::kOutcome), 7);
   EXPECT_EQ(raw_maximum(ik_report::kPositionResidual), 65535);
 }
 
@@ -209,7 +209,7 @@ TEST(ProtocolTable, ValueTablesNameEveryEnumerator) {
     EXPECT_EQ(code < int(std::size(values::kFaultCode)), enumerator) << code;
   }
   for (std::size_t i = 0; i < std::size(values::kFaultCode); ++i) EXPECT_EQ(values::kFaultCode[i].value, i);
-  EXPECT_EQ(static_cast<int>(IkOutcome::in_progress) + 1, int(std::size(values::kIkOutcome)));
+  EXPECT_EQ(static_cast<int>(IkOutcome::refused_extrapolating) + 1, int(std::size(values::kIkOutcome)));
   EXPECT_STREQ(values::kIkOutcome[static_cast<int>(IkOutcome::superseded)].name, "superseded");
   EXPECT_STREQ(values::kTargetMode[static_cast<int>(TargetMode::pose)].name, "pose");
 }
@@ -276,6 +276,21 @@ TEST(Frames, TargetPositionZCarriesModeTrackingAndSequence) {
   EXPECT_EQ(target.mode, TargetMode::pose);
   EXPECT_TRUE(target.tracking);
   EXPECT_EQ(target.sequence, 0xA5);
+  EXPECT_FALSE(target.refuse_extrapolating);
+}
+
+TEST(Frames, TargetPositionZCarriesTheRefusalOfExtrapolatingSolutions) {
+  hal::CanFrame frame;
+  TargetPositionZ sent{100.0, TargetMode::position, false, 3};
+  sent.refuse_extrapolating = true;
+  encode(sent, frame);
+  // REFUSE_EXTRAPOLATING is bit 34: byte 4, bit 2.
+  EXPECT_EQ(bytes_of(frame), (std::vector<std::uint8_t>{0x10, 0x27, 0, 0, 0x04, 3}));
+  TargetPositionZ target;
+  ASSERT_EQ(decode(frame, target), DecodeStatus::ok);
+  EXPECT_TRUE(target.refuse_extrapolating);
+  EXPECT_FALSE(target.tracking);
+  EXPECT_EQ(target.mode, TargetMode::position);
 }
 
 TEST(Frames, TargetPositionZOfTheFirstProtocolDecodesTheSame) {
@@ -292,7 +307,7 @@ TEST(Frames, TargetPositionZOfTheFirstProtocolDecodesTheSame) {
 
 TEST(Frames, ReservedBitsMakeAFrameMalformed) {
   TargetPositionZ target;
-  for (int bit = 34; bit <= 39; ++bit) {
+  for (int bit = 35; bit <= 39; ++bit) {
     hal::CanFrame frame = frame_of(0x122, {0x10, 0x27, 0, 0, 0x00, 1});
     frame.data[bit / 8] |= std::uint8_t(1u << (bit % 8));
     EXPECT_EQ(decode(frame, target), DecodeStatus::reserved_bits_set) << "bit " << bit;
@@ -371,7 +386,7 @@ TEST(Frames, IkReportSaturatesAndRejectsUnknownOutcomes) {
   EXPECT_EQ(report.cycles, 255);
   EXPECT_DOUBLE_EQ(report.position_residual_mm, 65.535);
   EXPECT_DOUBLE_EQ(report.orientation_residual_rad, 0.65535);
-  EXPECT_EQ(decode(frame_of(0x140, {0, 0x07, 0, 0, 0, 0, 0, 0}), report), DecodeStatus::out_of_range);
+  EXPECT_EQ(decode(frame_of(0x140, {0, 0x08, 0, 0, 0, 0, 0, 0}), report), DecodeStatus::out_of_range);
   EXPECT_EQ(decode(frame_of(0x140, {0, 0, 0, 0, 0, 0}), report), DecodeStatus::wrong_dlc);  // protocol 1's length
 }
 

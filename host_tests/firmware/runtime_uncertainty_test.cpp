@@ -35,6 +35,15 @@ class RuntimeUncertaintyTest : public RuntimeTest {
     const hal::CanFilter host_filters[] = {protocol::kPoseFrames, protocol::kStatusFrames};
     platform->host_node.set_filters(host_filters, 2);
   }
+
+  // A position target with REFUSE_EXTRAPOLATING set or not.
+  void send_guarded_position_target(const Eigen::Vector3d& position_mm, std::uint8_t sequence,
+                                    bool refuse_extrapolating) {
+    protocol::TargetPositionZ commit{position_mm.z(), protocol::TargetMode::position, false, sequence};
+    commit.refuse_extrapolating = refuse_extrapolating;
+    send_frame(protocol::TargetPositionXy{position_mm.x(), position_mm.y()});
+    send_frame(commit);
+  }
 };
 
 TEST_F(RuntimeUncertaintyTest, RadiiOfARecentPoseGoOutEveryFewCycles) {
@@ -164,6 +173,141 @@ TEST_F(RuntimeUncertaintyTest, APoseBeyondTheFittedRangeIsFlaggedInThePoseAndSta
   }
   EXPECT_TRUE(pose_flag);
   EXPECT_TRUE(status_flag);
+}
+
+// The outcomes the host heard, in order.
+std::vector<protocol::IkOutcome> outcomes_in(const std::vector<hal::CanFrame>& frames, int* setpoint_frames) {
+  std::vector<protocol::IkOutcome> outcomes;
+  for (const hal::CanFrame& frame : frames) {
+    protocol::IkReport report;
+    if (protocol::decode(frame, report) == protocol::DecodeStatus::ok) outcomes.push_back(report.outcome);
+    protocol::CableSetpoint setpoint;
+    if (protocol::decode(frame, setpoint) == protocol::DecodeStatus::ok) ++*setpoint_frames;
+  }
+  return outcomes;
+}
+
+// The fitted range a narrow box around the held pose's inputs: a target
+// whose solution bends further is outside it. Without a variance block the
+// range alone decides; with one, the range decides before the variance runs.
+class RefusalOutsideTheRange : public RuntimeUncertaintyTest, public ::testing::WithParamInterface<int> {};
+
+TEST_P(RefusalOutsideTheRange, ATargetThatRefusesExtrapolationIsRefusedOutsideTheFittedRange) {
+  const int rank = GetParam();
+  training::TrainedModel m = test_support::small_correction_model(200);
+  m.signal_variance.setConstant(m.signal_variance[0]);
+  m.noise_variance.setConstant(m.noise_variance[0]);
+  if (rank > 0) {
+    m.variance = training::fit_variance_factor(m, m.inputs, training::variance_points(m, m.inputs, rank, 1));
+    m.variance.extrapolation_variance = 1.0;  // the variance alone never flags
+  }
+  {
+    // The held pose (fixture's bent cables) before the image is made: boot
+    // once without a model to read its joints.
+    boot(test_support::small_image());
+    cycles(3);
+    const Joints bend = model::bend_from_joints(runtime->latest_pose().joints);
+    m.input_min = bend.cast<double>().array() - 0.02;
+    m.input_max = bend.cast<double>().array() + 0.02;
+  }
+  const std::vector<std::uint8_t> image = exporting::write_image(m);
+  for (const bool refuse : {true, false}) {
+    SCOPED_TRACE(refuse ? "refusing" : "accepting");
+    boot(image);
+    ASSERT_EQ(runtime->state(), RuntimeState::run);
+    cycles(3);
+    EXPECT_FALSE(runtime->latest_pose().outside_range);
+    host_frames();
+    // Where the tip is with the first segment bent 0.1 rad further (the
+    // correction moves it a fraction of a millimetre): reachable, outside the box.
+    Joints bend = model::bend_from_joints(runtime->latest_pose().joints);
+    bend.head<2>() *= 1.0f + 0.1f / bend.head<2>().norm();
+    const Eigen::Vector3d target = model::forward_kinematics_bend(bend, runtime->geometry()).position_mm.cast<double>();
+    send_guarded_position_target(target, 9, refuse);
+    const int cycles_spent_solving = cycles_until_ik_done();
+    int setpoint_frames = 0;
+    const std::vector<protocol::IkOutcome> outcomes = outcomes_in(host_frames(), &setpoint_frames);
+    ASSERT_FALSE(outcomes.empty());
+    if (refuse) {
+      EXPECT_EQ(outcomes.back(), protocol::IkOutcome::refused_extrapolating);
+      // Refused when found, without the variance's cycles.
+      EXPECT_EQ(runtime->last_ik_report().cycles, cycles_spent_solving);
+      EXPECT_EQ(setpoint_frames, 0);
+      EXPECT_FALSE(runtime->has_setpoints());
+      // Its residual is the solution's: it was found, then refused.
+      EXPECT_LT(runtime->last_ik_report().position_error_mm, kIkAcceptedPositionErrorMm);
+    } else {
+      EXPECT_EQ(outcomes.back(), protocol::IkOutcome::converged);
+      EXPECT_EQ(setpoint_frames, runtime->geometry().segment_count);
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(VarianceRanks, RefusalOutsideTheRange, ::testing::Values(0, 16));
+
+// Within the fitted range, the variance decides, over a few cycles of IK's
+// share: with a threshold above any share the solution goes out (later
+// than without the check); with one below the held pose's share it is
+// refused.
+TEST_F(RuntimeUncertaintyTest, ATargetThatRefusesExtrapolationWaitsForTheVarianceOfItsSolution) {
+  struct Case {
+    double threshold;
+    bool refuse;
+    protocol::IkOutcome expected;
+  };
+  int cycles_spent[3] = {};
+  const Case cases[] = {{1.0, false, protocol::IkOutcome::converged},
+                        {1.0, true, protocol::IkOutcome::converged},
+                        {1e-3, true, protocol::IkOutcome::refused_extrapolating}};
+  for (int c = 0; c < 3; ++c) {
+    SCOPED_TRACE(c);
+    boot(image_with_variance(64, cases[c].threshold));
+    ASSERT_EQ(runtime->state(), RuntimeState::run);
+    cycles(3);
+    host_frames();
+    const Eigen::Vector3d target = runtime->latest_pose().pose.position_mm.cast<double>() + Eigen::Vector3d(2, 0, 0);
+    send_guarded_position_target(target, 5, cases[c].refuse);
+    cycles_spent[c] = cycles_until_ik_done();
+    int setpoint_frames = 0;
+    const std::vector<protocol::IkOutcome> outcomes = outcomes_in(host_frames(), &setpoint_frames);
+    ASSERT_FALSE(outcomes.empty());
+    EXPECT_EQ(outcomes.back(), cases[c].expected);
+    EXPECT_EQ(setpoint_frames, cases[c].expected == protocol::IkOutcome::converged ? runtime->geometry().segment_count : 0);
+    EXPECT_EQ(runtime->statistics().overruns, 0u);
+  }
+  // 832 units of variance in IK's share of a few hundred a cycle.
+  EXPECT_GE(cycles_spent[1], cycles_spent[0] + 1);
+  EXPECT_EQ(cycles_spent[2], cycles_spent[1]);
+}
+
+// A stream that refuses extrapolation gets no best point so far: every
+// point is checked first. With a threshold below every share, nothing goes
+// out; the same stream without the refusal moves the drives.
+TEST_F(RuntimeUncertaintyTest, AStreamThatRefusesExtrapolationSendsOnlyCheckedPoints) {
+  for (const bool refuse : {false, true}) {
+    SCOPED_TRACE(refuse ? "refusing" : "accepting");
+    boot(image_with_variance(64, 1e-3));
+    cycles(3);
+    host_frames();
+    const Eigen::Vector3d start = runtime->latest_pose().pose.position_mm.cast<double>();
+    int setpoint_frames = 0;
+    std::vector<protocol::IkOutcome> outcomes;
+    for (int k = 0; k < 60; ++k) {
+      protocol::TargetPositionZ commit{start.z(), protocol::TargetMode::position, true, std::uint8_t(k)};
+      commit.refuse_extrapolating = refuse;
+      send_frame(protocol::TargetPositionXy{start.x() + 0.05 * k, start.y()});
+      send_frame(commit);
+      cycles(1);
+      const std::vector<protocol::IkOutcome> heard = outcomes_in(host_frames(), &setpoint_frames);
+      outcomes.insert(outcomes.end(), heard.begin(), heard.end());
+    }
+    if (refuse) {
+      EXPECT_EQ(setpoint_frames, 0);
+      EXPECT_EQ(std::count(outcomes.begin(), outcomes.end(), protocol::IkOutcome::converged), 0);
+    } else {
+      EXPECT_GT(setpoint_frames, 0);
+    }
+  }
 }
 
 TEST_F(RuntimeUncertaintyTest, WithoutAVarianceBlockNoRadiiGoOut) {

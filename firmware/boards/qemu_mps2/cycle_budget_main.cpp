@@ -107,7 +107,7 @@ void exchange_with_drives() {
 }
 
 void deliver_target(const model::Pose<float>& target, protocol::TargetMode mode, bool tracking,
-                    std::uint8_t sequence) {
+                    std::uint8_t sequence, bool refuse_extrapolating = false) {
   cdcr::hal::CanFrame frame;
   if (mode == protocol::TargetMode::pose) {
     Eigen::Quaternion<float> q(target.rotation);
@@ -117,7 +117,9 @@ void deliver_target(const model::Pose<float>& target, protocol::TargetMode mode,
   }
   protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
   board.can.deliver(frame);
-  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), mode, tracking, sequence}, frame);
+  protocol::TargetPositionZ commit{target.position_mm.z(), mode, tracking, sequence};
+  commit.refuse_extrapolating = refuse_extrapolating;
+  protocol::encode(commit, frame);
   board.can.deliver(frame);
 }
 
@@ -216,11 +218,15 @@ void cycle() {
 }
 
 std::uint8_t next_sequence = 0;
+std::int32_t refusing_targets = 0;
+std::int32_t refusing_converged = 0;
+std::int32_t refusing_refused = 0;
 
 // A target, then cycles until its request ends; returns the cycles spent.
-int solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies* latencies) {
+int solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies* latencies,
+          bool refuse_extrapolating = false) {
   const std::uint8_t sequence = next_sequence++;
-  deliver_target(target, mode, false, sequence);
+  deliver_target(target, mode, false, sequence, refuse_extrapolating);
   int spent = 0;
   do {
     cycle();
@@ -372,6 +378,17 @@ int main() {
     }
   }
 
+  // Pose targets that refuse extrapolation, inside the training data's
+  // range and beyond it (bends to 0.45 rad): the solution's check (range,
+  // then the variance in IK's slices) within the same budget.
+  for (int t = 0; t < 40; ++t) {
+    solve(reachable_target(t % 2 ? 0.45f : 0.15f), protocol::TargetMode::pose, nullptr, true);
+    ++refusing_targets;
+    const protocol::IkOutcome outcome = runtime.last_ik_report().outcome;
+    refusing_converged += outcome == protocol::IkOutcome::converged ? 1 : 0;
+    refusing_refused += outcome == protocol::IkOutcome::refused_extrapolating ? 1 : 0;
+  }
+
   // A streamed circle, 40 mm radius at 100 mm/s: a TRACKING position target
   // every cycle. It lies inside the workspace: at the height where the robot,
   // every segment bent the same way, reaches 120 mm off its axis, centred
@@ -440,6 +457,13 @@ int main() {
   paper_position.report();
   full_range_pose.report();
   streamed.report();
+  console::console_write("targets refusing extrapolation: n ");
+  console::console_write_int(refusing_targets);
+  console::console_write(" converged ");
+  console::console_write_int(refusing_converged);
+  console::console_write(" refused ");
+  console::console_write_int(refusing_refused);
+  console::console_write("\n");
   console::console_write("cycle overhead (beyond the units spent): at most ");
   console::console_write_int(worst_unaccounted);
   console::console_write(" instructions\n");
@@ -463,6 +487,10 @@ int main() {
   }
   if (!faulted || !recovered) {
     console::console_write("FAIL: the silent drive did not fault the runtime, or its return did not recover it\n");
+    ok = false;
+  }
+  if (refusing_converged == 0 || refusing_refused == 0) {
+    console::console_write("FAIL: targets refusing extrapolation were all accepted or all refused\n");
     ok = false;
   }
   if (cycles_run < 2000) {

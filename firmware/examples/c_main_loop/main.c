@@ -103,7 +103,7 @@ static cdcr_runtime runtime; /* the runtime's whole memory */
 
 int main(void) {
   cdcr_config config = {0}; /* fallback geometry all zero: the paper's prototype */
-  cdcr_target target = {{30.0f, -20.0f, 470.0f}, {1, 0, 0, 0}, CDCR_TARGET_POSITION, 0, 1};
+  cdcr_target target = {{30.0f, -20.0f, 470.0f}, {1, 0, 0, 0}, CDCR_TARGET_POSITION, 0, 1, 0};
   cdcr_status status;
   cdcr_pose pose;
   cdcr_setpoints setpoints;

@@ -99,7 +99,8 @@ typedef enum cdcr_ik_outcome {
   CDCR_IK_SUPERSEDED = 4,         /* a newer target replaced it */
   CDCR_IK_ABORTED_FAULT = 5,      /* the runtime entered FAULT while solving */
   CDCR_IK_IN_PROGRESS = 6,        /* periodic report while solving */
-  CDCR_IK_NONE = 7                /* no target received yet */
+  CDCR_IK_REFUSED_EXTRAPOLATING = 7, /* the solution extrapolates and the target refused that; setpoints held */
+  CDCR_IK_NONE = 15               /* no target received yet (never on the bus) */
 } cdcr_ik_outcome;
 
 typedef enum cdcr_target_mode {
@@ -163,6 +164,9 @@ typedef struct cdcr_target {
   cdcr_target_mode mode;
   int tracking;     /* non-zero: one of a stream along a path (TRACKING) */
   uint8_t sequence; /* echoed in cdcr_status.ik_sequence */
+  /* non-zero: refuse a solution where the model extrapolates
+   * (REFUSE_EXTRAPOLATING): CDCR_IK_REFUSED_EXTRAPOLATING, setpoints held */
+  int refuse_extrapolating;
 } cdcr_target;
 
 typedef struct cdcr_pose {

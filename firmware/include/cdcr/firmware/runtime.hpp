@@ -182,6 +182,9 @@ class Runtime {
   void start_solve(const Pose& target, const protocol::TargetPositionZ& commit);
   void continue_solve();
   void finish_solve(model::IkSolveState end);
+  bool begin_solution_check(const Joints& joints);
+  void continue_solution_check();
+  void conclude_solve(bool reached, const Joints& joints);
   void end_solve(protocol::IkOutcome outcome);
   bool set_setpoints(const Joints& joints);
   bool publish_tracking_point(Solver& solver);
@@ -244,6 +247,13 @@ class Runtime {
   Solver solver_;
   bool solving_ = false;
   bool solving_tracking_ = false;
+  // The target refuses a solution where the model extrapolates: a solution
+  // found is checked (input range, then the variance over a few cycles'
+  // IK slices) before its setpoints go out.
+  bool solving_refuses_extrapolation_ = false;
+  bool checking_solution_ = false;
+  Uncertainty::Evaluation solution_check_;
+  Joints checked_joints_;
   protocol::TargetMode solving_mode_ = protocol::TargetMode::position;
   std::uint8_t solving_sequence_ = 0;
   int solving_cycles_ = 0;

@@ -46,6 +46,7 @@ struct TargetPositionZ {
   TargetMode mode = TargetMode::position;
   bool tracking = false;
   std::uint8_t sequence = 0;
+  bool refuse_extrapolating = false;
 };
 
 struct PosePositionXy {
@@ -228,7 +229,9 @@ inline void encode(const TargetPositionZ& f, hal::CanFrame& frame) {
   using namespace target_position_z;
   frame = empty_frame(kMessage);
   set_data_word(frame, placed_saturating(kZ, f.z_mm) | placed_integer(kMode, static_cast<std::int64_t>(f.mode)) |
-                           placed_integer(kTracking, f.tracking ? 1 : 0) | placed_integer(kSequence, f.sequence));
+                           placed_integer(kTracking, f.tracking ? 1 : 0) |
+                           placed_integer(kRefuseExtrapolating, f.refuse_extrapolating ? 1 : 0) |
+                           placed_integer(kSequence, f.sequence));
 }
 inline DecodeStatus decode(const hal::CanFrame& frame, TargetPositionZ& f) {
   using namespace target_position_z;
@@ -237,6 +240,7 @@ inline DecodeStatus decode(const hal::CanFrame& frame, TargetPositionZ& f) {
   f.z_mm = physical_in_word(word, kZ);
   f.mode = static_cast<TargetMode>(raw_in_word(word, kMode));
   f.tracking = raw_in_word(word, kTracking) != 0;
+  f.refuse_extrapolating = raw_in_word(word, kRefuseExtrapolating) != 0;
   f.sequence = static_cast<std::uint8_t>(raw_in_word(word, kSequence));
   return DecodeStatus::ok;
 }

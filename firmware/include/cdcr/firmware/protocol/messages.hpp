@@ -38,6 +38,10 @@ enum class IkOutcome : std::uint8_t {
   superseded = 4,          // a newer target replaced this one before it finished
   aborted_fault = 5,       // the runtime entered FAULT while solving
   in_progress = 6,         // periodic report while a solve runs
+  // The solution extrapolates (outside the fitted input range, or the
+  // variance says so) and the target asked for such solutions to be
+  // refused (REFUSE_EXTRAPOLATING); setpoints held.
+  refused_extrapolating = 7,
 };
 
 // Scalings. u16 at 0.01 mm spans 0..655.34 mm for cables, several times the
@@ -55,7 +59,7 @@ namespace values {
 inline constexpr ValueName kTargetMode[] = {{0, "position"}, {1, "pose"}};
 inline constexpr ValueName kIkOutcome[] = {
     {0, "converged"},     {1, "unreachable"},   {2, "rejected_malformed"}, {3, "rejected_state"},
-    {4, "superseded"},    {5, "aborted_fault"}, {6, "in_progress"},
+    {4, "superseded"},    {5, "aborted_fault"}, {6, "in_progress"}, {7, "refused_extrapolating"},
 };
 inline constexpr ValueName kRuntimeState[] = {{0, "BOOT"}, {1, "RUN"}, {2, "DEGRADED"}, {3, "FAULT"}};
 inline constexpr ValueName kFaultCode[] = {
@@ -120,15 +124,19 @@ inline constexpr MessageSpec kMessage{
     "TARGET_POSITION_XY", 0x121, 1, 8, "HOST", signal_list(position_xy::kSignals), kTargetFrames};
 }
 
-// 0x122: target z; commits the target. Bits 34..39 are reserved and must be 0.
+// 0x122: target z; commits the target. Bits 35..39 are reserved and must be 0.
 namespace target_position_z {
 inline constexpr SignalSpec kZ{"Z", 0, 32, true, kLengthScaleMm, 0, -21474836.48, 21474836.47, "mm"};
 inline constexpr SignalSpec kMode{"MODE", 32, 1, false, 1, 0, 0, 1, "", value_table(values::kTargetMode)};
 // 1: one target of a stream along a path; the solver warm-starts from its
 // last solution and may publish the best point so far.
 inline constexpr SignalSpec kTracking{"TRACKING", 33, 1, false, 1, 0, 0, 1, ""};
+// 1: a solution where the model extrapolates is not sent: the request ends
+// as refused_extrapolating, and no best point so far goes out before the
+// solution has been checked.
+inline constexpr SignalSpec kRefuseExtrapolating{"REFUSE_EXTRAPOLATING", 34, 1, false, 1, 0, 0, 1, ""};
 inline constexpr SignalSpec kSequence{"SEQUENCE", 40, 8, false, 1, 0, 0, 255, ""};
-inline constexpr const SignalSpec* kSignals[] = {&kZ, &kMode, &kTracking, &kSequence};
+inline constexpr const SignalSpec* kSignals[] = {&kZ, &kMode, &kTracking, &kRefuseExtrapolating, &kSequence};
 inline constexpr MessageSpec kMessage{"TARGET_POSITION_Z", 0x122, 1, 6, "HOST", signal_list(kSignals), kTargetFrames};
 }  // namespace target_position_z
 
@@ -179,7 +187,7 @@ inline constexpr MessageSpec kMessage{"POSE_UNCERTAINTY", 0x133, 1, 7, "RUNTIME"
 // 0x140: the outcome of a committed target. Bits 12..15 are reserved (0).
 namespace ik_report {
 inline constexpr SignalSpec kSequence{"SEQUENCE", 0, 8, false, 1, 0, 0, 255, ""};
-inline constexpr SignalSpec kOutcome{"OUTCOME", 8, 4, false, 1, 0, 0, 6, "", value_table(values::kIkOutcome)};
+inline constexpr SignalSpec kOutcome{"OUTCOME", 8, 4, false, 1, 0, 0, 7, "", value_table(values::kIkOutcome)};
 inline constexpr SignalSpec kIterations{"ITERATIONS", 16, 8, false, 1, 0, 0, 255, ""};
 inline constexpr SignalSpec kCycles{"CYCLES", 24, 8, false, 1, 0, 0, 255, ""};
 inline constexpr SignalSpec kPositionResidual{"POSITION_RESIDUAL", 32, 16, false, 0.001, 0, 0, 65.535, "mm"};
