@@ -14,11 +14,7 @@ void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& c
   } else if (has_pose_) {
     initial = latest_pose_.joints;
   } else {
-    // A slight bend keeps the first Jacobian away from the straight pose.
-    for (int s = 0; s < geometry_.segment_count; ++s) {
-      initial[2 * s] = Scalar(0);
-      initial[2 * s + 1] = Scalar(0.1);
-    }
+    straight_start(initial);
   }
   const model::IkTargetKind kind =
       commit.mode == protocol::TargetMode::pose ? model::IkTargetKind::pose : model::IkTargetKind::position;
@@ -33,6 +29,8 @@ void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& c
   solving_tracking_ = commit.tracking;
   solving_refuses_extrapolation_ = commit.refuse_extrapolating;
   checking_solution_ = false;
+  solution_retried_ = false;
+  solving_target_ = target;
   solving_cycles_ = 0;
   // A streamed target that takes over the work may still send the point
   // already sent only once.
@@ -48,6 +46,15 @@ void Runtime::start_solve(const Pose& target, const protocol::TargetPositionZ& c
   }
   solving_end_ = model::IkSolveState::running;
   solving_ = true;
+}
+
+// A slight bend keeps the first Jacobian away from the straight pose.
+void Runtime::straight_start(Joints& joints) const {
+  joints.resize(2 * geometry_.segment_count);
+  for (int s = 0; s < geometry_.segment_count; ++s) {
+    joints[2 * s] = Scalar(0);
+    joints[2 * s + 1] = Scalar(0.1);
+  }
 }
 
 // A cycle's IK slice: solver steps within ik_units_per_cycle_, and the
@@ -186,7 +193,7 @@ bool Runtime::begin_solution_check(const Joints& joints) {
   Scalar coordinates[Correction::kMaxInputs];
   correction_.kernel_coordinates(model::bend_from_joints(joints), coordinates);
   if (uncertainty_.outside_range(coordinates)) {
-    end_solve(protocol::IkOutcome::refused_extrapolating);
+    retry_or_refuse();
     return true;
   }
   if (!uncertainty_.has_variance()) return false;
@@ -195,6 +202,23 @@ bool Runtime::begin_solution_check(const Joints& joints) {
   checked_joints_ = joints;
   checking_solution_ = true;
   return true;
+}
+
+// The robot is redundant: another start may find a solution inside the
+// data where the first did not. One more search from the straight start,
+// in the same request (its cycles and report), then the refusal.
+void Runtime::retry_or_refuse() {
+  checking_solution_ = false;
+  Joints start;
+  straight_start(start);
+  const model::IkTargetKind kind =
+      solving_mode_ == protocol::TargetMode::pose ? model::IkTargetKind::pose : model::IkTargetKind::position;
+  if (!solution_retried_ && solver_.start(solving_target_, kind, start) == model::Status::ok) {
+    solution_retried_ = true;
+    solving_end_ = model::IkSolveState::running;
+    return;
+  }
+  end_solve(protocol::IkOutcome::refused_extrapolating);
 }
 
 void Runtime::continue_solution_check() {
@@ -206,7 +230,7 @@ void Runtime::continue_solution_check() {
   if (!uncertainty_.evaluation_finished(solution_check_) || spent + kWorkCosts.ik_finish > ik_units_per_cycle_) return;
   ik_units_last_cycle_ += kWorkCosts.ik_finish;
   if (uncertainty_.evaluation_result(solution_check_).extrapolating) {
-    end_solve(protocol::IkOutcome::refused_extrapolating);
+    retry_or_refuse();
   } else {
     conclude_solve(true, checked_joints_);
   }

@@ -275,9 +275,10 @@ TEST_F(RuntimeUncertaintyTest, ATargetThatRefusesExtrapolationWaitsForTheVarianc
     EXPECT_EQ(setpoint_frames, cases[c].expected == protocol::IkOutcome::converged ? runtime->geometry().segment_count : 0);
     EXPECT_EQ(runtime->statistics().overruns, 0u);
   }
-  // 832 units of variance in IK's share of a few hundred a cycle.
+  // 832 units of variance in IK's share of a few hundred a cycle; a refused
+  // solution is looked for once more, from the straight start.
   EXPECT_GE(cycles_spent[1], cycles_spent[0] + 1);
-  EXPECT_EQ(cycles_spent[2], cycles_spent[1]);
+  EXPECT_GT(cycles_spent[2], cycles_spent[1]);
 }
 
 // A stream that refuses extrapolation gets no best point so far: every

@@ -184,6 +184,8 @@ class Runtime {
   void finish_solve(model::IkSolveState end);
   bool begin_solution_check(const Joints& joints);
   void continue_solution_check();
+  void retry_or_refuse();
+  void straight_start(Joints& joints) const;
   void conclude_solve(bool reached, const Joints& joints);
   void end_solve(protocol::IkOutcome outcome);
   bool set_setpoints(const Joints& joints);
@@ -252,6 +254,10 @@ class Runtime {
   // IK slices) before its setpoints go out.
   bool solving_refuses_extrapolation_ = false;
   bool checking_solution_ = false;
+  // A refused solution is looked for once more from the slightly bent
+  // straight start, near the middle of any training data.
+  bool solution_retried_ = false;
+  Pose solving_target_;
   Uncertainty::Evaluation solution_check_;
   Joints checked_joints_;
   protocol::TargetMode solving_mode_ = protocol::TargetMode::position;
