@@ -327,6 +327,38 @@ TEST_F(ModelUpdateTest, SecondTransferOverTheFirstIsRefused) {
   expect_old_model_running();
 }
 
+// Blocks whose SHA-256 is not the one START announced: refused at COMMIT,
+// before anything is made active.
+TEST_F(ModelUpdateTest, DigestMismatchIsRefusedAtCommit) {
+  deploy::UpdateSender sender(new_image);
+  std::vector<hal::CanFrame> out;
+  sender.start(out);
+  out[0].data[1] ^= 0x01;  // the first digest byte, as announced
+  board->cycle(out);
+  for (int i = 0; i < 100 && board->runtime->model_update().state() != UpdateState::receiving; ++i) board->cycle();
+  ASSERT_EQ(board->runtime->model_update().state(), UpdateState::receiving);
+  std::uint32_t next = 0;
+  for (int i = 0; i < 2000 && board->runtime->model_update().blocks_in_flash() < sender.total_blocks(); ++i) {
+    out.clear();
+    while (next < sender.total_blocks() &&
+           next < board->runtime->model_update().blocks_in_flash() + firmware::kUpdateWindowBlocks) {
+      sender.send_block(next++, out);
+    }
+    board->cycle(out);
+  }
+  board->take_reports();
+  hal::CanFrame commit;
+  firmware::protocol::encode(
+      firmware::protocol::UpdateCommandFrame{firmware::protocol::UpdateCommand::commit, sender.transfer_id(), 0}, commit);
+  board->cycle({commit});
+  for (int i = 0; i < 50; ++i) board->cycle();
+  EXPECT_TRUE(has_reason(UpdateReason::digest_mismatch));
+  EXPECT_EQ(board->runtime->model_update().state(), UpdateState::failed);
+  expect_old_model_running();
+  board->boot();
+  EXPECT_EQ(board->active_image(), old_image);
+}
+
 // Images the runtime refuses at the end of a transfer, or at its start.
 class RefusedImageTest : public ModelUpdateTest {
  protected:
