@@ -52,15 +52,20 @@ class LogLine {
 }  // namespace
 
 Runtime::Runtime(const hal::Hal& hal, const Geometry& fallback_geometry)
-    : hal_(hal), fallback_geometry_(fallback_geometry), geometry_(fallback_geometry) {}
+    : hal_(hal), fallback_geometry_(fallback_geometry), geometry_(fallback_geometry), update_(hal.flash, hal.can) {}
 
 RuntimeState Runtime::init() {
   state_ = RuntimeState::boot;
-  static constexpr hal::CanFilter kFilters[] = {protocol::kCableFeedbackFrames, protocol::kTargetFrames};
+  static constexpr hal::CanFilter kFilters[] = {protocol::kCableFeedbackFrames, protocol::kTargetFrames,
+                                                protocol::kUpdateRequestFrames};
   static_assert(sizeof(kFilters) / sizeof(kFilters[0]) <= kMaxCanFilters, "more filters than a controller must offer");
-  can_filters_accepted_ = hal_.can.set_filters(kFilters, sizeof(kFilters) / sizeof(kFilters[0]));
+  // The model update's frames only where there is a flash to write them to.
+  const std::size_t filter_count = sizeof(kFilters) / sizeof(kFilters[0]) - (update_.enabled() ? 0 : 1);
+  can_filters_accepted_ = hal_.can.set_filters(kFilters, filter_count);
 
-  const hal::MemoryRegion region = hal_.model_storage.model_region();
+  boot_fault_ = FaultCode::none;
+  boot_fault_detail_ = FaultDetail();
+  const hal::MemoryRegion region = model_region();
   geometry_ = fallback_geometry_;
   if (region.data == nullptr || region.size_bytes == 0) {
     boot_fault_ = FaultCode::image_missing;
@@ -200,6 +205,8 @@ void Runtime::run_cycle(const hal::TimerTick& tick) {
   if (variance_slice) continue_uncertainty();
   ik_units_per_cycle_ = variance_slice ? ik_units_beside_variance_ : ik_units_alone_;
   if (cycle_ % kStatusEveryCycles == 0) publish_status();
+  update_.step(cycle_, geometry_);
+  if (update_.switch_pending()) reload_model();
   // IK last: the pose, STATUS and the staleness check never wait for it.
   if (solving_) continue_solve();
 
@@ -223,6 +230,8 @@ void Runtime::handle_frame(const hal::CanFrame& frame) {
     handle_target_position(frame);
   } else if (protocol::target_position_z::kMessage.carries(frame.id)) {
     handle_target_commit(frame);
+  } else if (ModelUpdate::carries(frame.id)) {
+    update_.handle_frame(frame, cycle_);
   }
   // Anything else is another node's traffic: the unused id the target
   // filter passes, or everything when the controller refused the filters.

@@ -8,6 +8,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cdcr/firmware/model_slots.hpp>
+#include <cdcr/sim/sim_flash.hpp>
+
 #include "allocation_counter.hpp"
 #include "runtime_fixture.hpp"
 
@@ -79,6 +82,90 @@ TEST(RuntimeNoAllocation, TenThousandCyclesAfterInit) {
   EXPECT_NE(runtime.last_ik_report().outcome, protocol::IkOutcome::in_progress);
   EXPECT_FALSE(runtime.ik_running());
   EXPECT_EQ(runtime.statistics().stale_events, 1u);
+  EXPECT_EQ(runtime.state(), RuntimeState::run);
+}
+
+// A model update under the counter: the transfer with its flash work, the
+// verification, the commit and the switch to the new model, then a rollback.
+TEST(RuntimeNoAllocation, ModelUpdateAndRollback) {
+  test_support::SimulatedPlatform platform(test_support::small_image());
+  sim::SimFlash flash(1024, 32, 256);
+  hal::NullConsole silent_console;
+  const hal::Hal hal{platform.clock, platform.timer, platform.bus.node(0), platform.storage, silent_console, &flash};
+  Runtime runtime(hal, Geometry::uniform(2, 120.0f, 67.0f));
+  ASSERT_EQ(runtime.init(), RuntimeState::run);
+  sim::SimulatedCableDrives drives(platform.drives_node, test_support::bent_cables(runtime.geometry()), 50.0);
+  const hal::CanFilter nothing{0x7FF, 0x7FF};
+  platform.host_node.set_filters(&nothing, 1);
+
+  // Every frame the host sends, built before the counter starts.
+  const std::vector<std::uint8_t> image = exporting::write_image(test_support::small_correction_model(40));
+  std::uint8_t digest[kSha256Bytes];
+  sha256(image.data(), image.size(), digest);
+  std::vector<hal::CanFrame> start;
+  for (std::uint8_t part = 0; part < 8; ++part) {
+    protocol::UpdateDigest message;
+    message.part = part;
+    for (int i = 0; i < 4; ++i) message.bytes[i] = digest[4 * part + i];
+    hal::CanFrame frame;
+    protocol::encode(message, frame);
+    start.push_back(frame);
+  }
+  hal::CanFrame frame;
+  protocol::encode(protocol::UpdateCommandFrame{protocol::UpdateCommand::start, 7, std::uint32_t(image.size())}, frame);
+  start.push_back(frame);
+  const std::uint32_t blocks = std::uint32_t((image.size() + 63) / 64);
+  std::vector<std::vector<hal::CanFrame>> block_frames(blocks);
+  for (std::uint32_t b = 0; b < blocks; ++b) {
+    const std::size_t at = std::size_t(b) * 64;
+    const std::size_t length = std::min<std::size_t>(64, image.size() - at);
+    protocol::encode(protocol::UpdateBlock{std::uint16_t(b), std::uint8_t(length),
+                                           protocol::update_block_crc(std::uint16_t(b), image.data() + at, length)},
+                     frame);
+    block_frames[b].push_back(frame);
+    for (std::size_t offset = 0; offset < length; offset += 8) {
+      protocol::UpdateData data;
+      for (std::size_t i = 0; i < 8 && offset + i < length; ++i) data.bytes[i] = image[at + offset + i];
+      protocol::encode(data, frame);
+      block_frames[b].push_back(frame);
+    }
+  }
+  hal::CanFrame commit, rollback;
+  protocol::encode(protocol::UpdateCommandFrame{protocol::UpdateCommand::commit, 7, 0}, commit);
+  protocol::encode(protocol::UpdateCommandFrame{protocol::UpdateCommand::rollback, 0, 0}, rollback);
+
+  test_support::AllocationCounter counter;
+  std::uint32_t next = 0;
+  bool committed = false;
+  bool rolled_back = false;
+  for (int k = 0; k < 3000; ++k) {
+    const ModelUpdate& update = runtime.model_update();
+    if (k == 10) {
+      for (const hal::CanFrame& f : start) platform.host_node.send(f);
+    }
+    if (update.state() == protocol::UpdateState::receiving) {
+      while (next < blocks && next < update.blocks_in_flash() + kUpdateWindowBlocks) {
+        for (const hal::CanFrame& f : block_frames[next]) platform.host_node.send(f);
+        ++next;
+      }
+      if (update.blocks_in_flash() == blocks) platform.host_node.send(commit);
+    }
+    if (!committed && update.active_slot() == 0) {
+      committed = true;
+      platform.host_node.send(rollback);
+    }
+    if (committed && update.active_slot() == -1) rolled_back = true;
+    const hal::TimerTick tick = platform.timer.wait_next();
+    drives.step(1e-3);
+    runtime.run_cycle(tick);
+  }
+  counter.stop();
+
+  EXPECT_EQ(counter.operator_new_calls(), 0);
+  EXPECT_EQ(counter.malloc_calls(), 0);
+  EXPECT_TRUE(committed);
+  EXPECT_FALSE(rolled_back);  // refused: from the model storage's image there is nothing to roll back to
+  EXPECT_EQ(runtime.model_update().last_reason(), protocol::UpdateReason::none);
   EXPECT_EQ(runtime.state(), RuntimeState::run);
 }
 

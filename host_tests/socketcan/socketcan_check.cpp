@@ -11,6 +11,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <cstdlib>
 #include <cstdio>
 #include <fstream>
 #include <iterator>
@@ -94,10 +95,13 @@ std::string hex(const CanFrame& frame) {
   return text;
 }
 
-int write_image(const std::string& path) {
+// Another training set size or seed gives another model for the same robot
+// (the deploy test sends those).
+int write_image(const std::string& path, int training_points = 24, std::uint32_t seed = 20200921) {
   cdcr::test_support::SyntheticModelOptions options;
   options.segments = kSegments;
-  options.training_points = 24;
+  options.training_points = training_points;
+  options.seed = seed;
   cdcr::training::TrainedModel trained = cdcr::test_support::synthetic_trained_model(options);
   trained.geometry = model::RobotGeometry<double>::prototype();
   // Corrections of a few tenths of a millimetre, as a trained model makes.
@@ -405,6 +409,9 @@ int check(const Model& m, const std::string& log_path) {
 int main(int argc, char** argv) {
   const std::string command = argc > 1 ? argv[1] : "";
   if (command == "image" && argc == 3) return write_image(argv[2]);
+  if (command == "image" && argc == 5) {
+    return write_image(argv[2], std::atoi(argv[3]), static_cast<std::uint32_t>(std::strtoul(argv[4], nullptr, 10)));
+  }
   Model m;
   if ((command == "frames" && argc == 3) || (command == "check" && argc == 4)) {
     if (!load_model(argv[2], m)) {
@@ -413,6 +420,6 @@ int main(int argc, char** argv) {
     }
     return command == "frames" ? print_frames(m) : check(m, argv[3]);
   }
-  std::fprintf(stderr, "usage: socketcan_check image <out> | frames <image> | check <image> <candump log>\n");
+  std::fprintf(stderr, "usage: socketcan_check image <out> [points seed] | frames <image> | check <image> <candump log>\n");
   return 2;
 }

@@ -14,6 +14,9 @@
 #include "cli_errors.hpp"
 #include "command_output.hpp"
 #include "fk_command.hpp"
+#if CDCR_HAVE_DEPLOY
+#include "deploy_command.hpp"
+#endif
 #include "ik_command.hpp"
 #include "train_command.hpp"
 #include "eval_command.hpp"
@@ -76,6 +79,9 @@ int main(int argc, char** argv) {
   register_inspect_command(app, output);
   register_export_command(app, output);
   register_simulate_command(app, output);
+#if CDCR_HAVE_DEPLOY
+  register_deploy_command(app, output);
+#endif
 
   try {
     app.parse(argc, argv);

@@ -25,6 +25,7 @@
 
 #include "dataset/csv_dataset.hpp"
 #if CDCR_HAVE_LINUX_PLATFORM
+#include "linux/file_flash.hpp"
 #include "linux/mapped_model_storage.hpp"
 #include "linux/posix_time.hpp"
 #include "linux/socketcan_bus.hpp"
@@ -430,7 +431,7 @@ void print_cycle_statistics(const fw::Runtime& runtime, const cdcr::hal::CanErro
 // The runtime on a real bus: the same object the board runs, on the Linux
 // backends, until the duration ends or a signal asks it to stop.
 int run_on_socketcan(const std::string& image_path, const std::string& interface_name, double rate_hz,
-                     double seconds) {
+                     double seconds, const std::string& flash_dir) {
   if (!(rate_hz > 0) || !(rate_hz <= 100000)) throw std::invalid_argument("--rate must be in (0, 100000] Hz");
   if (seconds != 0 && (!(seconds > 0) || !(seconds <= 86400))) {
     throw std::invalid_argument("--seconds must be in (0, 86400]");
@@ -443,6 +444,10 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   std::string error;
   if (!image_path.empty() && !storage.map_file(image_path, error)) throw InputError(error);
   if (!bus.open(interface_name, error)) throw InputError("CAN interface " + interface_name + ": " + error);
+  // With a flash directory, models deployed over CAN (A/B slots) run in
+  // preference to --image, which stays the fallback.
+  static cdcr::linux_host::FileFlash flash;
+  if (!flash_dir.empty() && !flash.open_directory(flash_dir, error)) throw InputError("--flash-dir: " + error);
 
   struct sigaction action {};
   action.sa_handler = request_stop;
@@ -450,7 +455,7 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
 
-  static const cdcr::hal::Hal hal{clock, timer, bus, storage, console};
+  static const cdcr::hal::Hal hal{clock, timer, bus, storage, console, flash_dir.empty() ? nullptr : &flash};
   static fw::Runtime runtime(hal, fw::Geometry::prototype());
   runtime.init();
 
@@ -468,7 +473,7 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   return 0;
 }
 #else
-int run_on_socketcan(const std::string&, const std::string&, double, double) {
+int run_on_socketcan(const std::string&, const std::string&, double, double, const std::string&) {
   throw InputError("--can needs a Linux host (SocketCAN)");
 }
 #endif
@@ -485,6 +490,9 @@ int main(int argc, char** argv) {
   bool circle = false;
   double rate_hz = 1000.0, seconds = 2.0, circle_radius_mm = 40.0, circle_speed_mm_s = 50.0;
   app.add_option("--image", image_path, "model image (flash image v2, or v1)");
+  std::string flash_dir;
+  app.add_option("--flash-dir", flash_dir,
+                 "with --can: directory of the file-backed flash that models deployed over CAN are written to");
   auto* replay_option = app.add_option("--replay", replay_path, "cable-length CSV (dataset layout) to replay");
   app.add_option("--out", out_path, "pose CSV written by --replay");
   auto* sim_option = app.add_flag("--sim", run_sim, "close the loop with the simulated robot");
@@ -505,6 +513,7 @@ int main(int argc, char** argv) {
       throw CLI::ValidationError("one of --replay, --sim or --can is required");
     }
     if (circle && !run_sim) throw CLI::ValidationError("--circle needs --sim");
+    if (!flash_dir.empty() && can_interface.empty()) throw CLI::ValidationError("--flash-dir needs --can");
     if (!replay_path.empty() && (image_path.empty() || out_path.empty())) {
       throw CLI::ValidationError("--replay needs --image and --out");
     }
@@ -516,7 +525,8 @@ int main(int argc, char** argv) {
   }
   try {
     if (!can_interface.empty()) {
-      return run_on_socketcan(image_path, can_interface, rate_hz, app.count("--seconds") > 0 ? seconds : 0.0);
+      return run_on_socketcan(image_path, can_interface, rate_hz, app.count("--seconds") > 0 ? seconds : 0.0,
+                              flash_dir);
     }
     if (run_sim && circle) return follow_circle(image_path, rate_hz, circle_radius_mm, circle_speed_mm_s, ideal_robot);
     return run_sim ? simulate(image_path, rate_hz, seconds, ideal_robot) : replay(image_path, replay_path, out_path);

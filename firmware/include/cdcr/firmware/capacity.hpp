@@ -110,3 +110,23 @@ inline constexpr float kTrackingPublishPositionErrorMm = 1.0f;
 inline constexpr float kTrackingPublishOrientationErrorRad = 0.01f;
 
 }  // namespace cdcr::firmware
+
+namespace cdcr::firmware {
+
+// Model updates over CAN (model_update.hpp). Blocks the runtime holds in RAM
+// between their arrival and their program: the window it grants the host.
+inline constexpr int kUpdateWindowBlocks = 8;
+// An acknowledgement goes out after this many blocks reached the flash (and
+// whenever the runtime has caught up with what it received).
+inline constexpr int kUpdateAckEveryBlocks = 4;
+// Bytes of the new image hashed per cycle while it is verified: 1 KiB of
+// SHA-256 is about 25 % of a Cortex-M7 cycle's budget.
+inline constexpr std::uint32_t kUpdateHashBytesPerCycle = 1024;
+// A transfer without a valid frame for this many cycles (a minute at 1 kHz)
+// is dropped with reason timeout; the host may resume it with START.
+inline constexpr std::uint32_t kUpdateTimeoutCycles = 60'000;
+// A new image's segments may differ from the running model's geometry by
+// this fraction of their length and radius (a recalibration), no more.
+inline constexpr float kUpdateGeometryTolerance = 0.05f;
+
+}  // namespace cdcr::firmware

@@ -23,6 +23,7 @@
 #include "cdcr/firmware/capacity.hpp"
 #include "cdcr/firmware/fault.hpp"
 #include "cdcr/firmware/fault_detail.hpp"
+#include "cdcr/firmware/model_update.hpp"
 #include "cdcr/firmware/protocol.hpp"
 #include "cdcr/hal/hal.hpp"
 #include "cdcr/model/compensated_kinematics.hpp"
@@ -172,8 +173,14 @@ class Runtime {
   // Whether the latest pose extrapolates: outside the fitted range, or the
   // last radii said so.
   bool extrapolating() const;
+  // Model updates over CAN into the HAL's flash (model_update.hpp).
+  const ModelUpdate& model_update() const { return update_; }
 
  private:
+  // runtime_update.cpp: the image init() loads, and the switch to a new one.
+  hal::MemoryRegion model_region();
+  bool image_loads(const hal::MemoryRegion& region);
+  void reload_model();
   void handle_frame(const hal::CanFrame& frame);
   void handle_cable_frame(const hal::CanFrame& frame);
   void handle_target_orientation(const hal::CanFrame& frame);
@@ -278,6 +285,7 @@ class Runtime {
   hal::CanFrame setpoint_frames_[kMaxSegments] = {};
 
   CycleStatistics statistics_;
+  ModelUpdate update_;
 };
 
 }  // namespace cdcr::firmware

@@ -6,6 +6,7 @@
 #include "cdcr/hal/can_bus.hpp"
 #include "cdcr/hal/clock.hpp"
 #include "cdcr/hal/console.hpp"
+#include "cdcr/hal/flash.hpp"
 #include "cdcr/hal/model_storage.hpp"
 
 namespace cdcr::hal {
@@ -16,6 +17,9 @@ struct Hal {
   CanBus& can;
   ModelStorage& model_storage;
   Console& console;
+  // Where model updates are written (A/B slots); none: the model is
+  // model_storage's and cannot be updated over the bus.
+  Flash* flash = nullptr;
 };
 
 }  // namespace cdcr::hal

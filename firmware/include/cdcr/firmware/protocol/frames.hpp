@@ -14,6 +14,7 @@
 // identifier, the DLC, the reserved bits and every signal's range first, and
 // write the struct only when the frame is well formed.
 
+#include <cstddef>
 #include <cstdint>
 
 #include "cdcr/firmware/fault.hpp"
@@ -22,6 +23,7 @@
 #include "cdcr/firmware/protocol/messages.hpp"
 #include "cdcr/firmware/protocol/signal_codec.hpp"
 #include "cdcr/hal/can_bus.hpp"
+#include "cdcr/model/crc32.hpp"
 
 namespace cdcr::firmware::protocol {
 
@@ -363,6 +365,123 @@ inline DecodeStatus decode(const hal::CanFrame& frame, FaultCode reported_fault,
   f.cycle_count = static_cast<std::uint16_t>(raw_in_word(word, kCycleCount));
   f.fault_detail = FaultDetail::from_wire(reported_fault, static_cast<std::uint8_t>(raw_in_word(word, kFaultDetail)));
   f.stale_events = raw_in_word(word, kStaleEvents);
+  return DecodeStatus::ok;
+}
+
+// Model updates (messages.hpp, "Model updates").
+struct UpdateCommandFrame {
+  UpdateCommand command = UpdateCommand::status;
+  std::uint16_t transfer_id = 0;
+  std::uint32_t image_size = 0;  // START only; at most 2^24 - 1
+};
+struct UpdateDigest {
+  std::uint8_t part = 0;  // 0..7
+  std::uint8_t bytes[4] = {};
+};
+struct UpdateBlock {
+  std::uint16_t block = 0;
+  std::uint8_t length = kUpdateBlockBytes;
+  std::uint32_t crc = 0;
+};
+struct UpdateData {
+  std::uint8_t bytes[8] = {};
+};
+struct UpdateReport {
+  UpdateState state = UpdateState::idle;
+  std::uint8_t active_slot = 0;
+  UpdateReason reason = UpdateReason::none;
+  std::uint16_t next_block = 0;
+  std::uint8_t window = 0;
+  std::uint16_t transfer_id = 0;
+  std::uint8_t active_sequence = 0;  // low 8 bits
+};
+
+// The CRC an UPDATE_BLOCK carries for `size` bytes of block `block`.
+inline std::uint32_t update_block_crc(std::uint16_t block, const std::uint8_t* data, std::size_t size) {
+  const std::uint8_t number[2] = {static_cast<std::uint8_t>(block & 0xFF), static_cast<std::uint8_t>(block >> 8)};
+  return model::crc32(data, size, model::crc32(number, 2));
+}
+
+inline void encode(const UpdateCommandFrame& f, hal::CanFrame& frame) {
+  using namespace update_command;
+  frame = empty_frame(kMessage);
+  set_data_word(frame, placed_integer(kCommand, static_cast<std::int64_t>(f.command)) |
+                           placed_integer(kTransferId, f.transfer_id) | placed_integer(kImageSize, f.image_size));
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, UpdateCommandFrame& f) {
+  using namespace update_command;
+  if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
+  const std::uint64_t word = data_word(frame);
+  f.command = static_cast<UpdateCommand>(raw_in_word(word, kCommand));
+  f.transfer_id = static_cast<std::uint16_t>(raw_in_word(word, kTransferId));
+  f.image_size = static_cast<std::uint32_t>(raw_in_word(word, kImageSize));
+  return DecodeStatus::ok;
+}
+
+inline void encode(const UpdateDigest& f, hal::CanFrame& frame) {
+  using namespace update_digest;
+  frame = empty_frame(kMessage);
+  const std::uint32_t w = std::uint32_t(f.bytes[0]) | (std::uint32_t(f.bytes[1]) << 8) |
+                          (std::uint32_t(f.bytes[2]) << 16) | (std::uint32_t(f.bytes[3]) << 24);
+  set_data_word(frame, placed_integer(kPart, f.part) | placed_integer(kWord, w));
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, UpdateDigest& f) {
+  using namespace update_digest;
+  if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
+  const std::uint64_t word = data_word(frame);
+  f.part = static_cast<std::uint8_t>(raw_in_word(word, kPart));
+  const auto w = static_cast<std::uint32_t>(raw_in_word(word, kWord));
+  for (int i = 0; i < 4; ++i) f.bytes[i] = static_cast<std::uint8_t>(w >> (8 * i));
+  return DecodeStatus::ok;
+}
+
+inline void encode(const UpdateBlock& f, hal::CanFrame& frame) {
+  using namespace update_block;
+  frame = empty_frame(kMessage);
+  set_data_word(frame, placed_integer(kBlock, f.block) | placed_integer(kLength, f.length) |
+                           placed_integer(kCrc, f.crc));
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, UpdateBlock& f) {
+  using namespace update_block;
+  if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
+  const std::uint64_t word = data_word(frame);
+  f.block = static_cast<std::uint16_t>(raw_in_word(word, kBlock));
+  f.length = static_cast<std::uint8_t>(raw_in_word(word, kLength));
+  f.crc = static_cast<std::uint32_t>(raw_in_word(word, kCrc));
+  return DecodeStatus::ok;
+}
+
+inline void encode(const UpdateData& f, hal::CanFrame& frame) {
+  frame = empty_frame(update_data::kMessage);
+  for (int i = 0; i < 8; ++i) frame.data[i] = f.bytes[i];
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, UpdateData& f) {
+  if (const DecodeStatus s = check_frame(update_data::kMessage, frame); s != DecodeStatus::ok) return s;
+  for (int i = 0; i < 8; ++i) f.bytes[i] = frame.data[i];
+  return DecodeStatus::ok;
+}
+
+inline void encode(const UpdateReport& f, hal::CanFrame& frame) {
+  using namespace update_report;
+  frame = empty_frame(kMessage);
+  set_data_word(frame, placed_integer(kState, static_cast<std::int64_t>(f.state)) |
+                           placed_integer(kActiveSlot, f.active_slot) |
+                           placed_integer(kReason, static_cast<std::int64_t>(f.reason)) |
+                           placed_integer(kNextBlock, f.next_block) | placed_integer(kWindow, f.window) |
+                           placed_integer(kTransferId, f.transfer_id) |
+                           placed_integer(kActiveSequence, f.active_sequence));
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, UpdateReport& f) {
+  using namespace update_report;
+  if (const DecodeStatus s = check_frame(kMessage, frame); s != DecodeStatus::ok) return s;
+  const std::uint64_t word = data_word(frame);
+  f.state = static_cast<UpdateState>(raw_in_word(word, kState));
+  f.active_slot = static_cast<std::uint8_t>(raw_in_word(word, kActiveSlot));
+  f.reason = static_cast<UpdateReason>(raw_in_word(word, kReason));
+  f.next_block = static_cast<std::uint16_t>(raw_in_word(word, kNextBlock));
+  f.window = static_cast<std::uint8_t>(raw_in_word(word, kWindow));
+  f.transfer_id = static_cast<std::uint16_t>(raw_in_word(word, kTransferId));
+  f.active_sequence = static_cast<std::uint8_t>(raw_in_word(word, kActiveSequence));
   return DecodeStatus::ok;
 }
 

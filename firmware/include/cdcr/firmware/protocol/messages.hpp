@@ -224,12 +224,133 @@ inline constexpr const SignalSpec* kSignals[] = {&kJitterMax, &kRejectedFrames, 
 inline constexpr MessageSpec kMessage{"STATS", 0x151, 1, 8, "RUNTIME", signal_list(kSignals), kStatusFrames};
 }  // namespace stats
 
+// Model updates (0x170..0x17F; firmware/model_update.hpp): the host writes a
+// new model image into the inactive flash slot, in blocks of up to
+// kUpdateBlockBytes, each an UPDATE_BLOCK header and its UPDATE_DATA frames.
+// The runtime acknowledges cumulatively and grants a window of blocks.
+inline constexpr hal::CanFilter kUpdateRequestFrames{0x170, 0x7F8};  // UPDATE_COMMAND, _DIGEST, _BLOCK, _DATA
+inline constexpr hal::CanFilter kUpdateReportFrames{0x178, 0x7F8};   // UPDATE_REPORT
+
+inline constexpr int kUpdateBlockBytes = 64;
+inline constexpr int kUpdateDataFramesPerBlock = kUpdateBlockBytes / 8;
+
+enum class UpdateCommand : std::uint8_t { start = 1, status = 2, abort = 3, commit = 4, rollback = 5 };
+
+enum class UpdateState : std::uint8_t {
+  idle = 0,       // no transfer
+  preparing = 1,  // erasing the inactive slot
+  receiving = 2,  // blocks are welcome: NEXT_BLOCK and WINDOW say which
+  verifying = 3,  // all blocks in flash; hashing and validating before commit
+  committed = 4,  // the new image is active
+  failed = 5,     // the transfer ended with REASON; the active model is unchanged
+};
+
+// Why a frame or a transfer was refused (REASON); the active model keeps
+// running in every case.
+enum class UpdateReason : std::uint8_t {
+  none = 0,
+  corrupted = 1,             // a block's CRC does not match its data
+  duplicate = 2,             // a block already received
+  out_of_order = 3,          // a block beyond the next expected one
+  missing_block = 4,         // data frames missing from a block, or commit with blocks missing
+  timeout = 5,               // the transfer was left without progress for kUpdateTimeoutCycles
+  wrong_geometry = 6,        // the image was trained for another robot geometry
+  wrong_segment_count = 7,   // the image has another segment count
+  unsupported_version = 8,   // an image format version this runtime does not read
+  too_large = 9,             // larger than the inactive slot
+  busy = 10,                 // another transfer is in progress (abort it first)
+  image_invalid = 11,        // the image does not parse or bind (its CRC, its fields)
+  digest_mismatch = 12,      // the SHA-256 of the received bytes is not the announced one
+  no_transfer = 13,          // a block or commit without a transfer
+  no_rollback_image = 14,    // rollback with no valid image in the other slot
+  flash_failed = 15,         // the flash reported an error
+  malformed = 16,            // a frame of the protocol that does not decode
+};
+
+namespace values {
+inline constexpr ValueName kUpdateCommand[] = {
+    {1, "start"}, {2, "status"}, {3, "abort"}, {4, "commit"}, {5, "rollback"}};
+inline constexpr ValueName kUpdateState[] = {{0, "idle"},      {1, "preparing"}, {2, "receiving"},
+                                             {3, "verifying"}, {4, "committed"}, {5, "failed"}};
+inline constexpr ValueName kUpdateReason[] = {
+    {0, "none"},           {1, "corrupted"},        {2, "duplicate"},
+    {3, "out_of_order"},   {4, "missing_block"},    {5, "timeout"},
+    {6, "wrong_geometry"}, {7, "wrong_segment_count"}, {8, "unsupported_version"},
+    {9, "too_large"},      {10, "busy"},            {11, "image_invalid"},
+    {12, "digest_mismatch"}, {13, "no_transfer"},   {14, "no_rollback_image"},
+    {15, "flash_failed"},  {16, "malformed"},
+};
+}  // namespace values
+
+// 0x170: a command. START announces a transfer (or resumes the one in
+// flash with the same TRANSFER_ID, size and digest); the eight
+// UPDATE_DIGEST frames must precede it. Bits 4..7 are reserved.
+namespace update_command {
+inline constexpr SignalSpec kCommand{"COMMAND", 0, 4, false, 1, 0, 1, 5, "", value_table(values::kUpdateCommand)};
+inline constexpr SignalSpec kTransferId{"TRANSFER_ID", 8, 16, false, 1, 0, 0, 65535, ""};
+inline constexpr SignalSpec kImageSize{"IMAGE_SIZE", 24, 24, false, 1, 0, 0, 16777215, "B"};
+inline constexpr const SignalSpec* kSignals[] = {&kCommand, &kTransferId, &kImageSize};
+inline constexpr MessageSpec kMessage{"UPDATE_COMMAND", 0x170, 1, 6, "HOST", signal_list(kSignals),
+                                      kUpdateRequestFrames};
+}  // namespace update_command
+
+// 0x171: bytes 4 * PART .. 4 * PART + 3 of the image's SHA-256, in order
+// (WORD little-endian). Bits 3..7 are reserved.
+namespace update_digest {
+inline constexpr SignalSpec kPart{"PART", 0, 3, false, 1, 0, 0, 7, ""};
+inline constexpr SignalSpec kWord{"WORD", 8, 32, false, 1, 0, 0, 4294967295.0, ""};
+inline constexpr const SignalSpec* kSignals[] = {&kPart, &kWord};
+inline constexpr MessageSpec kMessage{"UPDATE_DIGEST", 0x171, 1, 5, "HOST", signal_list(kSignals),
+                                      kUpdateRequestFrames};
+}  // namespace update_digest
+
+// 0x172: the header of block BLOCK (image bytes 64 * BLOCK ..): its length
+// and the CRC-32 of its two BLOCK bytes (little-endian) then its data.
+namespace update_block {
+inline constexpr SignalSpec kBlock{"BLOCK", 0, 16, false, 1, 0, 0, 65535, ""};
+inline constexpr SignalSpec kLength{"LENGTH", 16, 8, false, 1, 0, 1, kUpdateBlockBytes, "B"};
+inline constexpr SignalSpec kCrc{"CRC", 24, 32, false, 1, 0, 0, 4294967295.0, ""};
+inline constexpr const SignalSpec* kSignals[] = {&kBlock, &kLength, &kCrc};
+inline constexpr MessageSpec kMessage{"UPDATE_BLOCK", 0x172, 1, 7, "HOST", signal_list(kSignals),
+                                      kUpdateRequestFrames};
+}  // namespace update_block
+
+// 0x173: the next 8 bytes of the block whose header came last (the last
+// frame of a block is zero-padded).
+namespace update_data {
+inline constexpr SignalSpec kDataLow{"DATA_LOW", 0, 32, false, 1, 0, 0, 4294967295.0, ""};
+inline constexpr SignalSpec kDataHigh{"DATA_HIGH", 32, 32, false, 1, 0, 0, 4294967295.0, ""};
+inline constexpr const SignalSpec* kSignals[] = {&kDataLow, &kDataHigh};
+inline constexpr MessageSpec kMessage{"UPDATE_DATA", 0x173, 1, 8, "HOST", signal_list(kSignals),
+                                      kUpdateRequestFrames};
+}  // namespace update_data
+
+// 0x178: the update's state, the answer to every command and the
+// acknowledgement of blocks: blocks 0 .. NEXT_BLOCK - 1 are in flash, and
+// the host may send up to WINDOW blocks from NEXT_BLOCK on.
+namespace update_report {
+inline constexpr SignalSpec kState{"STATE", 0, 4, false, 1, 0, 0, 5, "", value_table(values::kUpdateState)};
+// 0: the image of ModelStorage (no slot), 1: slot A, 2: slot B.
+inline constexpr SignalSpec kActiveSlot{"ACTIVE_SLOT", 4, 2, false, 1, 0, 0, 2, ""};
+inline constexpr SignalSpec kReason{"REASON", 8, 8, false, 1, 0, 0, 16, "", value_table(values::kUpdateReason)};
+inline constexpr SignalSpec kNextBlock{"NEXT_BLOCK", 16, 16, false, 1, 0, 0, 65535, ""};
+inline constexpr SignalSpec kWindow{"WINDOW", 32, 8, false, 1, 0, 0, 255, ""};
+inline constexpr SignalSpec kTransferId{"TRANSFER_ID", 40, 16, false, 1, 0, 0, 65535, ""};
+inline constexpr SignalSpec kActiveSequence{"ACTIVE_SEQUENCE", 56, 8, false, 1, 0, 0, 255, ""};
+inline constexpr const SignalSpec* kSignals[] = {&kState,  &kActiveSlot,  &kReason,         &kNextBlock,
+                                                 &kWindow, &kTransferId, &kActiveSequence};
+inline constexpr MessageSpec kMessage{"UPDATE_REPORT", 0x178, 1, 8, "RUNTIME", signal_list(kSignals),
+                                      kUpdateReportFrames};
+}  // namespace update_report
+
 // Every message of the protocol, as the DBC lists them.
 inline constexpr const MessageSpec* kMessages[] = {
     &cable_feedback::kMessage,     &cable_setpoint::kMessage,   &target_orientation::kMessage,
     &target_position_xy::kMessage, &target_position_z::kMessage, &pose_position_xy::kMessage,
     &pose_position_z::kMessage,    &pose_orientation::kMessage, &pose_uncertainty::kMessage,
     &ik_report::kMessage,          &status::kMessage,           &stats::kMessage,
+    &update_command::kMessage,     &update_digest::kMessage,    &update_block::kMessage,
+    &update_data::kMessage,        &update_report::kMessage,
 };
 
 }  // namespace cdcr::firmware::protocol

@@ -1,0 +1,99 @@
+#!/bin/sh
+# The deploy test, run inside the guest on vcan0: `cdcr deploy` sends new
+# models to `cdcr-runtime --flash-dir` while the drives' cable frames flow.
+#   1. A new model reaches the runtime; poses keep coming during the
+#      transfer and change to the new model's values after the commit.
+#   2. A larger model, with the runtime killed (SIGKILL) at 10 random moments
+#      of the transfer and restarted each time on the same flash: every
+#      restart runs a valid image, and the deploy resumes and finishes.
+#   CDCR_RUNTIME, CDCR_CLI, CDCR_CHECK: host-built binaries; CDCR_WORK_DIR.
+set -u
+work=$CDCR_WORK_DIR
+capture_dir=$work/capture
+mkdir -p "$capture_dir"
+mount -t tmpfs tmpfs "$capture_dir" || exit 1
+log=$capture_dir/candump.log
+flash=$work/flash
+rm -rf "$flash" "$work"/runtime.err.* "$work"/deploy.*
+
+. "$(dirname "$0")/bus_waits.sh"
+
+"$CDCR_CHECK" image "$work/old.img" 24 1 || fail "cannot write the old image"
+"$CDCR_CHECK" image "$work/new.img" 40 2 || fail "cannot write the new image"
+"$CDCR_CHECK" image "$work/big.img" 1000 3 || fail "cannot write the large image"
+eval "$("$CDCR_CHECK" frames "$work/old.img")" || fail "cannot compute the frames"
+
+feeders=""
+segment=0
+while [ "$segment" -lt "$SEGMENTS" ]; do
+  eval "data=\$FEEDBACK_$segment"
+  cangen vcan0 -I "10$segment" -L 8 -D "$data" -g 10 &
+  feeders="$feeders $!"
+  segment=$((segment + 1))
+done
+stdbuf -oL candump -L -r 4194304 vcan0,130:7F8,150:7FF,178:7FF,7F0:7FF > "$log" &
+candump_pid=$!
+
+restarts=0
+start_runtime() {
+  "$CDCR_RUNTIME" --image "$work/old.img" --can vcan0 --flash-dir "$flash" --rate 100 \
+    > /dev/null 2> "$work/runtime.err.$restarts" &
+  runtime_pid=$!
+}
+stop_all() {
+  kill "$runtime_pid" $feeders "$candump_pid" 2>/dev/null
+  wait 2>/dev/null
+}
+start_runtime
+wait_until "the runtime in RUN" in_run
+progress "runtime up on the old model"
+
+# 1. A deploy while poses flow.
+marker 01
+wait_until "poses on the old model" seen_count 01 "130#" 5
+pose_before=$(in_phase 01 '$3 ~ /^130#/ { print $3; exit }')
+"$CDCR_CLI" deploy --can vcan0 --image "$work/new.img" --quiet > "$work/deploy.out" 2> "$work/deploy.err" ||
+  fail "deploy: $(cat "$work/deploy.err")"
+marker 02
+progress "$(cat "$work/deploy.out")"
+wait_until "poses on the new model" seen_count 02 "130#" 5
+pose_after=$(in_phase 02 '$3 ~ /^130#/ { last = $3 } END { print last }')
+[ "$pose_before" != "$pose_after" ] || fail "the pose did not change with the new model ($pose_after)"
+# Poses every cycle (100 Hz) during the transfer: no gap of more than
+# 0.5 s, a generous bound for the guest, and none missing around the switch.
+gap=$(in_phase 01 '
+  $3 == marker { after = 1; next }
+  after && $3 ~ /^7F0#/ { exit }
+  after && $3 ~ /^131#/ { t = substr($1, 2, length($1) - 2) + 0; if (last && t - last > max) max = t - last; last = t; n++ }
+  END { printf "%d %.3f\n", n, max }')
+progress "poses during the transfer and max gap (s): $gap"
+echo "$gap" | awk '{ exit !($1 >= 10 && $2 < 0.5) }' || fail "poses stalled during the transfer: $gap"
+"$CDCR_CLI" deploy --can vcan0 --status > "$work/deploy.status" 2>&1 || fail "status: $(cat "$work/deploy.status")"
+grep -q "active slot A" "$work/deploy.status" || fail "status: $(cat "$work/deploy.status")"
+progress "$(cat "$work/deploy.status")"
+
+# 2. SIGKILL at 10 random moments of a transfer.
+"$CDCR_CLI" deploy --can vcan0 --image "$work/big.img" --quiet --timeout 120 \
+  > "$work/deploy.big.out" 2> "$work/deploy.big.err" &
+deploy_pid=$!
+while [ "$restarts" -lt 10 ]; do
+  pause=$(awk -v seed="$restarts$$" 'BEGIN { srand(seed); printf "%.2f", 0.2 + rand() * 0.8 }')
+  sleep "$pause"
+  kill -0 "$deploy_pid" 2>/dev/null || fail "the deploy ended before kill $((restarts + 1)): $(cat "$work/deploy.big.err")"
+  kill -KILL "$runtime_pid"
+  wait "$runtime_pid" 2>/dev/null
+  restarts=$((restarts + 1))
+  start_runtime
+  wait_until "restart $restarts in RUN on a valid image" grep -q "state RUN" "$work/runtime.err.$restarts"
+  if grep -q "fault" "$work/runtime.err.$restarts"; then
+    fail "restart $restarts: $(cat "$work/runtime.err.$restarts")"
+  fi
+  progress "kill $restarts after $pause s: restarted in RUN"
+done
+wait "$deploy_pid" || fail "deploy after 10 kills: $(cat "$work/deploy.big.err")"
+progress "$(cat "$work/deploy.big.out")"
+"$CDCR_CLI" deploy --can vcan0 --status > "$work/deploy.status" 2>&1 || fail "status: $(cat "$work/deploy.status")"
+grep -q "active slot B" "$work/deploy.status" || fail "status after the large model: $(cat "$work/deploy.status")"
+stop_all
+echo "SOCKETCAN_TEST_PASS"
+exit 0
