@@ -56,7 +56,8 @@ Runtime::Runtime(const hal::Hal& hal, const Geometry& fallback_geometry)
 
 RuntimeState Runtime::init() {
   state_ = RuntimeState::boot;
-  static constexpr hal::CanFilter kFilters[] = {protocol::kCableFeedbackFrames, protocol::kTargetFrames};
+  static constexpr hal::CanFilter kFilters[] = {protocol::kCableFeedbackFrames, protocol::kTargetFrames,
+                                                protocol::kPayloadFrames};
   static_assert(sizeof(kFilters) / sizeof(kFilters[0]) <= kMaxCanFilters, "more filters than a controller must offer");
   can_filters_accepted_ = hal_.can.set_filters(kFilters, sizeof(kFilters) / sizeof(kFilters[0]));
 
@@ -96,6 +97,12 @@ RuntimeState Runtime::init() {
     return state_;
   }
   mode_ = boot_fault_ == FaultCode::none ? RuntimeState::run : RuntimeState::degraded;
+  // A payload received before init stays; otherwise the image's default.
+  if (payload_received_) {
+    correction_.set_payload_kg(payload_kg_);
+  } else {
+    payload_kg_ = correction_.payload_kg();
+  }
   latest_cables_mm_.setZero(4 * geometry_.segment_count);
   model::IkSolverOptions<Scalar> solver_options;
   solver_options.max_corrections = kMaxIkCorrections;
@@ -223,6 +230,8 @@ void Runtime::handle_frame(const hal::CanFrame& frame) {
     handle_target_position(frame);
   } else if (protocol::target_position_z::kMessage.carries(frame.id)) {
     handle_target_commit(frame);
+  } else if (protocol::payload::kMessage.carries(frame.id)) {
+    handle_payload(frame);
   }
   // Anything else is another node's traffic: the unused id the target
   // filter passes, or everything when the controller refused the filters.
@@ -252,6 +261,27 @@ void Runtime::handle_target_orientation(const hal::CanFrame& frame) {
 void Runtime::handle_target_position(const hal::CanFrame& frame) {
   has_pending_position_ = protocol::decode(frame, pending_position_) == protocol::DecodeStatus::ok;
   if (!has_pending_position_) reject_frame(FaultCode::target_malformed);
+}
+
+void Runtime::handle_payload(const hal::CanFrame& frame) {
+  protocol::Payload payload;
+  if (protocol::decode(frame, payload) != protocol::DecodeStatus::ok) {
+    reject_frame(FaultCode::payload_invalid);
+    return;
+  }
+  set_payload_kg(static_cast<Scalar>(payload.payload_kg));
+}
+
+bool Runtime::set_payload_kg(Scalar payload_kg) {
+  const protocol::SignalSpec& signal = protocol::payload::kPayload;
+  if (!(payload_kg >= Scalar(signal.minimum) && payload_kg <= Scalar(signal.maximum))) {  // NaN fails both
+    record_event(FaultCode::payload_invalid);
+    return false;
+  }
+  payload_kg_ = payload_kg;
+  payload_received_ = true;
+  correction_.set_payload_kg(payload_kg);
+  return true;
 }
 
 // A segment's cables are used for a pose until they are stale (the same
