@@ -5,6 +5,7 @@
 // and the previous payload stays in use.
 
 #include <cmath>
+#include <cstdio>
 #include <limits>
 #include <vector>
 
@@ -21,7 +22,7 @@ using test_support::RuntimeTest;
 
 training::TrainedModel payload_model() {
   test_support::SyntheticModelOptions options;
-  options.training_points = 60;
+  options.training_points = 8;
   options.payload_input = true;
   training::TrainedModel m = test_support::synthetic_trained_model(options);
   for (int k = 0; k < 6; ++k) {
@@ -146,7 +147,7 @@ TEST_F(RuntimePayloadTest, InverseKinematicsUsesTheCurrentPayload) {
   cycles(3);
   ASSERT_EQ(runtime->payload_kg(), 0.9f);
   const model::Vec3<double> target = runtime->latest_pose().pose.position_mm.cast<double>() +
-                                     model::Vec3<double>(2.0, -1.5, 0.5);
+                                     model::Vec3<double>(3.0, -2.0, 0.0);
   send_position_target(target.x(), target.y(), target.z(), 7);
   cycles_until_ik_done();
   protocol::IkReport report;
@@ -154,8 +155,11 @@ TEST_F(RuntimePayloadTest, InverseKinematicsUsesTheCurrentPayload) {
   ASSERT_EQ(report.outcome, protocol::IkOutcome::converged);
   ASSERT_TRUE(runtime->has_setpoints());
   const Cables setpoints = runtime->setpoints_mm();
-  EXPECT_LT((expected_pose(setpoints, 0.9).position_mm - target).norm(), 0.06);
-  EXPECT_GT((expected_pose(setpoints, 0.375).position_mm - target).norm(), 0.1);
+  const double at_payload = (expected_pose(setpoints, 0.9).position_mm - target).norm();
+  const double at_default = (expected_pose(setpoints, 0.375).position_mm - target).norm();
+  std::printf("IK at 0.9 kg: residual %.4f mm at 0.9 kg, %.4f mm at the default 0.375 kg\n", at_payload, at_default);
+  EXPECT_LT(at_payload, 0.05);
+  EXPECT_GT(at_default, 4 * at_payload + 0.02);
 }
 
 }  // namespace
