@@ -113,17 +113,24 @@ RuntimeState Runtime::init() {
   // The forward path spends one unit per training point and the overhead,
   // a cycle with a slice of the variance that too; IK gets the rest.
   const bool with_variance = mode_ == RuntimeState::run && uncertainty_.has_variance();
+  // A payload model's points cost more units each (work_costs.hpp), and
+  // IK's smallest step may then be a block of its gradient.
+  const bool compensated = mode_ == RuntimeState::run;
   const std::uint32_t forward_units =
-      kWorkCosts.cycle_overhead + (mode_ == RuntimeState::run ? correction_.training_points() : 0);
-  const auto ik_share = [](std::uint32_t used) {
-    return used + kMinIkUnitsPerCycle < kCycleWorkUnits ? kCycleWorkUnits - used : kMinIkUnitsPerCycle;
+      kWorkCosts.cycle_overhead + (compensated ? correction_.training_points() * correction_.mean_point_units() : 0);
+  const std::uint32_t min_ik_units =
+      compensated && correction_.smallest_gradient_slice_units() > kMinIkUnitsPerCycle
+          ? correction_.smallest_gradient_slice_units()
+          : kMinIkUnitsPerCycle;
+  const auto ik_share = [min_ik_units](std::uint32_t used) {
+    return used + min_ik_units < kCycleWorkUnits ? kCycleWorkUnits - used : min_ik_units;
   };
   ik_units_alone_ = ik_share(forward_units);
   ik_units_beside_variance_ = ik_share(forward_units + (with_variance ? kUncertaintyUnitsPerCycle : 0));
   ik_units_per_cycle_ = ik_units_beside_variance_;
   // A large model leaves no room for a slice beside IK's smallest step:
   // then the variance waits while a target is solved.
-  variance_beside_ik_ = forward_units + kUncertaintyUnitsPerCycle + kMinIkUnitsPerCycle <= kCycleWorkUnits;
+  variance_beside_ik_ = forward_units + kUncertaintyUnitsPerCycle + min_ik_units <= kCycleWorkUnits;
   enter(mode_);
   if (boot_fault_ != FaultCode::none) {
     LogLine line;

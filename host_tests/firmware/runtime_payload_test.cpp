@@ -139,6 +139,25 @@ TEST_F(RuntimePayloadTest, TheStatusFrameReportsARefusedPayload) {
   EXPECT_TRUE(reported);
 }
 
+// The fitted input range includes the payload's: a payload the frame can
+// carry but the model never saw flags the pose as outside the range.
+TEST_F(RuntimePayloadTest, APayloadBeyondTheFittedRangeIsOutsideIt) {
+  // The drives' bend within the model's fitted bend range.
+  cycles(3);
+  send_frame(protocol::Payload{0.5});
+  cycles(2);
+  ASSERT_EQ(runtime->payload_kg(), 0.5f);
+  EXPECT_FALSE(runtime->latest_pose().outside_range);
+  send_frame(protocol::Payload{5.0});
+  cycles(2);
+  ASSERT_EQ(runtime->payload_kg(), 5.0f);
+  EXPECT_TRUE(runtime->latest_pose().outside_range);
+  EXPECT_TRUE(runtime->extrapolating());
+  send_frame(protocol::Payload{0.5});
+  cycles(2);
+  EXPECT_FALSE(runtime->latest_pose().outside_range);
+}
+
 // IK solves the compensated model at the current payload: the setpoints it
 // publishes put the compensated tip on the target at that payload, and
 // away from it at the default.

@@ -64,6 +64,10 @@ class GpCorrection {
     extra_inputs_ = image.extra_inputs;
     if (bend_dims_ + extra_inputs_ != input_dims_ || extra_inputs_ > kMaxExtraInputs) return Status::correction_failed;
     for (int e = 0; e < extra_inputs_; ++e) extra_[e] = S(image.extra_input_default[e]);
+    // A payload model's points run in the run-time loop, and cost more.
+    mean_point_units_ = extra_inputs_ > 0 ? Arch::kWorkCosts.run_time_loop_point : 1;
+    gradient_point_units_ = extra_inputs_ > 0 ? Arch::kWorkCosts.run_time_loop_gradient_point : kGradientPointUnits;
+    gradient_granule_ = extra_inputs_ > 0 ? kBlockPoints : kChunkPoints;
     encoding_ = image.encoding;
     for (int d = 0; d < input_dims_; ++d) {
       input_mean_[d] = S(image.input_mean[d]);
@@ -91,6 +95,12 @@ class GpCorrection {
   InputEncoding encoding() const { return encoding_; }
 
   std::uint32_t training_points() const { return training_points_; }
+  // Work units of a point (work_costs.hpp): 1 and kGradientPointUnits, or
+  // the run-time loop's for a payload model.
+  std::uint32_t mean_point_units() const { return mean_point_units_; }
+  std::uint32_t gradient_point_units() const { return gradient_point_units_; }
+  // The fewest units a slice with the gradient needs to advance.
+  std::uint32_t smallest_gradient_slice_units() const { return gradient_granule_ * gradient_point_units_; }
 
   // z = (x - input_mean) / (input_scale * length_scale) for x = encode(bend)
   // followed by the payload: the coordinates the points are stored in
@@ -159,8 +169,11 @@ class GpCorrection {
   // with the gradient; the ragged end only together with the rest); returns
   // the units spent, 0 when not even one block fits.
   std::uint32_t continue_evaluation(Evaluation& evaluation, std::uint32_t max_units) const {
-    const std::uint32_t unit = evaluation.with_gradient ? kGradientPointUnits : 1;
-    const std::uint32_t granule = evaluation.with_gradient ? kChunkPoints : kBlockPoints;
+    // A payload model's gradient goes in blocks rather than chunks, so that
+    // its dearer points still fit a cycle's slice; the sums' order, and so
+    // their bits, are the same.
+    const std::uint32_t unit = evaluation.with_gradient ? gradient_point_units_ : mean_point_units_;
+    const std::uint32_t granule = evaluation.with_gradient ? gradient_granule_ : kBlockPoints;
     const std::uint32_t left = training_points_ - evaluation.next_point;
     const std::uint32_t affordable = max_units / unit;
     std::uint32_t count = left;
@@ -326,7 +339,8 @@ class GpCorrection {
   // training points: one pass computes the chunk's kernel values and the
   // mean's terms (add_point), then one pass per pair of outputs adds
   // alpha_ik r_i z_i for both, so that a pair's 2 D sums stay in registers.
-  // Points [first, first + points): first is a multiple of kChunkPoints.
+  // Points [first, first + points): first is a multiple of kChunkPoints (of
+  // kBlockPoints for a payload model, whose slices go in blocks).
   template <int Dims>
   void accumulate_mean_and_gradient(const S* query, std::uint32_t first_point, std::uint32_t points, Accumulator* sums,
                                     S (&weighted)[kImageOutputs][kMaxInputs]) const {
@@ -410,6 +424,9 @@ class GpCorrection {
   int input_dims_ = 0;
   int bend_dims_ = 0;
   int extra_inputs_ = 0;
+  std::uint32_t mean_point_units_ = 1;
+  std::uint32_t gradient_point_units_ = kGradientPointUnits;
+  std::uint32_t gradient_granule_ = kChunkPoints;
   S extra_[kMaxExtraInputs] = {};
   InputEncoding encoding_ = InputEncoding::bend_vector;
   std::array<S, kMaxInputs> input_mean_{};
