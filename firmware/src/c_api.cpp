@@ -15,9 +15,9 @@
 namespace cdcr::firmware {
 namespace {
 
-// Frames queued between two steps: one cable frame per segment twice over
-// and two targets (three frames each).
-constexpr int kInputQueueDepth = 2 * kMaxSegments + 6;
+// Frames queued between two steps: one cable frame per segment twice over,
+// two targets (three frames each) and a payload.
+constexpr int kInputQueueDepth = 2 * kMaxSegments + 6 + 1;
 constexpr std::uint32_t kInitializedMagic = 0x43444352u;  // "CDCR"
 
 class CallbackClock final : public hal::MonotonicClock {
@@ -216,7 +216,7 @@ namespace firmware = cdcr::firmware;
 namespace protocol = cdcr::firmware::protocol;
 
 static_assert(int(CDCR_STATE_FAULT) == int(firmware::RuntimeState::fault), "states as in fault.hpp");
-static_assert(int(CDCR_FAULT_CAN_FILTERS_REFUSED) == int(firmware::FaultCode::can_filters_refused),
+static_assert(int(CDCR_FAULT_PAYLOAD_INVALID) == int(firmware::FaultCode::payload_invalid),
               "fault codes as in fault.hpp");
 static_assert(int(CDCR_IK_IN_PROGRESS) == int(protocol::IkOutcome::in_progress), "outcomes as in messages.hpp");
 static_assert(int(CDCR_IK_REFUSED_EXTRAPOLATING) == int(protocol::IkOutcome::refused_extrapolating),
@@ -278,6 +278,16 @@ cdcr_result cdcr_set_cable_lengths(cdcr_runtime* runtime, const float* lengths_m
   }
   if (!c->bus.has_room(segments)) return CDCR_ERROR_QUEUE_FULL;
   for (int s = 0; s < segments; ++s) cdcr_set_segment_cable_lengths(runtime, s, lengths_mm + 4 * s);
+  return CDCR_OK;
+}
+
+cdcr_result cdcr_set_payload(cdcr_runtime* runtime, float payload_kg) {
+  CRuntime* c = nullptr;
+  if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
+  cdcr::hal::CanFrame frame;
+  if (!protocol::encode(protocol::Payload{payload_kg}, frame)) return CDCR_ERROR_OUT_OF_RANGE;
+  if (!c->bus.has_room(1)) return CDCR_ERROR_QUEUE_FULL;
+  c->bus.queue(frame);
   return CDCR_OK;
 }
 

@@ -57,7 +57,7 @@ Runtime::Runtime(const hal::Hal& hal, const Geometry& fallback_geometry)
 RuntimeState Runtime::init() {
   state_ = RuntimeState::boot;
   static constexpr hal::CanFilter kFilters[] = {protocol::kCableFeedbackFrames, protocol::kTargetFrames,
-                                                protocol::kUpdateRequestFrames};
+                                                protocol::kPayloadFrames, protocol::kUpdateRequestFrames};
   static_assert(sizeof(kFilters) / sizeof(kFilters[0]) <= kMaxCanFilters, "more filters than a controller must offer");
   // The model update's frames only where there is a flash to write them to.
   const std::size_t filter_count = sizeof(kFilters) / sizeof(kFilters[0]) - (update_.enabled() ? 0 : 1);
@@ -101,6 +101,12 @@ RuntimeState Runtime::init() {
     return state_;
   }
   mode_ = boot_fault_ == FaultCode::none ? RuntimeState::run : RuntimeState::degraded;
+  // A payload received before init stays; otherwise the image's default.
+  if (payload_received_) {
+    correction_.set_payload_kg(payload_kg_);
+  } else {
+    payload_kg_ = correction_.payload_kg();
+  }
   latest_cables_mm_.setZero(4 * geometry_.segment_count);
   model::IkSolverOptions<Scalar> solver_options;
   solver_options.max_corrections = kMaxIkCorrections;
@@ -111,17 +117,24 @@ RuntimeState Runtime::init() {
   // The forward path spends one unit per training point and the overhead,
   // a cycle with a slice of the variance that too; IK gets the rest.
   const bool with_variance = mode_ == RuntimeState::run && uncertainty_.has_variance();
+  // A payload model's points cost more units each (work_costs.hpp), and
+  // IK's smallest step may then be a block of its gradient.
+  const bool compensated = mode_ == RuntimeState::run;
   const std::uint32_t forward_units =
-      kWorkCosts.cycle_overhead + (mode_ == RuntimeState::run ? correction_.training_points() : 0);
-  const auto ik_share = [](std::uint32_t used) {
-    return used + kMinIkUnitsPerCycle < kCycleWorkUnits ? kCycleWorkUnits - used : kMinIkUnitsPerCycle;
+      kWorkCosts.cycle_overhead + (compensated ? correction_.training_points() * correction_.mean_point_units() : 0);
+  const std::uint32_t min_ik_units =
+      compensated && correction_.smallest_gradient_slice_units() > kMinIkUnitsPerCycle
+          ? correction_.smallest_gradient_slice_units()
+          : kMinIkUnitsPerCycle;
+  const auto ik_share = [min_ik_units](std::uint32_t used) {
+    return used + min_ik_units < kCycleWorkUnits ? kCycleWorkUnits - used : min_ik_units;
   };
   ik_units_alone_ = ik_share(forward_units);
   ik_units_beside_variance_ = ik_share(forward_units + (with_variance ? kUncertaintyUnitsPerCycle : 0));
   ik_units_per_cycle_ = ik_units_beside_variance_;
   // A large model leaves no room for a slice beside IK's smallest step:
   // then the variance waits while a target is solved.
-  variance_beside_ik_ = forward_units + kUncertaintyUnitsPerCycle + kMinIkUnitsPerCycle <= kCycleWorkUnits;
+  variance_beside_ik_ = forward_units + kUncertaintyUnitsPerCycle + min_ik_units <= kCycleWorkUnits;
   enter(mode_);
   if (boot_fault_ != FaultCode::none) {
     LogLine line;
@@ -230,6 +243,8 @@ void Runtime::handle_frame(const hal::CanFrame& frame) {
     handle_target_position(frame);
   } else if (protocol::target_position_z::kMessage.carries(frame.id)) {
     handle_target_commit(frame);
+  } else if (protocol::payload::kMessage.carries(frame.id)) {
+    handle_payload(frame);
   } else if (ModelUpdate::carries(frame.id)) {
     update_.handle_frame(frame, cycle_);
   }
@@ -261,6 +276,27 @@ void Runtime::handle_target_orientation(const hal::CanFrame& frame) {
 void Runtime::handle_target_position(const hal::CanFrame& frame) {
   has_pending_position_ = protocol::decode(frame, pending_position_) == protocol::DecodeStatus::ok;
   if (!has_pending_position_) reject_frame(FaultCode::target_malformed);
+}
+
+void Runtime::handle_payload(const hal::CanFrame& frame) {
+  protocol::Payload payload;
+  if (protocol::decode(frame, payload) != protocol::DecodeStatus::ok) {
+    reject_frame(FaultCode::payload_invalid);
+    return;
+  }
+  set_payload_kg(static_cast<Scalar>(payload.payload_kg));
+}
+
+bool Runtime::set_payload_kg(Scalar payload_kg) {
+  const protocol::SignalSpec& signal = protocol::payload::kPayload;
+  if (!(payload_kg >= Scalar(signal.minimum) && payload_kg <= Scalar(signal.maximum))) {  // NaN fails both
+    record_event(FaultCode::payload_invalid);
+    return false;
+  }
+  payload_kg_ = payload_kg;
+  payload_received_ = true;
+  correction_.set_payload_kg(payload_kg);
+  return true;
 }
 
 // A segment's cables are used for a pose until they are stale (the same

@@ -194,6 +194,52 @@ class CApiRuntime : public ::testing::Test {
   cdcr_runtime runtime{};
 };
 
+// cdcr_set_payload: a payload model's pose is the runtime's at that payload
+// from the next step, and a payload the PAYLOAD frame cannot carry (NaN,
+// negative, beyond 50 kg) is refused without changing the one in use.
+TEST_F(CApiRuntime, PayloadReachesThePoseAndBadOnesAreRefused) {
+  test_support::SyntheticModelOptions options;
+  options.payload_input = true;
+  training::TrainedModel m = test_support::synthetic_trained_model(options);
+  for (int k = 0; k < 6; ++k) {
+    m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
+    m.output_scale[k] *= k < 3 ? 0.1 : 0.001;
+  }
+  init(exporting::write_image(m));
+  QuietHal platform(image);
+  Runtime reference(platform.hal(), Geometry::prototype());
+  ASSERT_EQ(reference.init(), RuntimeState::run);
+  const std::vector<float> lengths = bent_cables(reference.geometry());
+  const Cables cables = as_transmitted(lengths);
+  const auto pose_at = [&](float payload_kg) {
+    EXPECT_TRUE(reference.set_payload_kg(payload_kg));
+    PoseEstimate e;
+    EXPECT_EQ(reference.estimate_pose(cables, e), model::Status::ok);
+    return e.pose.position_mm;
+  };
+  step_with(lengths, 2);
+  cdcr_pose pose{};
+  ASSERT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_OK);
+  const model::Vec3<float> at_default = pose_at(0.375f);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(pose.position_mm[i], at_default[i]);
+
+  ASSERT_EQ(cdcr_set_payload(&runtime, 0.75f), CDCR_OK);
+  step_with(lengths);
+  ASSERT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_OK);
+  const model::Vec3<float> loaded = pose_at(0.75f);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(pose.position_mm[i], loaded[i]);
+  EXPECT_GT((loaded - at_default).norm(), 1e-3f);
+
+  for (const float bad : {std::nanf(""), -0.5f, 50.5f, INFINITY}) {
+    EXPECT_EQ(cdcr_set_payload(&runtime, bad), CDCR_ERROR_OUT_OF_RANGE) << bad;
+  }
+  step_with(lengths);
+  ASSERT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_OK);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(pose.position_mm[i], loaded[i]);
+  EXPECT_EQ(cdcr_set_payload(nullptr, 0.5f), CDCR_ERROR_NULL_ARGUMENT);
+  EXPECT_STREQ(cdcr_fault_name(CDCR_FAULT_PAYLOAD_INVALID), "payload invalid");
+}
+
 // A pose target from the C API: solved over steps, setpoints out, and the
 // drives at the setpoints put the tip on the target.
 TEST_F(CApiRuntime, TargetIsSolvedToSetpoints) {
@@ -330,7 +376,7 @@ TEST_F(CApiRuntime, CanCallbacksCarryTheProtocol) {
     return 1;
   };
   ASSERT_EQ(cdcr_init(&runtime, &config), CDCR_OK);
-  EXPECT_EQ(bus.filters_set, 2);
+  EXPECT_EQ(bus.filters_set, 3);  // cable feedback, targets, payload
   EXPECT_EQ(status().fault, CDCR_FAULT_NONE);
 
   // The same lengths as frames on the caller's bus give the same pose as fed.

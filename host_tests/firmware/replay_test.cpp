@@ -106,6 +106,136 @@ TEST(RuntimeReplay, MatchesTheEvaluationsFirmwarePoses) {
   EXPECT_LT(extrapolating, static_cast<int>(replayed.size()));
 }
 
+// The line --replay writes for an estimate, formatted here as the tool
+// formats it.
+std::string replay_line(const training::FirmwareEstimate& e) {
+  Eigen::Quaterniond q(e.pose.rotation);
+  q.normalize();
+  if (q.w() < 0) q.coeffs() *= -1.0;
+  char line[256];
+  std::snprintf(line, sizeof line, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d", e.pose.position_mm.x(),
+                e.pose.position_mm.y(), e.pose.position_mm.z(), q.w(), q.x(), q.y(), q.z(), e.uncertainty.r95_mm,
+                e.uncertainty.r95_deg, e.uncertainty.extrapolating ? 1 : 0);
+  return line;
+}
+
+int run_replay(const std::filesystem::path& dir, const std::string& image, const std::string& cables,
+               const std::string& extra = "") {
+  const std::string command = std::string("\"") + CDCR_RUNTIME_EXE + "\" --image \"" + (dir / image).string() +
+                              "\" --replay \"" + (dir / cables).string() + "\" --out \"" +
+                              (dir / "poses.csv").string() + "\"" + extra;
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// With a payload model and the payload beside the cables in each row, the
+// replay's output is eval's float32 path (training::firmware_estimates with
+// the rows' payloads), line for line and digit for digit; the payload moves
+// the poses (the rows differ from the same cables at the default payload).
+TEST(RuntimeReplay, WithThePayloadInEachRowEqualsTheEvaluationBitForBit) {
+  test_support::SyntheticModelOptions options;
+  options.training_points = 40;
+  options.payload_input = true;
+  training::TrainedModel trained = test_support::synthetic_trained_model(options);
+  trained.signal_variance.setConstant(trained.signal_variance[0]);
+  trained.noise_variance.setConstant(trained.noise_variance[0]);
+  trained.variance = training::fit_variance_factor(trained, trained.inputs,
+                                                   training::variance_points(trained, trained.inputs, 12, 1));
+  trained.variance.extrapolation_variance = 0.5;
+  const std::vector<std::uint8_t> image = exporting::write_image(trained);
+  model::ImageView view;
+  ASSERT_EQ(model::parse_image(image.data(), image.size(), view), model::ImageStatus::ok);
+  ASSERT_EQ(view.extra_inputs, 1);
+  model::RobotGeometry<double> geometry;
+  ASSERT_EQ(model::geometry_from_image(view, geometry), model::Status::ok);
+
+  dataset::Dataset data;
+  data.segment_count = geometry.segment_count;
+  const int samples = 120;
+  data.cables_mm.resize(samples, 4 * geometry.segment_count);
+  data.has_payload = true;
+  data.payload_kg.resize(samples);
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> alpha(-M_PI, M_PI), theta(0.0, 1.2), payload(0.0, 1.0);
+  for (int i = 0; i < samples; ++i) {
+    model::JointVector<double> joints(2 * geometry.segment_count);
+    for (int s = 0; s < geometry.segment_count; ++s) {
+      joints[2 * s] = alpha(rng);
+      joints[2 * s + 1] = theta(rng);
+    }
+    model::CableVector<double> cables;
+    ASSERT_EQ(model::cables_from_joints(joints, geometry, cables), model::Status::ok);
+    data.cables_mm.row(i) = cables.transpose();
+    data.payload_kg[i] = payload(rng);
+  }
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_payload";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream out(dir / "model.img", std::ios::binary);
+    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
+  }
+  dataset::write_dataset_csv((dir / "cables.csv").string(), data);
+  ASSERT_EQ(run_replay(dir, "model.img", "cables.csv"), 0);
+
+  const dataset::Dataset written = dataset::read_dataset_csv((dir / "cables.csv").string());
+  ASSERT_TRUE(written.has_payload);
+  const std::vector<training::FirmwareEstimate> estimates =
+      training::firmware_estimates(view, written.cables_mm, written.payload_kg);
+  // eval's poses are these estimates' poses: the same float32 path.
+  const std::vector<model::Pose<double>> poses =
+      training::firmware_poses(view, written.cables_mm, training::FirmwareAccumulator::float64, written.payload_kg);
+  const std::vector<training::FirmwareEstimate> at_default =
+      training::firmware_estimates(view, written.cables_mm, Eigen::VectorXd::Constant(samples, 0.375));
+  std::ifstream in(dir / "poses.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  std::size_t row = 0;
+  int moved = 0;
+  while (std::getline(in, line)) {
+    ASSERT_LT(row, estimates.size());
+    EXPECT_EQ(line, replay_line(estimates[row])) << "row " << row;
+    EXPECT_EQ(poses[row].position_mm, estimates[row].pose.position_mm) << "row " << row;
+    if (line != replay_line(at_default[row])) ++moved;
+    ++row;
+  }
+  EXPECT_EQ(row, estimates.size());
+  EXPECT_GT(moved, 0.9 * samples);
+}
+
+// A payload image over cables without the column is refused in one line; a
+// model without the input replays a file with the column and says it
+// ignores it.
+TEST(RuntimeReplay, ThePayloadColumnMustMatchTheImage) {
+  test_support::SyntheticModelOptions options;
+  options.payload_input = true;
+  const std::vector<std::uint8_t> payload_image = exporting::write_image(test_support::synthetic_trained_model(options));
+  const std::vector<std::uint8_t> plain_image = exporting::write_image(test_support::synthetic_trained_model());
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_column";
+  std::filesystem::create_directories(dir);
+  for (const auto& [name, bytes] : {std::pair{"payload.img", &payload_image}, std::pair{"plain.img", &plain_image}}) {
+    std::ofstream out(dir / name, std::ios::binary);
+    out.write(reinterpret_cast<const char*>(bytes->data()), static_cast<std::streamsize>(bytes->size()));
+  }
+  { std::ofstream(dir / "plain.csv") << "l1_1,l1_2,l1_3,l1_4,l2_1,l2_2,l2_3,l2_4\n120,120,120,120,95.5,95.5,95.5,95.5\n"; }
+  {
+    std::ofstream(dir / "loaded.csv")
+        << "l1_1,l1_2,l1_3,l1_4,l2_1,l2_2,l2_3,l2_4,payload_kg\n120,120,120,120,95.5,95.5,95.5,95.5,0.5\n";
+  }
+  const std::string err = (dir / "err.txt").string();
+  EXPECT_EQ(run_replay(dir, "payload.img", "plain.csv", " 2>\"" + err + "\""), 1);
+  std::ifstream refused(err);
+  const std::string message((std::istreambuf_iterator<char>(refused)), std::istreambuf_iterator<char>());
+  EXPECT_NE(message.find("the image takes a payload input and the data have no payload_kg column"), std::string::npos)
+      << message;
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+
+  EXPECT_EQ(run_replay(dir, "plain.img", "loaded.csv", " 2>\"" + err + "\""), 0);
+  std::ifstream noted(err);
+  const std::string note((std::istreambuf_iterator<char>(noted)), std::istreambuf_iterator<char>());
+  EXPECT_NE(note.find("the payload_kg column is ignored"), std::string::npos) << note;
+  EXPECT_EQ(run_replay(dir, "payload.img", "loaded.csv"), 0);
+}
+
 TEST(RuntimeReplay, CorruptImageIsOneLineErrorWithExitOne) {
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_bad";
   std::filesystem::create_directories(dir);

@@ -604,7 +604,7 @@ TEST_F(FlashImage, UnknownModelKindOrExtraInputs) {
   const std::pair<std::size_t, std::uint8_t> cases[] = {{image_field::model_kind, 0},
                                                         {image_field::model_kind, 3},
                                                         {image_field::model_kind, 0xFF},
-                                                        {image_field::extra_inputs, 1},
+                                                        {image_field::extra_inputs, 2},
                                                         {image_field::extra_inputs, 0xFF}};
   for (const auto& [offset, value] : cases) {
     Bytes bad = image;
@@ -620,14 +620,62 @@ TEST_F(FlashImage, UnknownModelKindOrExtraInputs) {
   }
 }
 
-// extra_inputs widens D; a parser that accepted it would have to supply the
-// extra input. Both the kind and the header see the damage.
-TEST_F(FlashImage, ExtraInputsWithAWiderInputIsStillUnsupported) {
+// extra_inputs 1 (the payload) widens D by one and the parameters block by
+// its default: a header that says so over a joint-only image's dims or
+// blocks is inconsistent, not unsupported.
+TEST_F(FlashImage, OnePayloadInputNeedsItsDimsAndBlocks) {
   Bytes bad = image;
   bad[image_field::extra_inputs] = 1;
+  reseal(bad);
+  EXPECT_EQ(parse_failing(bad, ImageCheckId::header), ImageStatus::bad_header);
   put<std::uint16_t>(bad, image_field::input_dims, 5);
   reseal(bad);
-  EXPECT_EQ(parse_failing(bad, ImageCheckId::kind), ImageStatus::unsupported_kind);
+  EXPECT_EQ(parse_failing(bad, ImageCheckId::layout), ImageStatus::size_mismatch);
+}
+
+// A payload model: D = 2n + 1, the payload's range among the inputs', and
+// the default payload after input_max.
+TEST_F(FlashImage, PayloadModelRoundTrip) {
+  test_support::SyntheticModelOptions options;
+  options.payload_input = true;
+  const training::TrainedModel payload_model = test_support::synthetic_trained_model(options);
+  const Bytes payload_image = exporting::write_image(payload_model);
+  const ImageLayout expected = image_layout(5, 5, 2, kImageVersionMajor, 0, 1);
+  ASSERT_EQ(payload_image.size(), expected.total_size);
+  // One float more in the parameters than a 5-input model without the payload.
+  EXPECT_EQ(image_parameter_floats(5, kImageVersionMajor, 1), image_parameter_floats(5) + 1);
+  ImageView view{};
+  ASSERT_EQ(parse(payload_image), ImageStatus::ok);
+  ASSERT_EQ(parse_image(payload_image.data(), payload_image.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.extra_inputs, 1);
+  EXPECT_EQ(view.input_dims, 5);
+  EXPECT_EQ(view.segment_count, 2);
+  ASSERT_NE(view.extra_input_default, nullptr);
+  EXPECT_EQ(*view.extra_input_default, 0.375f);
+  EXPECT_EQ(get<std::uint8_t>(payload_image, image_field::extra_inputs), 1);
+  EXPECT_EQ(view.extra_input_default, view.input_max + 5);
+  EXPECT_EQ(view.input_min[4], static_cast<float>(payload_model.inputs.col(4).minCoeff()));
+  EXPECT_EQ(view.input_max[4], static_cast<float>(payload_model.inputs.col(4).maxCoeff()));
+  // An image without the input has no default.
+  ImageView joint_only{};
+  ASSERT_EQ(parse_image(image.data(), image.size(), joint_only), ImageStatus::ok);
+  EXPECT_EQ(joint_only.extra_inputs, 0);
+  EXPECT_EQ(joint_only.extra_input_default, nullptr);
+
+  // A negative default is no mass.
+  Bytes bad = payload_image;
+  const std::size_t default_offset =
+      expected.parameters_offset + 4 * (image_parameter_floats(5, kImageVersionMajor, 1) - 1);
+  put<float>(bad, default_offset, -0.25f);
+  reseal(bad);
+  EXPECT_EQ(parse_failing(bad, ImageCheckId::ranges), ImageStatus::invalid_parameters);
+  put<float>(bad, default_offset, std::numeric_limits<float>::quiet_NaN());
+  reseal(bad);
+  EXPECT_EQ(parse_failing(bad, ImageCheckId::finite), ImageStatus::non_finite_payload);
+  // A build without room for the extra input refuses it.
+  ImageCapacity no_extra;
+  no_extra.max_extra_inputs = 0;
+  EXPECT_EQ(parse_failing(payload_image, ImageCheckId::capacity, no_extra), ImageStatus::over_capacity);
 }
 
 TEST_F(FlashImage, UnsupportedScalarKernelOrEncoding) {

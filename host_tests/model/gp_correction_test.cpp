@@ -278,5 +278,82 @@ TEST_P(GpCorrectionChunks, FloatGradientMatchesCentralDifferences) {
   EXPECT_LT(worst_compensated, 3e-4);
 }
 
+// A model with the payload input: the board's mean against the trainer's
+// double prediction (its own code, not the image's) at the image's default
+// payload and at payloads set afterwards, in double and float; the
+// gradient is d(eps)/d(bend) alone, 6 x 2n, and matches central differences
+// at the set payload.
+class GpCorrectionPayload : public ::testing::TestWithParam<int> {};
+
+INSTANTIATE_TEST_SUITE_P(Segments, GpCorrectionPayload, ::testing::Values(2, 3, 4));
+
+TEST_P(GpCorrectionPayload, TheMeanFollowsThePayloadAsTheTrainerPredictsIt) {
+  const int segments = GetParam();
+  test_support::SyntheticModelOptions options;
+  options.segments = segments;
+  options.training_points = 37;
+  options.payload_input = true;
+  BoundModel b;
+  b.model = test_support::synthetic_trained_model(options);
+  b.image = exporting::write_image(b.model);
+  ASSERT_EQ(parse_image(b.image.data(), b.image.size(), b.view), ImageStatus::ok);
+  ASSERT_EQ(b.view.extra_inputs, 1);
+  ASSERT_EQ(b.view.input_dims, 2 * segments + 1);
+  ASSERT_EQ(*b.view.extra_input_default, 0.375f);
+  GpCorrection<double, double> reference;
+  GpCorrection<float, double> correction;
+  ASSERT_EQ(reference.bind(b.view), Status::ok);
+  ASSERT_EQ(correction.bind(b.view), Status::ok);
+  EXPECT_TRUE(correction.has_payload_input());
+  EXPECT_EQ(correction.bend_dims(), 2 * segments);
+  EXPECT_EQ(correction.payload_kg(), 0.375f);
+
+  std::mt19937 rng(5);
+  for (const double payload_kg : {-1.0, 0.0, 0.45, 1.0}) {  // -1: the default, none set
+    if (payload_kg >= 0.0) {
+      reference.set_payload_kg(payload_kg);
+      correction.set_payload_kg(static_cast<float>(payload_kg));
+    }
+    const double used_kg = payload_kg >= 0.0 ? payload_kg : 0.375;
+    Eigen::MatrixXd bends(12, 2 * segments);
+    for (int q = 0; q < bends.rows(); ++q) bends.row(q) = random_bend(segments, rng).transpose();
+    const Eigen::MatrixXd expected =
+        training::predict_error_twists(b.model, bends, Eigen::VectorXd::Constant(bends.rows(), used_kg));
+    for (int q = 0; q < bends.rows(); ++q) {
+      const JointVector<double> bend = bends.row(q).transpose();
+      Twist<double> eps;
+      Jacobian<double> gradient;
+      ASSERT_EQ(reference(bend, eps, gradient), Status::ok);
+      ASSERT_EQ(gradient.cols(), 2 * segments);
+      const Twist<float> eps_float = correction.predict(bend.cast<float>());
+      for (int k = 0; k < 6; ++k) {
+        const double scale = b.model.output_scale[k] * b.model.signal_variance[k] + std::abs(b.model.output_mean[k]);
+        EXPECT_NEAR(eps[k], expected(q, k), 2e-6 * scale) << "payload " << used_kg << ", query " << q;
+        EXPECT_NEAR(eps_float[k], eps[k], 2e-6 * scale) << "payload " << used_kg << ", query " << q;
+      }
+      constexpr double h = 1e-6;
+      for (int d = 0; d < 2 * segments; ++d) {
+        JointVector<double> plus = bend;
+        JointVector<double> minus = bend;
+        plus[d] += h;
+        minus[d] -= h;
+        const Twist<double> difference = (reference.predict(plus) - reference.predict(minus)) / (2 * h);
+        for (int k = 0; k < 6; ++k) EXPECT_NEAR(gradient(k, d), difference[k], 1e-6 * (1.0 + std::abs(difference[k])));
+      }
+    }
+  }
+  // The payload is an input, not a constant: two payloads, two corrections.
+  const JointVector<double> bend = random_bend(segments, rng);
+  reference.set_payload_kg(0.1);
+  const Twist<double> light = reference.predict(bend);
+  reference.set_payload_kg(0.9);
+  EXPECT_GT((reference.predict(bend) - light).norm(), 1e-3);
+  // A bend vector with the payload's slot is not one.
+  JointVector<double> too_long(2 * segments + 1);
+  too_long.setZero();
+  Twist<double> eps;
+  EXPECT_EQ(reference.value(too_long, eps), Status::correction_failed);
+}
+
 }  // namespace
 }  // namespace cdcr::model

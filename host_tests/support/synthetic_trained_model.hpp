@@ -19,6 +19,8 @@ struct SyntheticModelOptions {
   int segments = 2;
   model::InputEncoding encoding = model::InputEncoding::bend_vector;
   std::uint32_t seed = 20200921;
+  // One more input after the bend pairs: the payload, 0 to 1 kg.
+  bool payload_input = false;
 };
 
 inline training::TrainedModel synthetic_trained_model(const SyntheticModelOptions& options = {}) {
@@ -31,7 +33,7 @@ inline training::TrainedModel synthetic_trained_model(const SyntheticModelOption
   m.geometry.segments[options.segments - 1].backbone_length_mm = 95.5;  // not all segments alike
 
   const int n = options.training_points;
-  const int d = 2 * options.segments;
+  const int d = 2 * options.segments + (options.payload_input ? 1 : 0);
   m.inputs.resize(n, d);
   for (int i = 0; i < n; ++i) {
     for (int s = 0; s < options.segments; ++s) {
@@ -45,7 +47,9 @@ inline training::TrainedModel synthetic_trained_model(const SyntheticModelOption
         m.inputs(i, 2 * s + 1) = theta_rad;
       }
     }
+    if (options.payload_input) m.inputs(i, d - 1) = uniform(0.0, 1.0);
   }
+  if (options.payload_input) m.default_payload_kg = 0.375;
   m.input_mean = m.inputs.colwise().mean().transpose();
   m.input_scale.resize(d);
   m.length_scales.resize(d);

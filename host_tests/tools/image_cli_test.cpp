@@ -305,7 +305,7 @@ class ImageReportDamage : public ImageCli, public ::testing::WithParamInterface<
       put<std::uint32_t>(bad, variance_offset, layout.metadata_offset);
     }
     if (name == "model_kind") bad[model_kind] = 3;
-    if (name == "extra_inputs") bad[extra_inputs] = 1;
+    if (name == "extra_inputs") bad[extra_inputs] = 2;  // one is the payload input
     if (name == "dims") put<std::uint16_t>(bad, input_dims, 3);
     if (name == "offset_alignment") put<std::uint32_t>(bad, alpha_offset, layout.alpha_offset + 4);
     if (name == "checksum") bad[layout.inputs_offset] ^= 1;

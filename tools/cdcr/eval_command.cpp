@@ -56,13 +56,22 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     throw InputError(fmt::format("{} has {} segments but the model has {}", o.data_path, data.segment_count,
                                  geometry.segment_count));
   }
+  // A payload model needs the column; a model without the input runs on
+  // the cables alone and the column is ignored (the output says so).
+  const bool payload_input = image.view.extra_inputs > 0;
+  if (payload_input && !data.has_payload) {
+    throw InputError(fmt::format("{}: the model takes a payload input and the data have no payload_kg column",
+                                 o.data_path));
+  }
+  const char* payload_use = payload_input ? "used" : (data.has_payload ? "ignored" : "none");
   training::TrainingSet set;
   std::vector<model::Pose<double>> compensated;
   std::vector<training::FirmwareEstimate> estimates;
   try {
-    set = training::make_training_set(data, geometry, image.view.encoding);
-    compensated = training::firmware_poses(image.view, set.cables_mm);
-    estimates = training::firmware_estimates(image.view, set.cables_mm);
+    set = training::make_training_set(data, geometry, image.view.encoding, payload_input);
+    compensated = training::firmware_poses(image.view, set.cables_mm, training::FirmwareAccumulator::float64,
+                                           set.payload_kg);
+    estimates = training::firmware_estimates(image.view, set.cables_mm, set.payload_kg);
   } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
   }
@@ -81,6 +90,7 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     j["compensated"] = {{"position_mm", after.position_mm}, {"orientation_deg", after.orientation_deg}};
     j["extrapolating"] = coverage.extrapolating;
     j["outside_range"] = coverage.outside_range;
+    j["payload"] = payload_use;
     if (has_variance) {
       j["coverage"] = {{"r95_mm", coverage.position_coverage},
                        {"r95_deg", coverage.orientation_coverage},
@@ -107,6 +117,11 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     }
     output.text += fmt::format("  extrapolating        {} of {} samples ({} outside the fitted input range)\n",
                                coverage.extrapolating, set.size(), coverage.outside_range);
+    if (data.has_payload && !payload_input) {
+      output.text += "  payload              the payload_kg column is ignored: the model has no payload input\n";
+    } else if (payload_input) {
+      output.text += "  payload              each sample's payload_kg is the model's payload input\n";
+    }
   }
   return output;
 }

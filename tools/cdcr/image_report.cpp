@@ -387,7 +387,9 @@ ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
     const std::uint64_t n = h.training_points;
     const std::uint64_t d = h.input_dims;
     const std::uint64_t segments = h.segment_count;
-    const std::uint64_t parameter_floats = (v1 ? 3 : 5) * d + 4 * model::kImageOutputs;
+    const std::uint64_t extra = v1 ? 0 : h.extra_inputs;
+    const std::uint64_t parameter_floats = model::image_parameter_floats(
+        static_cast<std::uint32_t>(d), h.version_major, static_cast<std::uint32_t>(extra));
     const std::uint64_t offsets[] = {h.geometry_offset, h.parameters_offset, h.inputs_offset, h.alpha_offset,
                                      h.metadata_offset};
     const std::uint64_t block_sizes[] = {12 * segments, 4 * parameter_floats, 4 * n * d, 4 * n * model::kImageOutputs,
@@ -428,6 +430,7 @@ ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
       if (!v1) {
         p.input_min = slice(3 * d + 24, d);
         p.input_max = slice(4 * d + 24, d);
+        p.extra_input_default = slice(5 * d + 24, extra);
       }
       r.parameters = std::move(p);
     }

@@ -71,6 +71,7 @@ struct ImageParameters {
   std::vector<float> output_mean, output_scale;                    // 6 each
   std::vector<float> signal_variance, noise_variance;              // 6 each
   std::vector<float> input_min, input_max;                         // D each, v2; empty for v1
+  std::vector<float> extra_input_default;                          // extra_inputs: the default payload (kg)
 };
 
 struct ImageMetadata {

@@ -58,7 +58,9 @@ bool is_sparse(const ImageHeaderFields& h) {
   return model_kind_code(h) == static_cast<std::uint8_t>(model::ImageModelKind::sparse_gp);
 }
 
-std::string input_name(std::uint8_t encoding, std::size_t dim) {
+std::string input_name(const ImageHeaderFields& h, std::size_t dim) {
+  const std::uint8_t encoding = h.input_encoding;
+  if (dim >= std::size_t{2} * h.segment_count) return "payload (kg)";
   const std::size_t segment = dim / 2 + 1;
   if (encoding == static_cast<std::uint8_t>(model::InputEncoding::joint_angles)) {
     return fmt::format("{}_{} (rad)", dim % 2 == 0 ? "alpha" : "theta", segment);
@@ -150,11 +152,14 @@ std::string format_text(const std::string& path, const ImageReport& r) {
     t += fmt::format("  {:<16}{:>16}{:>16}{:>16}", "input", "mean", "scale", "length scale");
     t += ranges ? fmt::format("{:>16}{:>16}\n", "min", "max") : "\n";
     for (std::size_t i = 0; i < p.input_mean.size() && i < kMaxListedRows; ++i) {
-      t += fmt::format("  {:<16}{:>16}{:>16}{:>16}", input_name(r.header->input_encoding, i), p.input_mean[i],
+      t += fmt::format("  {:<16}{:>16}{:>16}{:>16}", input_name(*r.header, i), p.input_mean[i],
                        p.input_scale[i], p.length_scale[i]);
       t += ranges ? fmt::format("{:>16}{:>16}\n", p.input_min[i], p.input_max[i]) : "\n";
     }
     if (p.input_mean.size() > kMaxListedRows) t += fmt::format("  ({} more not listed)\n", p.input_mean.size() - kMaxListedRows);
+    if (!p.extra_input_default.empty()) {
+      t += fmt::format("default payload (until the runtime receives one): {} kg\n", p.extra_input_default[0]);
+    }
     t += "outputs, error twist (v, omega) (y = mean + scale y_n; variances in normalised units)\n";
     t += fmt::format("  {:<16}{:>16}{:>16}{:>16}{:>16}\n", "output", "mean", "scale", "signal var", "noise var");
     for (std::size_t k = 0; k < 6; ++k) {
@@ -311,10 +316,12 @@ Json format_json(const std::string& path, const ImageReport& r) {
     j["input_range"] = p.input_min.empty()
                            ? Json(nullptr)
                            : Json{{"input_min", floats_json(p.input_min)}, {"input_max", floats_json(p.input_max)}};
+    j["default_payload_kg"] = p.extra_input_default.empty() ? Json(nullptr) : Json(p.extra_input_default[0]);
   } else {
     j["normalisation"] = nullptr;
     j["hyperparameters"] = nullptr;
     j["input_range"] = nullptr;
+    j["default_payload_kg"] = nullptr;
   }
   j["training_set"] = {{"max_abs_kernel_coordinate", r.max_abs_input ? float_json(*r.max_abs_input) : Json(nullptr)},
                        {"max_abs_alpha", r.max_abs_alpha ? float_json(*r.max_abs_alpha) : Json(nullptr)}};

@@ -33,6 +33,7 @@ struct TrainCommandOptions {
   GeometryOptions geometry;
   TrainingFlags training;
   bool calibrate = false;
+  bool ignore_payload = false;
   bool json = false;
 };
 
@@ -75,10 +76,17 @@ CommandOutput run_train(const TrainCommandOptions& o) {
   const auto build_sets = [&](const model::RobotGeometry<double>& g) {
     Sets sets;
     try {
-      sets.all = training::make_training_set(data, g, options.encoding);
+      const bool with_payload = !o.ignore_payload;
+      sets.all = training::make_training_set(data, g, options.encoding, with_payload);
       if (!o.validation_path.empty()) {
         sets.train = sets.all;
-        sets.validation = training::make_training_set(load_dataset(o.validation_path, true), g, options.encoding);
+        sets.validation =
+            training::make_training_set(load_dataset(o.validation_path, true), g, options.encoding, with_payload);
+        if (sets.validation.has_payload() != sets.all.has_payload()) {
+          throw InputError(fmt::format("{} {} a payload_kg column and {} {}", o.data_path,
+                                       sets.all.has_payload() ? "has" : "has no", o.validation_path,
+                                       sets.validation.has_payload() ? "has" : "has none"));
+        }
       } else if (o.holdout == 0) {
         sets.train = sets.all;
       } else {
@@ -166,6 +174,8 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     }
     j["calibration_skipped"] = calibration_skipped.empty() ? Json(nullptr) : Json(calibration_skipped);
     j["encoding"] = model::to_string(m.encoding);
+    j["payload_input"] = m.has_payload_input();
+    j["default_payload_kg"] = m.has_payload_input() ? Json(m.default_payload_kg) : Json(nullptr);
     j["kernel"] = o.training.kernel;
     j["length_scales"] = std::vector<double>(m.length_scales.data(), m.length_scales.data() + m.length_scales.size());
     j["signal_variance"] = m.signal_variance[0];
@@ -223,6 +233,13 @@ CommandOutput run_train(const TrainCommandOptions& o) {
     }
     t += fmt::format("  encoding {}, kernel {} squared exponential, hyperparameters shared by the 6 outputs\n",
                      model::to_string(m.encoding), o.training.kernel);
+    if (m.has_payload_input()) {
+      t += fmt::format("  inputs: the bend vector and the payload (the last length scale; {:.3f} kg until the "
+                       "runtime receives one)\n",
+                       m.default_payload_kg);
+    } else if (data.has_payload) {
+      t += "  inputs: the bend vector; the payload_kg column is ignored (--ignore-payload)\n";
+    }
     t += "  length scales (normalised inputs):";
     for (Eigen::Index i = 0; i < m.length_scales.size(); ++i) t += fmt::format(" {:.4g}", m.length_scales[i]);
     t += fmt::format("\n  signal variance {:.4g}, noise variance {:.4g} (normalised outputs)\n",
@@ -291,6 +308,8 @@ void register_train_command(CLI::App& app, CommandOutput& output) {
                     "before the GP, and ship the calibrated geometry in the image");
   add_geometry_options(*command, o->geometry, "Number of segments (default: from the dataset's cable columns)");
   add_training_flags(*command, o->training);
+  command->add_flag("--ignore-payload", o->ignore_payload,
+                    "Train on the cables alone even when the data have a payload_kg column");
   command->add_flag("--json", o->json, "Print one JSON object");
   command->callback([o, &output] { output = run_train(*o); });
 }

@@ -43,7 +43,8 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   const int n = model.training_points();
   const int d = model.input_dims();
   const int segments = model.geometry.segment_count;
-  if (n < 1 || d != 2 * segments || model.alpha.rows() != n || model.alpha.cols() != model::kImageOutputs ||
+  const int extra = d - 2 * segments;  // 1: the payload input
+  if (n < 1 || extra < 0 || extra > model::kMaxExtraInputs || model.alpha.rows() != n || model.alpha.cols() != model::kImageOutputs ||
       model.input_mean.size() != d || model.input_scale.size() != d || model.length_scales.size() != d) {
     throw std::invalid_argument("trained model has inconsistent dimensions");
   }
@@ -73,7 +74,7 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   const model::ImageLayout layout =
       model::image_layout(static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(d),
                           static_cast<std::uint32_t>(segments), model::kImageVersionMajor,
-                          static_cast<std::uint32_t>(rank));
+                          static_cast<std::uint32_t>(rank), static_cast<std::uint32_t>(extra));
   ImageBuffer image(layout.total_size);
 
   image.put<std::uint32_t>(magic, model::kImageMagic);
@@ -89,7 +90,7 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   image.put<std::uint8_t>(kernel_kind, static_cast<std::uint8_t>(model::ImageKernel::squared_exponential_ard));
   image.put<std::uint8_t>(input_encoding, static_cast<std::uint8_t>(model.encoding));
   image.put<std::uint8_t>(model_kind, static_cast<std::uint8_t>(model.kind));
-  image.put<std::uint8_t>(extra_inputs, 0);  // the joint encoding only
+  image.put<std::uint8_t>(extra_inputs, static_cast<std::uint8_t>(extra));
   image.put<std::uint32_t>(geometry_offset, layout.geometry_offset);
   image.put<std::uint32_t>(parameters_offset, layout.parameters_offset);
   image.put<std::uint32_t>(inputs_offset, layout.inputs_offset);
@@ -129,6 +130,7 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
     put_all(Eigen::VectorXd(model.inputs.colwise().minCoeff().transpose()));
     put_all(Eigen::VectorXd(model.inputs.colwise().maxCoeff().transpose()));
   }
+  if (extra > 0) put_all(Eigen::VectorXd::Constant(1, model.default_payload_kg));
 
   // Training inputs go in as kernel coordinates, computed in double and
   // rounded once.

@@ -72,11 +72,26 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
     throw InputError(cables_path + ": " + std::to_string(data.segment_count) + " segments, the image has " +
                      std::to_string(runtime.geometry().segment_count));
   }
+  // A payload model takes each row's payload as if it had come in a PAYLOAD
+  // frame with the row's cables; a model without the input ignores the column.
+  const bool payload_input = runtime.correction().has_payload_input();
+  if (payload_input && !data.has_payload) {
+    throw InputError(cables_path + ": the image takes a payload input and the data have no payload_kg column");
+  }
+  if (!payload_input && data.has_payload) {
+    std::fprintf(stderr, "note: %s: the payload_kg column is ignored: the image has no payload input\n",
+                 cables_path.c_str());
+  }
   std::FILE* out = std::fopen(out_path.c_str(), "w");
   if (out == nullptr) throw InputError("cannot write " + out_path);
   std::fprintf(out, "x,y,z,qw,qx,qy,qz,r95_mm,r95_deg,extrapolating\n");
   for (Eigen::Index i = 0; i < data.cables_mm.rows(); ++i) {
     const fw::Cables cables = data.cables_mm.row(i).transpose().cast<float>();
+    if (payload_input && !runtime.set_payload_kg(static_cast<float>(data.payload_kg[i]))) {
+      std::fclose(out);
+      throw InputError(cables_path + ": sample " + std::to_string(i + 1) + ": payload " +
+                       std::to_string(data.payload_kg[i]) + " kg is beyond what the PAYLOAD frame carries");
+    }
     fw::PoseEstimate estimate;
     if (const model::Status s = runtime.estimate_pose(cables, estimate); s != model::Status::ok) {
       std::fclose(out);

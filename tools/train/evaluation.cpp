@@ -53,7 +53,14 @@ namespace {
 
 // The firmware's path with the given accumulator: pose, radii and flags.
 template <typename Accumulator>
-std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
+std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
+                                             const Eigen::VectorXd& payload_kg) {
+  if (image.extra_inputs > 0 && payload_kg.size() == 0) {
+    throw std::invalid_argument("the model takes a payload input and the data have no payload_kg column");
+  }
+  if (image.extra_inputs > 0 && payload_kg.size() != cables_mm.rows()) {
+    throw std::invalid_argument("one payload per sample is needed");
+  }
   model::RobotGeometry<float> geometry;
   if (const model::Status s = model::geometry_from_image(image, geometry); s != model::Status::ok) {
     throw std::invalid_argument(std::string("image geometry: ") + model::to_string(s));
@@ -70,6 +77,7 @@ std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, cons
   estimates.reserve(static_cast<std::size_t>(cables_mm.rows()));
   for (Eigen::Index i = 0; i < cables_mm.rows(); ++i) {
     const model::CableVector<float> cables = cables_mm.row(i).transpose().cast<float>();
+    if (image.extra_inputs > 0) correction.set_payload_kg(static_cast<float>(payload_kg[i]));
     model::ForwardResult<float> result;
     if (const model::Status s = model::compensated_forward(cables, geometry, correction, result);
         s != model::Status::ok) {
@@ -91,29 +99,31 @@ std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, cons
 }
 
 template <typename Accumulator>
-std::vector<model::Pose<double>> firmware_poses_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
+std::vector<model::Pose<double>> firmware_poses_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
+                                                     const Eigen::VectorXd& payload_kg) {
   std::vector<model::Pose<double>> poses;
-  for (const FirmwareEstimate& e : estimates_with<Accumulator>(image, cables_mm)) poses.push_back(e.pose);
+  for (const FirmwareEstimate& e : estimates_with<Accumulator>(image, cables_mm, payload_kg)) poses.push_back(e.pose);
   return poses;
 }
 
 }  // namespace
 
 std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
-                                                FirmwareAccumulator accumulator) {
+                                                FirmwareAccumulator accumulator, const Eigen::VectorXd& payload_kg) {
   switch (accumulator) {
     case FirmwareAccumulator::compensated_float32:
-      return firmware_poses_with<model::CompensatedFloat>(image, cables_mm);
+      return firmware_poses_with<model::CompensatedFloat>(image, cables_mm, payload_kg);
     case FirmwareAccumulator::float32:
-      return firmware_poses_with<float>(image, cables_mm);
+      return firmware_poses_with<float>(image, cables_mm, payload_kg);
     case FirmwareAccumulator::float64:
       break;
   }
-  return firmware_poses_with<double>(image, cables_mm);
+  return firmware_poses_with<double>(image, cables_mm, payload_kg);
 }
 
-std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm) {
-  return estimates_with<double>(image, cables_mm);
+std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
+                                                const Eigen::VectorXd& payload_kg) {
+  return estimates_with<double>(image, cables_mm, payload_kg);
 }
 
 CoverageCheck check_coverage(const std::vector<model::Pose<double>>& measured,

@@ -42,9 +42,13 @@ enum class FirmwareAccumulator {
 const char* to_string(FirmwareAccumulator accumulator);
 
 // The firmware's forward path in float32 (model::compensated_forward on the
-// parsed image) over the samples' commanded cables.
+// parsed image) over the samples' commanded cables. An image with the
+// payload input takes each sample's payload_kg, set on the correction before
+// the sample as the runtime sets a received one (throws
+// std::invalid_argument when there are none); other images ignore them.
 std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
-                                                FirmwareAccumulator accumulator = FirmwareAccumulator::float64);
+                                                FirmwareAccumulator accumulator = FirmwareAccumulator::float64,
+                                                const Eigen::VectorXd& payload_kg = {});
 
 struct Fidelity {
   double max_position_mm = 0.0;
@@ -59,7 +63,8 @@ struct FirmwareEstimate {
   model::Pose<double> pose;
   model::PoseUncertainty<double> uncertainty;
 };
-std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm);
+std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
+                                                const Eigen::VectorXd& payload_kg = {});
 
 // How well the radii describe measured poses: the share of samples whose
 // measured position lies within r95_mm of the compensated one (and the

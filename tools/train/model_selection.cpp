@@ -15,7 +15,8 @@ namespace {
 
 std::uint32_t image_bytes(int points, int input_dims, int segments, std::uint32_t variance_rank) {
   return model::image_layout(static_cast<std::uint32_t>(points), static_cast<std::uint32_t>(input_dims),
-                             static_cast<std::uint32_t>(segments), model::kImageVersionMajor, variance_rank)
+                             static_cast<std::uint32_t>(segments), model::kImageVersionMajor, variance_rank,
+                             static_cast<std::uint32_t>(input_dims - 2 * segments))
       .total_size;
 }
 
@@ -45,8 +46,9 @@ ModelSelection select_model(int rows, int input_dims, int segments, ModelChoice 
   const int by_flash =
       points_within_flash(input_dims, segments, limits.variance_rank, limits.flash_budget_bytes, capacity);
   const bool with_variance = limits.variance_rank > 0;
-  const int by_cycle =
-      static_cast<int>(limits.forward_cycle.points_within(limits.forward_cycle_instructions, with_variance));
+  const int extra_inputs = input_dims - 2 * segments;
+  const int by_cycle = static_cast<int>(
+      limits.forward_cycle.points_within(limits.forward_cycle_instructions, with_variance, extra_inputs));
   const int largest = std::min({capacity, by_flash, by_cycle});
   // The tightest of the three limits, in words.
   std::string limit;
@@ -95,7 +97,8 @@ ModelSelection select_model(int rows, int input_dims, int segments, ModelChoice 
     }
   }
   s.image_bytes = image_bytes(s.points, input_dims, segments, limits.variance_rank);
-  s.forward_cycle_instructions = limits.forward_cycle.for_points(static_cast<std::uint32_t>(s.points), with_variance);
+  s.forward_cycle_instructions =
+      limits.forward_cycle.for_points(static_cast<std::uint32_t>(s.points), with_variance, extra_inputs);
   return s;
 }
 

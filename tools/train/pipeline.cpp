@@ -99,17 +99,18 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   };
   add_variance(searched, train_set);
   if (validation_set.size() > 0) {
-    const Eigen::MatrixXd predicted = predict_error_twists(searched, validation_set.bends);
+    const Eigen::MatrixXd predicted = predict_error_twists(searched, validation_set.bends, validation_set.payload_kg);
     r.validation = evaluate(validation_set, predicted);
     const std::vector<std::uint8_t> image = exporting::write_image(searched);
     r.firmware.samples = validation_set.size();
     r.firmware.initial = r.validation.initial;
     r.firmware.compensated = mean_errors(
         validation_set.measured,
-        firmware_poses(parsed(image), validation_set.cables_mm, FirmwareAccumulator::float64));
+        firmware_poses(parsed(image), validation_set.cables_mm, FirmwareAccumulator::float64,
+                       validation_set.payload_kg));
     if (searched.variance.rank() > 0) {
       r.validation_coverage =
-          check_coverage(validation_set.measured, firmware_estimates(parsed(image), validation_set.cables_mm));
+          check_coverage(validation_set.measured, firmware_estimates(parsed(image), validation_set.cables_mm, validation_set.payload_kg));
     }
   }
 
@@ -128,12 +129,12 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   // write the final one with the figures; the payload is identical.
   const TrainingSet& fidelity_set = r.validation.samples > 0 ? validation_set : fitted_set;
   const std::vector<model::Pose<double>> double_poses =
-      compensated_poses(fidelity_set, predict_error_twists(r.model, fidelity_set.bends));
+      compensated_poses(fidelity_set, predict_error_twists(r.model, fidelity_set.bends, fidelity_set.payload_kg));
   const std::vector<std::uint8_t> first_image = exporting::write_image(r.model);
   const model::ImageView view = parsed(first_image);
   for (const FirmwareAccumulator accumulator :
        {FirmwareAccumulator::float64, FirmwareAccumulator::compensated_float32, FirmwareAccumulator::float32}) {
-    const std::vector<model::Pose<double>> float_poses = firmware_poses(view, fidelity_set.cables_mm, accumulator);
+    const std::vector<model::Pose<double>> float_poses = firmware_poses(view, fidelity_set.cables_mm, accumulator, fidelity_set.payload_kg);
     const Fidelity f = compare_poses(double_poses, float_poses);
     r.fidelity_by_accumulator.emplace_back(accumulator, f);
     if (accumulator == FirmwareAccumulator::float32) continue;  // no firmware build sums this way

@@ -55,6 +55,9 @@ struct TrainedModel {
   // `inputs`, which is the fitted rows' for an exact model.
   Eigen::VectorXd input_min, input_max;
   VarianceFactor variance;
+  // The payload the board uses until one arrives (a payload model only):
+  // the mean over the fitted rows.
+  double default_payload_kg = 0.0;
 
   // Metadata carried into the image.
   std::uint64_t dataset_hash = 0;
@@ -65,6 +68,9 @@ struct TrainedModel {
 
   int training_points() const { return static_cast<int>(inputs.rows()); }  // the points, N or M
   int input_dims() const { return static_cast<int>(inputs.cols()); }
+  // Inputs after the bend pairs: 1 when the model takes the payload.
+  int extra_inputs() const { return input_dims() - 2 * geometry.segment_count; }
+  bool has_payload_input() const { return extra_inputs() > 0; }
 
   // Records the range of the rows the model is fitted on (rows x D, raw).
   void set_input_range(const Eigen::MatrixXd& fitted_inputs) {

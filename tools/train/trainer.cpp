@@ -32,6 +32,7 @@ TrainedModel packaged(const TrainingSet& set, const model::RobotGeometry<double>
   m.output_scale = n.output_scale;
   m.inputs = set.inputs;
   m.set_input_range(set.inputs);
+  if (set.has_payload()) m.default_payload_kg = set.payload_kg.mean();
   return m;
 }
 
@@ -159,6 +160,7 @@ TrainedModel refit(const TrainedModel& model, ModelKind kind, const TrainingSet&
   const Eigen::MatrixXd y = normalise(set.error_twists, model.output_mean, model.output_scale);
   TrainedModel refitted = model;
   refitted.set_input_range(set.inputs);
+  if (set.has_payload()) refitted.default_payload_kg = set.payload_kg.mean();
   refitted.fitted_rows = static_cast<std::uint32_t>(set.size());
   if (kind == ModelKind::exact) {
     refitted.kind = model::ImageModelKind::exact_gp;
@@ -174,8 +176,18 @@ TrainedModel refit(const TrainedModel& model, ModelKind kind, const TrainingSet&
   return refitted;
 }
 
-Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends) {
-  const Eigen::MatrixXd x = normalise(encode_rows(bends, model.encoding), model.input_mean, model.input_scale);
+namespace {
+// The model's inputs for these rows: the payload only if the model takes it.
+Eigen::MatrixXd inputs_for(const TrainedModel& model, const Eigen::MatrixXd& bends, const Eigen::VectorXd& payload_kg) {
+  if (!model.has_payload_input()) return encode_rows(bends, model.encoding);
+  if (payload_kg.size() == 0) throw std::invalid_argument("the model takes a payload input and the rows have none");
+  return model_inputs(bends, payload_kg, model.encoding);
+}
+}  // namespace
+
+Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends,
+                                     const Eigen::VectorXd& payload_kg) {
+  const Eigen::MatrixXd x = normalise(inputs_for(model, bends, payload_kg), model.input_mean, model.input_scale);
   const Eigen::MatrixXd train_x = normalise(model.inputs, model.input_mean, model.input_scale);
   Eigen::MatrixXd y(x.rows(), 6);
   for (int k = 0; k < 6; ++k) {
@@ -209,9 +221,9 @@ Compensator fit_compensator(const TrainingSet& set, const model::RobotGeometry<d
   return c;
 }
 
-Eigen::MatrixXd Compensator::predict(const Eigen::MatrixXd& bends) const {
-  if (sharing == HyperparameterSharing::shared) return predict_error_twists(shared, bends);
-  const Eigen::MatrixXd x = normalise(encode_rows(bends, shared.encoding), shared.input_mean, shared.input_scale);
+Eigen::MatrixXd Compensator::predict(const Eigen::MatrixXd& bends, const Eigen::VectorXd& payload_kg) const {
+  if (sharing == HyperparameterSharing::shared) return predict_error_twists(shared, bends, payload_kg);
+  const Eigen::MatrixXd x = normalise(inputs_for(shared, bends, payload_kg), shared.input_mean, shared.input_scale);
   Eigen::MatrixXd y(x.rows(), 6);
   for (int k = 0; k < 6; ++k) y.col(k) = per_output[k].predict(x);
   return (y.array().rowwise() * shared.output_scale.transpose().array()).rowwise() +

@@ -78,8 +78,12 @@ TrainedModel refit(const TrainedModel& model, ModelKind kind, const TrainingSet&
 // `iterations` of Lloyd's algorithm (a centre with no rows stays put).
 Eigen::MatrixXd inducing_inputs(const Eigen::MatrixXd& x, int m, int iterations, std::uint64_t seed);
 
-// Double-precision error twists (rows, (v, omega)) for stacked bend vectors.
-Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends);
+// Double-precision error twists (rows, (v, omega)) for stacked bend vectors
+// and, for a model with the payload input, their payloads (throws
+// std::invalid_argument when such a model gets none; a model without the
+// input ignores them).
+Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends,
+                                     const Eigen::VectorXd& payload_kg = {});
 
 // A fitted compensator of either sharing mode, for measurements that compare
 // them; only the shared one can be exported.
@@ -89,7 +93,7 @@ struct Compensator {
   // per_output: the normalisation is in `shared`, the six GPs here.
   std::vector<GaussianProcess> per_output;
 
-  Eigen::MatrixXd predict(const Eigen::MatrixXd& bends) const;
+  Eigen::MatrixXd predict(const Eigen::MatrixXd& bends, const Eigen::VectorXd& payload_kg = {}) const;
 };
 
 Compensator fit_compensator(const TrainingSet& set, const model::RobotGeometry<double>& geometry,

@@ -14,11 +14,13 @@ TrainingSet TrainingSet::subset(const std::vector<int>& rows) const {
   s.cables_mm.resize(n, cables_mm.cols());
   s.bends.resize(n, bends.cols());
   s.inputs.resize(n, inputs.cols());
+  if (has_payload()) s.payload_kg.resize(n);
   s.error_twists.resize(n, 6);
   for (Eigen::Index i = 0; i < n; ++i) {
     s.cables_mm.row(i) = cables_mm.row(rows[i]);
     s.bends.row(i) = bends.row(rows[i]);
     s.inputs.row(i) = inputs.row(rows[i]);
+    if (has_payload()) s.payload_kg[i] = payload_kg[rows[i]];
     s.error_twists.row(i) = error_twists.row(rows[i]);
     s.nominal.push_back(nominal[rows[i]]);
     s.measured.push_back(measured[rows[i]]);
@@ -37,8 +39,18 @@ Eigen::MatrixXd encode_rows(const Eigen::MatrixXd& bends, model::InputEncoding e
   return inputs;
 }
 
+Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::VectorXd& payload_kg,
+                             model::InputEncoding encoding) {
+  if (payload_kg.size() == 0) return encode_rows(bends, encoding);
+  if (payload_kg.size() != bends.rows()) throw std::invalid_argument("one payload per row is needed");
+  Eigen::MatrixXd inputs(bends.rows(), bends.cols() + 1);
+  inputs.leftCols(bends.cols()) = encode_rows(bends, encoding);
+  inputs.col(bends.cols()) = payload_kg;
+  return inputs;
+}
+
 TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGeometry<double>& geometry,
-                              model::InputEncoding encoding) {
+                              model::InputEncoding encoding, bool with_payload) {
   if (!data.has_poses) throw std::invalid_argument("dataset has no measured poses (x,y,z,qw,qx,qy,qz columns)");
   if (data.segment_count != geometry.segment_count) {
     throw std::invalid_argument("dataset has " + std::to_string(data.segment_count) + " segments, geometry has " +
@@ -63,7 +75,8 @@ TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGe
     s.nominal.push_back(nominal);
     s.measured.push_back(data.poses[i]);
   }
-  s.inputs = encode_rows(s.bends, encoding);
+  if (data.has_payload && with_payload) s.payload_kg = data.payload_kg;
+  s.inputs = model_inputs(s.bends, s.payload_kg, encoding);
   return s;
 }
 

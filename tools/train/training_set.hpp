@@ -1,7 +1,9 @@
 #pragma once
 // Turns a measured dataset into GP training pairs: inputs are the encoded
 // joint variables of each sample (nominal inverse of the commanded cables),
-// outputs the tip error twists of eq. (18), ordered (v, omega).
+// outputs the tip error twists of eq. (18), ordered (v, omega). A dataset
+// with a payload column gives one more input, the payload (kg), after the
+// encoded joints.
 
 #include <vector>
 
@@ -17,22 +19,30 @@ namespace cdcr::training {
 struct TrainingSet {
   Eigen::MatrixXd cables_mm;     // samples x 4n, as commanded
   Eigen::MatrixXd bends;         // samples x 2n, stacked bend vectors
-  Eigen::MatrixXd inputs;        // samples x D, encoded
+  Eigen::VectorXd payload_kg;    // samples, or empty: the data carried no payload column
+  Eigen::MatrixXd inputs;        // samples x D, encoded (and the payload last, when there is one)
   Eigen::MatrixXd error_twists;  // samples x 6
   std::vector<model::Pose<double>> nominal;
   std::vector<model::Pose<double>> measured;
 
   int size() const { return static_cast<int>(inputs.rows()); }
+  bool has_payload() const { return payload_kg.size() > 0; }
   TrainingSet subset(const std::vector<int>& rows) const;
 };
 
 // Throws std::invalid_argument naming the sample (1-based data row) whose
 // cables the nominal model rejects, or if the dataset has no poses or a
-// segment count other than the geometry's.
+// segment count other than the geometry's. The payload column, when the
+// dataset has one, becomes an input unless with_payload is false.
 TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGeometry<double>& geometry,
-                              model::InputEncoding encoding);
+                              model::InputEncoding encoding, bool with_payload = true);
 
 // Encoded GP inputs for stacked bend vectors (rows).
 Eigen::MatrixXd encode_rows(const Eigen::MatrixXd& bends, model::InputEncoding encoding);
+
+// The GP inputs: the encoded bends, then the payload column when payload_kg
+// is not empty (one value per row).
+Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::VectorXd& payload_kg,
+                             model::InputEncoding encoding);
 
 }  // namespace cdcr::training

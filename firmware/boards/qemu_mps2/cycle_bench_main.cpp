@@ -266,7 +266,7 @@ int main() {
   }
   report("forward_cycle", forward_cycle, kCases);
   // The figure the trainer sizes models by must hold on the board.
-  const std::uint32_t forward_limit = kForwardCycle.for_points(image.training_points, image.variance_rank > 0);
+  const std::uint32_t forward_limit = kForwardCycle.for_points(image.training_points, image.variance_rank > 0, image.extra_inputs);
   const std::uint32_t forward_worst = *std::max_element(forward_cycle, forward_cycle + kCases);
   if (forward_worst > forward_limit) {
     console::console_write("FAIL: a forward cycle took ");

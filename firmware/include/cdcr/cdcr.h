@@ -87,7 +87,8 @@ typedef enum cdcr_fault {
   CDCR_FAULT_TARGET_MALFORMED = 7,
   CDCR_FAULT_TARGET_UNREACHABLE = 8,     /* fault_detail: the model's status */
   CDCR_FAULT_CAN_TRANSMIT_FAILED = 9,    /* can_send returned non-zero */
-  CDCR_FAULT_CAN_FILTERS_REFUSED = 10    /* can_receive given without can_set_filters, or it refused */
+  CDCR_FAULT_CAN_FILTERS_REFUSED = 10,   /* can_receive given without can_set_filters, or it refused */
+  CDCR_FAULT_PAYLOAD_INVALID = 11        /* a PAYLOAD frame beyond 0..50 kg: the previous payload stays */
 } cdcr_fault;
 
 /* How the last target ended (the IK_REPORT frame's OUTCOME). */
@@ -233,6 +234,13 @@ cdcr_result cdcr_step(cdcr_runtime *runtime);
  * fed for more than 10 steps takes the runtime to FAULT. */
 cdcr_result cdcr_set_cable_lengths(cdcr_runtime *runtime, const float *lengths_mm, size_t count);
 cdcr_result cdcr_set_segment_cable_lengths(cdcr_runtime *runtime, int segment, const float lengths_mm[4]);
+
+/* The tip payload in kg (0 to 50), for a model image with a payload input:
+ * the pose and inverse kinematics use it from the next cdcr_step(); until
+ * one is set, the image's default. CDCR_ERROR_OUT_OF_RANGE for NaN or a
+ * value outside 0..50 kg, and nothing changes. A model without a payload
+ * input ignores it. */
+cdcr_result cdcr_set_payload(cdcr_runtime *runtime, float payload_kg);
 
 /* A target for the tip; the runtime solves it over the next steps and
  * publishes setpoints when it converges (see cdcr_status.ik_outcome). */

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fstream>
+#include <iostream>
 #include <iterator>
 #include <sstream>
 #include <string>
@@ -103,6 +104,103 @@ TEST(TrainEndToEnd, TheRadiusHoldsAbout95PercentOfAnIndependentTestSet) {
   }
   ASSERT_GT(beyond, 100);
   EXPECT_GE(beyond_flagged, 0.95 * beyond) << beyond_flagged << " of " << beyond;
+}
+
+// The file without its payload_kg column: the same rows as a robot that
+// never said what it carried.
+void strip_payload_column(const std::string& from, const std::string& to) {
+  std::ifstream in(from);
+  std::ofstream out(to);
+  int column = -1;
+  for (std::string line; std::getline(in, line);) {
+    if (line.empty() || line[0] == '#') {
+      out << line << '\n';
+      continue;
+    }
+    std::vector<std::string> fields;
+    std::stringstream split(line);
+    for (std::string field; std::getline(split, field, ',');) fields.push_back(field);
+    if (column < 0) column = static_cast<int>(std::find(fields.begin(), fields.end(), "payload_kg") - fields.begin());
+    ASSERT_LT(column, static_cast<int>(fields.size())) << line;
+    fields.erase(fields.begin() + column);
+    for (std::size_t i = 0; i < fields.size(); ++i) out << (i > 0 ? "," : "") << fields[i];
+    out << '\n';
+  }
+}
+
+nlohmann::json eval_json(const std::string& image, const std::string& data) {
+  const CliRun run = run_cdcr("eval --model " + image + " --data " + data + " --json");
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return run.exit_code == 0 ? nlohmann::json::parse(run.out) : nlohmann::json();
+}
+
+// The payload acceptance: a robot whose tip load varies from 0 to
+// 1 kg per sample, 700 training rows and 150 test rows from another
+// session. Trained with the payload column, the firmware's path on the test
+// rows comes within 1.15 times their noise floor (measured against the true
+// poses by the simulator); trained on the same rows without the column, the
+// model cannot tell a heavy tip from a light one, and the payload model's
+// error is at most 0.7 times that one's.
+TEST(TrainEndToEnd, ThePayloadAsAnInputReachesTheNoiseFloor) {
+  const std::string dir = testing::TempDir();
+  const std::string train = dir + "payload_train.csv";
+  const std::string test = dir + "payload_test.csv";
+  const std::string train_stripped = dir + "payload_train_stripped.csv";
+  const std::string test_stripped = dir + "payload_test_stripped.csv";
+  const std::string with_image = "'" + dir + "payload_model.img'";
+  const std::string without_image = "'" + dir + "payload_stripped_model.img'";
+  CliRun run = run_cdcr("simulate --samples 700 --seed 1 --payload-range 0,1 --out '" + train + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  run = run_cdcr("simulate --samples 150 --seed 1 --session 1 --payload-range 0,1 --json --out '" + test + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const double floor_mm = nlohmann::json::parse(run.out).at("noise_floor").at("position_mm").get<double>();
+  strip_payload_column(train, train_stripped);
+  strip_payload_column(test, test_stripped);
+
+  run = run_cdcr("train --data '" + train + "' --out " + with_image + " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json trained = nlohmann::json::parse(run.out);
+  EXPECT_TRUE(trained.at("payload_input").get<bool>());
+  // Its own length scale: one per bend input and one for the payload.
+  EXPECT_EQ(trained.at("length_scales").size(), 9u);
+  run = run_cdcr("inspect " + with_image + " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(nlohmann::json::parse(run.out).at("extra_inputs").get<int>(), 1);
+  run = run_cdcr("train --data '" + train_stripped + "' --out " + without_image + " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_FALSE(nlohmann::json::parse(run.out).at("payload_input").get<bool>());
+
+  const nlohmann::json with = eval_json(with_image, "'" + test + "'");
+  const nlohmann::json without = eval_json(without_image, "'" + test_stripped + "'");
+  ASSERT_FALSE(with.is_null());
+  ASSERT_FALSE(without.is_null());
+  EXPECT_EQ(with.at("payload").get<std::string>(), "used");
+  EXPECT_EQ(with.at("n").get<int>(), 150);
+  const double with_mm = with.at("compensated").at("position_mm").get<double>();
+  const double without_mm = without.at("compensated").at("position_mm").get<double>();
+  std::cout << "payload acceptance, 150 test rows: noise floor " << floor_mm << " mm; with the payload input "
+            << with_mm << " mm (" << with_mm / floor_mm << " x the floor), without " << without_mm << " mm (with / without "
+            << with_mm / without_mm << ")\n";
+  EXPECT_LE(with_mm, 1.15 * floor_mm);
+  EXPECT_LE(with_mm, 0.7 * without_mm);
+
+  // A model without the input runs on files with the column, ignoring it.
+  const nlohmann::json ignored = eval_json(without_image, "'" + test + "'");
+  ASSERT_FALSE(ignored.is_null());
+  EXPECT_EQ(ignored.at("payload").get<std::string>(), "ignored");
+  EXPECT_EQ(ignored.at("compensated").at("position_mm").get<double>(), without_mm);
+  run = run_cdcr("eval --model " + without_image + " --data '" + test + "'");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_NE(run.out.find("the payload_kg column is ignored: the model has no payload input"), std::string::npos)
+      << run.out;
+
+  // A payload model on a file without the column: one line, exit 1.
+  run = run_cdcr("eval --model " + with_image + " --data '" + test_stripped + "'");
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_NE(run.err.find("the model takes a payload input and the data have no payload_kg column"), std::string::npos)
+      << run.err;
+  EXPECT_EQ(std::count(run.err.begin(), run.err.end(), '\n'), 1) << run.err;
+  EXPECT_TRUE(run.out.empty()) << run.out;
 }
 
 // Held-out rows measure the model, then join the exported fit.

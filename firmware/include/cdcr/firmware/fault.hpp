@@ -27,6 +27,8 @@ enum class FaultCode : std::uint8_t {
   can_transmit_failed = 9,     // a frame could not be queued for transmission
   can_filters_refused = 10,    // the controller refused the acceptance filters: the runtime runs and ignores
                                // foreign frames, but every frame on the bus now costs it a receive
+  payload_invalid = 11,        // last payload refused (malformed PAYLOAD frame, beyond its range, NaN); the
+                               // previous payload stays in use
 };
 
 constexpr const char* to_string(RuntimeState state) {
@@ -52,6 +54,7 @@ constexpr const char* to_string(FaultCode code) {
     case FaultCode::target_unreachable: return "target unreachable";
     case FaultCode::can_transmit_failed: return "CAN transmit failed";
     case FaultCode::can_filters_refused: return "CAN acceptance filters refused";
+    case FaultCode::payload_invalid: return "payload invalid";
   }
   return "unknown fault";
 }

@@ -35,6 +35,7 @@ constexpr FaultDetailKind detail_kind(FaultCode code) {
     case FaultCode::target_malformed:
     case FaultCode::can_transmit_failed:
     case FaultCode::can_filters_refused:
+    case FaultCode::payload_invalid:
       return FaultDetailKind::none;
   }
   return FaultDetailKind::none;

@@ -48,7 +48,7 @@ using Geometry = model::RobotGeometry<Scalar, kMaxSegments>;
 using Cables = model::CableVector<Scalar, kMaxSegments>;
 using Joints = model::JointVector<Scalar, kMaxSegments>;
 using Correction = model::GpCorrection<Scalar, Accumulator, kMaxSegments>;
-using Uncertainty = model::GpUncertainty<Scalar, 2 * kMaxSegments>;
+using Uncertainty = model::GpUncertainty<Scalar, Correction::kMaxInputs>;
 using Pose = model::Pose<Scalar>;
 // The correction as the IK solver sees it: the GP's evaluation in slices.
 // Its functions are defined in runtime.cpp, beside the forward path, so the
@@ -176,6 +176,16 @@ class Runtime {
   // Model updates over CAN into the HAL's flash (model_update.hpp).
   const ModelUpdate& model_update() const { return update_; }
 
+  // The tip payload, for an image with a payload input: the image's default
+  // until a valid one arrives (the PAYLOAD frame, or this call). A payload
+  // that is NaN or outside the PAYLOAD signal's range is refused with
+  // FaultCode::payload_invalid, and the previous one stays in use. The next
+  // pose and the next IK evaluation use the new one. Without a payload input
+  // a valid payload is accepted and changes nothing.
+  bool set_payload_kg(Scalar payload_kg);
+  Scalar payload_kg() const { return payload_kg_; }
+  bool payload_received() const { return payload_received_; }
+
  private:
   // runtime_update.cpp: the image init() loads, and the switch to a new one.
   hal::MemoryRegion model_region();
@@ -186,6 +196,7 @@ class Runtime {
   void handle_target_orientation(const hal::CanFrame& frame);
   void handle_target_position(const hal::CanFrame& frame);
   void handle_target_commit(const hal::CanFrame& frame);
+  void handle_payload(const hal::CanFrame& frame);
   void start_solve(const Pose& target, const protocol::TargetPositionZ& commit);
   void continue_solve();
   void finish_solve(model::IkSolveState end);
@@ -234,6 +245,8 @@ class Runtime {
 
   PoseEstimate latest_pose_;
   bool has_pose_ = false;
+  Scalar payload_kg_ = 0;
+  bool payload_received_ = false;
 
   // The variance of a recent pose, a few cycles' work.
   Uncertainty uncertainty_;

@@ -97,6 +97,7 @@ struct ImageCapacity {
   std::uint32_t max_training_points = kMaxTrainingPoints;
   std::uint32_t max_segments = kMaxSegments;
   std::uint32_t max_variance_rank = kMaxVarianceRank;
+  std::uint32_t max_extra_inputs = kMaxExtraInputs;
 };
 
 // The predictive-variance block (v2.1): a few calibration values, then the
@@ -133,7 +134,7 @@ inline constexpr std::size_t scalar_type = 26;      // u8, ImageScalar
 inline constexpr std::size_t kernel_kind = 27;      // u8, ImageKernel
 inline constexpr std::size_t input_encoding = 28;   // u8, InputEncoding
 inline constexpr std::size_t model_kind = 29;       // u8, ImageModelKind (v1: reserved, zero)
-inline constexpr std::size_t extra_inputs = 30;     // u8, inputs after the joint encoding (v1: reserved, zero)
+inline constexpr std::size_t extra_inputs = 30;     // u8, inputs after the joint encoding: 0, or 1 the payload (v1: reserved)
 inline constexpr std::size_t reserved_a = 31;       // 1 byte, zero (v1: bytes 29..31)
 inline constexpr std::size_t geometry_offset = 32;  // u32
 inline constexpr std::size_t parameters_offset = 36;
@@ -175,8 +176,9 @@ struct ImageView {
   ImageModelKind model_kind;      // exact_gp for a v1 image
   std::uint32_t training_points;  // the points: N training inputs (exact) or M inducing inputs (sparse)
   std::uint32_t fitted_rows;      // data rows behind the model; N for an exact model and for every v1 image
-  int input_dims;                 // D
+  int input_dims;                 // D = 2 segment_count + extra_inputs
   int segment_count;
+  int extra_inputs;               // 0, or 1: input D - 1 is the tip payload, kg
   InputEncoding encoding;
   const float* geometry;        // segment_count x {backbone_length_mm, anchor_radius_mm, theta_max_rad}
   const float* input_mean;      // D
@@ -188,6 +190,7 @@ struct ImageView {
   const float* noise_variance;  // 6, normalised output units
   const float* input_min;       // D, raw input units, the fitted data's range; nullptr for a v1 image
   const float* input_max;       // D, likewise
+  const float* extra_input_default;  // extra_inputs: the value used until one arrives (the payload, kg); null without
   const float* inputs;          // points x D row-major, kernel coordinates: (x - mean) / (scale * length_scale)
   const float* alpha;           // points x 6 row-major: the weights (alpha or beta) per normalised output
   // The predictive variance (v2.1; rank 0 and null pointers without it).
@@ -218,23 +221,26 @@ constexpr std::uint32_t align_up(std::uint32_t value, std::uint32_t alignment) {
   return (value + alignment - 1) / alignment * alignment;
 }
 
-// v2 appends input_min and input_max (D each) to v1's parameters. A major
-// version this parser does not know is laid out as the newest it does.
+// v2 appends input_min and input_max (D each) to v1's parameters, and a
+// default per extra input. A major version this parser does not know is laid
+// out as the newest it does.
 constexpr std::uint32_t image_parameter_floats(std::uint32_t input_dims,
-                                               std::uint16_t version_major = kImageVersionMajor) {
-  return (version_major == 1 ? 3 : 5) * input_dims + 4 * kImageOutputs;
+                                               std::uint16_t version_major = kImageVersionMajor,
+                                               std::uint32_t extra_inputs = 0) {
+  return version_major == 1 ? 3 * input_dims + 4 * kImageOutputs
+                            : 5 * input_dims + 4 * kImageOutputs + extra_inputs;
 }
 
 // Blocks follow the header in this order, each 8-byte aligned, then the CRC.
 constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t input_dims,
                                    std::uint32_t segment_count, std::uint16_t version_major = kImageVersionMajor,
-                                   std::uint32_t variance_rank = 0) {
+                                   std::uint32_t variance_rank = 0, std::uint32_t extra_inputs = 0) {
   ImageLayout layout{};
   std::uint32_t at = kImageHeaderSize;
   layout.geometry_offset = at;
   at = align_up(at + 4 * 3 * segment_count, kImageBlockAlignment);
   layout.parameters_offset = at;
-  at = align_up(at + 4 * image_parameter_floats(input_dims, version_major), kImageBlockAlignment);
+  at = align_up(at + 4 * image_parameter_floats(input_dims, version_major, extra_inputs), kImageBlockAlignment);
   layout.inputs_offset = at;
   at = align_up(at + 4 * training_points * input_dims, kImageBlockAlignment);
   layout.alpha_offset = at;
@@ -493,11 +499,12 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   const ImageModelKind kind = v1 ? ImageModelKind::exact_gp : static_cast<ImageModelKind>(bytes[model_kind]);
   const std::uint32_t extra = v1 ? 0 : bytes[extra_inputs];
   if (!v1) {
-    // The payload input a later change adds; this parser evaluates only the
-    // joint encoding.
+    // One extra input is defined, the tip payload; more would be inputs this
+    // parser cannot supply.
     if (!run.expect(is_known(kind), Check::kind, Status::unsupported_kind, "model_kind", -1, bytes[model_kind],
                     static_cast<std::uint8_t>(ImageModelKind::sparse_gp), Expect::known) ||
-        !run.expect(extra == 0, Check::kind, Status::unsupported_kind, "extra_inputs", -1, extra, 0, Expect::equal)) {
+        !run.expect(extra <= kMaxExtraInputs, Check::kind, Status::unsupported_kind, "extra_inputs", -1, extra,
+                    kMaxExtraInputs, Expect::at_most)) {
       return run.status;
     }
   }
@@ -520,7 +527,9 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
       !run.expect(segments <= capacity.max_segments, Check::capacity, Status::over_capacity, "segment_count", -1,
                   segments, capacity.max_segments, Expect::at_most) ||
       !run.expect(rank <= capacity.max_variance_rank, Check::capacity, Status::over_capacity, "variance_rank", -1,
-                  rank, capacity.max_variance_rank, Expect::at_most)) {
+                  rank, capacity.max_variance_rank, Expect::at_most) ||
+      !run.expect(extra <= capacity.max_extra_inputs, Check::capacity, Status::over_capacity, "extra_inputs", -1,
+                  extra, capacity.max_extra_inputs, Expect::at_most)) {
     return run.status;
   }
 
@@ -544,7 +553,7 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
     return run.status;
   }
   if (array_bytes <= declared_total) {
-    const ImageLayout expected = image_layout(n, d, segments, major, rank);
+    const ImageLayout expected = image_layout(n, d, segments, major, rank, extra);
     const std::uint32_t expected_offsets[] = {expected.geometry_offset, expected.parameters_offset,
                                               expected.inputs_offset,   expected.alpha_offset,
                                               expected.metadata_offset, expected.variance_offset};
@@ -574,7 +583,7 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
     }
     return reinterpret_cast<const float*>(bytes + offset);
   };
-  const std::uint32_t parameter_floats = image_parameter_floats(d, major);
+  const std::uint32_t parameter_floats = image_parameter_floats(d, major, extra);
   const float* geometry = block(offsets[0], 3 * std::uint64_t{segments});
   const float* parameters = block(offsets[1], parameter_floats);
   const float* inputs = block(offsets[2], std::uint64_t{n} * d);
@@ -629,6 +638,7 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
 
   const float* input_min = v1 ? nullptr : parameter(3 * d + 4 * kImageOutputs);
   const float* input_max = v1 ? nullptr : parameter(4 * d + 4 * kImageOutputs);
+  const float* extra_default = extra > 0 ? parameter(5 * d + 4 * kImageOutputs) : nullptr;
   if (input_min != nullptr) {
     bool all_ordered = true;
     for (std::uint32_t i = 0; i < d; ++i) {
@@ -641,6 +651,14 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
     }
     if (all_ordered) {
       run.expect(true, Check::ranges, Status::invalid_parameters, "input_min", -1, 0, 0, Expect::at_most, d);
+    }
+  }
+
+  // A payload is a mass: its default is not negative.
+  for (std::uint32_t i = 0; extra_default != nullptr && i < extra; ++i) {
+    if (!run.expect(extra_default[i] >= 0.0f, Check::ranges, Status::invalid_parameters, "extra_input_default",
+                    static_cast<std::int32_t>(i), extra_default[i], 0, Expect::at_least)) {
+      return run.status;
     }
   }
 
@@ -715,6 +733,7 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   v.fitted_rows = fitted;
   v.input_dims = static_cast<int>(d);
   v.segment_count = static_cast<int>(segments);
+  v.extra_inputs = static_cast<int>(extra);
   v.encoding = static_cast<InputEncoding>(bytes[input_encoding]);
   v.geometry = geometry;
   v.input_mean = parameters;
@@ -726,6 +745,7 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   v.noise_variance = noise_variance;
   v.input_min = input_min;
   v.input_max = input_max;
+  v.extra_input_default = extra_default;
   v.inputs = inputs;
   v.alpha = alpha;
   v.variance_rank = rank;

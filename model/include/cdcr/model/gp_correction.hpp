@@ -20,6 +20,12 @@
 // loop; model/arch/): arch::Selected, the one the build picks with
 // CDCR_MODEL_ARCH, by default, and arch::Portable for the plain C++
 // reference, which a board program compares its own loops against.
+//
+// An image with a payload input (extra_inputs 1) takes the tip payload as its
+// last input, after the bend pairs. The payload is state of the correction:
+// the image's default until set_payload_kg(), and every evaluation that
+// begins after a set uses the new value, the forward path's and IK's alike.
+// The bend vector stays the only variable: the gradient is d(eps)/d(bend).
 
 #include <array>
 #include <cmath>
@@ -40,7 +46,7 @@ namespace cdcr::model {
 template <typename S, typename Accumulator = double, int MaxSegments = kMaxSegments, typename Arch = arch::Selected>
 class GpCorrection {
  public:
-  static constexpr int kMaxInputs = 2 * MaxSegments;
+  static constexpr int kMaxInputs = max_model_inputs(MaxSegments);
   // Training points summed in S before a sum goes into the accumulator.
   static constexpr std::uint32_t kBlockPoints = 8;
   // Large enough for any whole evaluation in one slice.
@@ -54,6 +60,14 @@ class GpCorrection {
     alpha_ = image.alpha;
     training_points_ = image.training_points;
     input_dims_ = image.input_dims;
+    bend_dims_ = 2 * image.segment_count;
+    extra_inputs_ = image.extra_inputs;
+    if (bend_dims_ + extra_inputs_ != input_dims_ || extra_inputs_ > kMaxExtraInputs) return Status::correction_failed;
+    for (int e = 0; e < extra_inputs_; ++e) extra_[e] = S(image.extra_input_default[e]);
+    // A payload model's points run in the run-time loop, and cost more.
+    mean_point_units_ = extra_inputs_ > 0 ? Arch::kWorkCosts.run_time_loop_point : 1;
+    gradient_point_units_ = extra_inputs_ > 0 ? Arch::kWorkCosts.run_time_loop_gradient_point : kGradientPointUnits;
+    gradient_granule_ = extra_inputs_ > 0 ? kBlockPoints : kChunkPoints;
     encoding_ = image.encoding;
     for (int d = 0; d < input_dims_; ++d) {
       input_mean_[d] = S(image.input_mean[d]);
@@ -68,16 +82,34 @@ class GpCorrection {
 
   bool bound() const { return alpha_ != nullptr; }
   int input_dims() const { return input_dims_; }
+  // Inputs of the bend vector, 2 per segment: the inputs before the extra ones.
+  int bend_dims() const { return bend_dims_; }
+  bool has_payload_input() const { return extra_inputs_ > 0; }
+  // The payload the next evaluations use (0 for a model without the input).
+  S payload_kg() const { return extra_inputs_ > 0 ? extra_[0] : S(0); }
+  // Range checks are the caller's (the runtime's); a model without a payload
+  // input ignores it.
+  void set_payload_kg(S payload_kg) {
+    if (extra_inputs_ > 0) extra_[0] = payload_kg;
+  }
   InputEncoding encoding() const { return encoding_; }
 
   std::uint32_t training_points() const { return training_points_; }
+  // Work units of a point (work_costs.hpp): 1 and kGradientPointUnits, or
+  // the run-time loop's for a payload model.
+  std::uint32_t mean_point_units() const { return mean_point_units_; }
+  std::uint32_t gradient_point_units() const { return gradient_point_units_; }
+  // The fewest units a slice with the gradient needs to advance.
+  std::uint32_t smallest_gradient_slice_units() const { return gradient_granule_ * gradient_point_units_; }
 
-  // z = (x - input_mean) / (input_scale * length_scale) for x = encode(bend):
-  // the coordinates the points are stored in (input_dims() values).
+  // z = (x - input_mean) / (input_scale * length_scale) for x = encode(bend)
+  // followed by the payload: the coordinates the points are stored in
+  // (input_dims() values).
   void kernel_coordinates(const JointVector<S, MaxSegments>& bend, S* z) const {
-    Input x(input_dims_);
+    Input x(bend_dims_);
     encode_inputs(encoding_, bend, x);
-    for (int d = 0; d < input_dims_; ++d) z[d] = (x[d] - input_mean_[d]) * input_gain_[d];
+    for (int d = 0; d < bend_dims_; ++d) z[d] = (x[d] - input_mean_[d]) * input_gain_[d];
+    for (int d = bend_dims_; d < input_dims_; ++d) z[d] = (extra_[d - bend_dims_] - input_mean_[d]) * input_gain_[d];
   }
 
   // The error twist eps (v, omega) for a stacked bend vector.
@@ -121,7 +153,7 @@ class GpCorrection {
 
   Status begin_evaluation(const JointVector<S, MaxSegments>& bend, Evaluation& evaluation,
                           bool with_gradient = false) const {
-    if (!bound() || bend.size() != input_dims_) return Status::correction_failed;
+    if (!bound() || bend.size() != bend_dims_) return Status::correction_failed;
     kernel_coordinates(bend, evaluation.z);
     for (auto& sum : evaluation.sums) sum = Accumulator{};
     for (auto& row : evaluation.weighted) {
@@ -137,8 +169,11 @@ class GpCorrection {
   // with the gradient; the ragged end only together with the rest); returns
   // the units spent, 0 when not even one block fits.
   std::uint32_t continue_evaluation(Evaluation& evaluation, std::uint32_t max_units) const {
-    const std::uint32_t unit = evaluation.with_gradient ? kGradientPointUnits : 1;
-    const std::uint32_t granule = evaluation.with_gradient ? kChunkPoints : kBlockPoints;
+    // A payload model's gradient goes in blocks rather than chunks, so that
+    // its dearer points still fit a cycle's slice; the sums' order, and so
+    // their bits, are the same.
+    const std::uint32_t unit = evaluation.with_gradient ? gradient_point_units_ : mean_point_units_;
+    const std::uint32_t granule = evaluation.with_gradient ? gradient_granule_ : kBlockPoints;
     const std::uint32_t left = training_points_ - evaluation.next_point;
     const std::uint32_t affordable = max_units / unit;
     std::uint32_t count = left;
@@ -166,11 +201,12 @@ class GpCorrection {
 
   Twist<S> evaluation_result(const Evaluation& evaluation) const { return outputs(evaluation.sums); }
 
-  // eps and, for an evaluation with the gradient, d(eps)/d(bend) (6 x D).
+  // eps and, for an evaluation with the gradient, d(eps)/d(bend) (6 x 2n;
+  // the payload is no variable of the solver).
   void evaluation_result(const Evaluation& evaluation, Twist<S>& eps, Jacobian<S, MaxSegments>& d_eps_d_bend) const {
     eps = outputs(evaluation.sums);
     const int dims = input_dims_;
-    d_eps_d_bend.setZero(6, dims);
+    d_eps_d_bend.setZero(6, bend_dims_);
     if (!evaluation.with_gradient) return;
     // d/dz of sum_i alpha_ik r_i = sum_i alpha_ik r_i (z_i - z)
     //                            = sum_i alpha_ik r_i z_i - z sum_i alpha_ik r_i.
@@ -186,7 +222,7 @@ class GpCorrection {
         scaled(k, d) = (evaluation.weighted[k][d] - evaluation.z[d] * total) * output_gain_[k] * input_gain_[d];
       }
     }
-    for (int s = 0; s < dims / 2; ++s) {
+    for (int s = 0; s < bend_dims_ / 2; ++s) {
       const Eigen::Matrix<S, 2, 2> jacobian =
           encoding_jacobian_block<S>(encoding_, evaluation.bend.template segment<2>(2 * s));
       d_eps_d_bend.template middleCols<2>(2 * s) = scaled.template middleCols<2>(2 * s) * jacobian;
@@ -196,14 +232,14 @@ class GpCorrection {
   // The correction-term interface of solve_ik(): the twist alone, for trial
   // steps, and with its derivative.
   Status value(const JointVector<S, MaxSegments>& bend, Twist<S>& eps) const {
-    if (!bound() || bend.size() != input_dims_) return Status::correction_failed;
+    if (!bound() || bend.size() != bend_dims_) return Status::correction_failed;
     eps = predict(bend);
     return Status::ok;
   }
 
   Status operator()(const JointVector<S, MaxSegments>& bend, Twist<S>& eps,
                     Jacobian<S, MaxSegments>& d_eps_d_bend) const {
-    if (!bound() || bend.size() != input_dims_) return Status::correction_failed;
+    if (!bound() || bend.size() != bend_dims_) return Status::correction_failed;
     predict_with_gradient(bend, eps, d_eps_d_bend);
     return Status::ok;
   }
@@ -211,7 +247,9 @@ class GpCorrection {
  private:
   // Calls work(std::integral_constant<int, D>) with the input count D as a
   // constant for the paper's robots (2 to 4 segments), which lets the
-  // compiler unroll the distance, and with 0 (count read at run time) otherwise.
+  // compiler unroll the distance, and with 0 (count read at run time)
+  // otherwise: a payload model's odd count takes the run-time loop, whose
+  // extra cost per point the cycle's accounting charges (work_costs.hpp).
   template <typename Work>
   void with_input_count(Work&& work) const {
     switch (input_dims_) {
@@ -301,7 +339,8 @@ class GpCorrection {
   // training points: one pass computes the chunk's kernel values and the
   // mean's terms (add_point), then one pass per pair of outputs adds
   // alpha_ik r_i z_i for both, so that a pair's 2 D sums stay in registers.
-  // Points [first, first + points): first is a multiple of kChunkPoints.
+  // Points [first, first + points): first is a multiple of kChunkPoints (of
+  // kBlockPoints for a payload model, whose slices go in blocks).
   template <int Dims>
   void accumulate_mean_and_gradient(const S* query, std::uint32_t first_point, std::uint32_t points, Accumulator* sums,
                                     S (&weighted)[kImageOutputs][kMaxInputs]) const {
@@ -383,6 +422,12 @@ class GpCorrection {
   const float* alpha_ = nullptr;
   std::uint32_t training_points_ = 0;
   int input_dims_ = 0;
+  int bend_dims_ = 0;
+  int extra_inputs_ = 0;
+  std::uint32_t mean_point_units_ = 1;
+  std::uint32_t gradient_point_units_ = kGradientPointUnits;
+  std::uint32_t gradient_granule_ = kChunkPoints;
+  S extra_[kMaxExtraInputs] = {};
   InputEncoding encoding_ = InputEncoding::bend_vector;
   std::array<S, kMaxInputs> input_mean_{};
   std::array<S, kMaxInputs> input_gain_{};

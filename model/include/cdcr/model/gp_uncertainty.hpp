@@ -79,7 +79,7 @@ void gaussian_radii_95(const S (&variances)[kImageOutputs], const Vec3<S>& tip_m
   r95_deg = gaussian_radius_95(w[0] + w[1] + w[2], w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * S(kDegreesPerRadian);
 }
 
-template <typename S, int MaxInputs = 2 * kMaxSegments>
+template <typename S, int MaxInputs = kMaxInputs>
 class GpUncertainty {
  public:
   static constexpr int kMaxRank = static_cast<int>(kMaxVarianceRank);

@@ -37,6 +37,11 @@ struct CableSetpoint {
   double lengths_mm[4] = {};  // L1..L4
 };
 
+// PAYLOAD: kg.
+struct Payload {
+  double payload_kg = 0;
+};
+
 struct TargetOrientation {
   double qw = 1, qx = 0, qy = 0, qz = 0;
 };
@@ -244,6 +249,21 @@ inline DecodeStatus decode(const hal::CanFrame& frame, TargetPositionZ& f) {
   f.tracking = raw_in_word(word, kTracking) != 0;
   f.refuse_extrapolating = raw_in_word(word, kRefuseExtrapolating) != 0;
   f.sequence = static_cast<std::uint8_t>(raw_in_word(word, kSequence));
+  return DecodeStatus::ok;
+}
+
+// A payload outside the signal's range (or NaN) is refused: the encoder
+// returns false and leaves the frame alone.
+inline bool encode(const Payload& f, hal::CanFrame& frame) {
+  std::int64_t raw = 0;
+  if (!to_raw_checked(payload::kPayload, f.payload_kg, raw)) return false;
+  frame = empty_frame(payload::kMessage);
+  set_data_word(frame, placed(payload::kPayload, raw));
+  return true;
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, Payload& f) {
+  if (const DecodeStatus s = check_frame(payload::kMessage, frame); s != DecodeStatus::ok) return s;
+  f.payload_kg = physical_in_word(data_word(frame), payload::kPayload);
   return DecodeStatus::ok;
 }
 

@@ -27,6 +27,7 @@ inline constexpr hal::CanFilter kTargetFrames{0x120, 0x7FC};         // TARGET_O
 inline constexpr hal::CanFilter kPoseFrames{0x130, 0x7FC};           // POSE_POSITION_XY, _POSITION_Z, POSE_ORIENTATION
 inline constexpr hal::CanFilter kIkReportFrames{0x140, 0x7FF};       // IK_REPORT
 inline constexpr hal::CanFilter kStatusFrames{0x150, 0x7FE};         // STATUS, STATS
+inline constexpr hal::CanFilter kPayloadFrames{0x160, 0x7FF};        // PAYLOAD
 
 enum class TargetMode : std::uint8_t { position = 0, pose = 1 };
 
@@ -74,6 +75,7 @@ inline constexpr ValueName kFaultCode[] = {
     {8, "target_unreachable"},
     {9, "can_transmit_failed"},
     {10, "can_filters_refused"},
+    {11, "payload_invalid"},
 };
 }  // namespace values
 
@@ -224,6 +226,16 @@ inline constexpr const SignalSpec* kSignals[] = {&kJitterMax, &kRejectedFrames, 
 inline constexpr MessageSpec kMessage{"STATS", 0x151, 1, 8, "RUNTIME", signal_list(kSignals), kStatusFrames};
 }  // namespace stats
 
+// 0x160: the tip payload the robot carries now, for a model with a payload
+// input (model/flash-image-v2.md); until one arrives the image's default is
+// used. A frame beyond the signal's range is refused (FAULT payload_invalid)
+// and the previous payload stays.
+namespace payload {
+inline constexpr SignalSpec kPayload{"PAYLOAD", 0, 16, false, 0.001, 0, 0, 50, "kg"};
+inline constexpr const SignalSpec* kSignals[] = {&kPayload};
+inline constexpr MessageSpec kMessage{"PAYLOAD", 0x160, 1, 2, "HOST", signal_list(kSignals), kPayloadFrames};
+}  // namespace payload
+
 // Model updates (0x170..0x17F; firmware/model_update.hpp): the host writes a
 // new model image into the inactive flash slot, in blocks of up to
 // kUpdateBlockBytes, each an UPDATE_BLOCK header and its UPDATE_DATA frames.
@@ -349,6 +361,7 @@ inline constexpr const MessageSpec* kMessages[] = {
     &target_position_xy::kMessage, &target_position_z::kMessage, &pose_position_xy::kMessage,
     &pose_position_z::kMessage,    &pose_orientation::kMessage, &pose_uncertainty::kMessage,
     &ik_report::kMessage,          &status::kMessage,           &stats::kMessage,
+    &payload::kMessage,
     &update_command::kMessage,     &update_digest::kMessage,    &update_block::kMessage,
     &update_data::kMessage,        &update_report::kMessage,
 };
