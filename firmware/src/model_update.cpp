@@ -4,6 +4,7 @@
 #include <cstring>
 
 #include "cdcr/model/compensated_kinematics.hpp"
+#include "cdcr/model/crc32.hpp"
 #include "cdcr/model/flash_image.hpp"
 
 namespace cdcr::firmware {
@@ -193,6 +194,7 @@ void ModelUpdate::handle_command(const protocol::UpdateCommandFrame& command) {
         last_reason_ = UpdateReason::none;
         hash_.reset();
         hashed_ = 0;
+        crc_ = 0;
         report(UpdateReason::none);
       }
       return;
@@ -211,6 +213,7 @@ void ModelUpdate::handle_command(const protocol::UpdateCommandFrame& command) {
       last_reason_ = UpdateReason::none;
       hash_.reset();
       hashed_ = 0;
+      crc_ = 0;
       phase_ = Phase::rollback_verifying;
       report(UpdateReason::none);
       return;
@@ -389,7 +392,9 @@ void ModelUpdate::operation_done() {
         if (candidates_[i].slot == active_slot_) running = candidates_[i];
       }
       candidates_[0] = SlotImage{target_slot_, committed_sequence_,
-                                 {flash_->read() + target_.image_offset(), record_.image_size}};
+                                 {flash_->read() + target_.image_offset(), record_.image_size},
+                                 crc_,
+                                 true};
       candidate_count_ = 1;
       if (running.slot >= 0 && running.slot == active_slot_) candidates_[candidate_count_++] = running;
       switch_slot_ = target_slot_;
@@ -403,7 +408,9 @@ void ModelUpdate::operation_done() {
         // The rolled-back-to image is the only candidate now.
         candidates_[0] = SlotImage{rollback_slot_, rollback_header_.sequence,
                                    {flash_->read() + slot_geometry(*flash_, rollback_slot_).image_offset(),
-                                    rollback_header_.image_size}};
+                                    rollback_header_.image_size},
+                                   crc_,
+                                   true};
         candidate_count_ = 1;
         switch_slot_ = rollback_slot_;
         rollback_slot_ = -1;
@@ -462,6 +469,9 @@ void ModelUpdate::start_work(const Geometry& geometry) {
       const std::uint8_t* image = flash_->read() + slot_geometry(*flash_, slot).image_offset();
       const std::uint32_t take = size - hashed_ < kUpdateHashBytesPerCycle ? size - hashed_ : kUpdateHashBytesPerCycle;
       hash_.update(image + hashed_, take);
+      // The image's CRC-32 (the bytes before its trailer) in the same pass.
+      const std::uint32_t crc_end = size >= model::kImageTrailerSize ? size - model::kImageTrailerSize : 0;
+      if (hashed_ < crc_end) crc_ = model::crc32(image + hashed_, crc_end - hashed_ < take ? crc_end - hashed_ : take, crc_);
       hashed_ += take;
       if (hashed_ < size) return;
       std::uint8_t digest[kSha256Bytes];
@@ -528,7 +538,8 @@ void ModelUpdate::finish_verification(const Geometry& geometry) {
   capacity.max_training_points = kMaxTrainingPoints;
   capacity.max_segments = kMaxSegments;
   capacity.max_variance_rank = model::kMaxVarianceRank;
-  const model::ImageStatus parsed = model::parse_image(image, record_.image_size, view, capacity);
+  const model::ImageCrc crc{crc_, record_.image_size - model::kImageTrailerSize};
+  const model::ImageStatus parsed = model::parse_image(image, record_.image_size, view, capacity, crc);
   if (parsed == model::ImageStatus::unsupported_version) {
     fail(UpdateReason::unsupported_version);
     return;

@@ -65,16 +65,13 @@ RuntimeState Runtime::init() {
 
   boot_fault_ = FaultCode::none;
   boot_fault_detail_ = FaultDetail();
-  const hal::MemoryRegion region = model_region();
+  const SlotImage source = model_source();
+  const hal::MemoryRegion region = source.region;
   geometry_ = fallback_geometry_;
   if (region.data == nullptr || region.size_bytes == 0) {
     boot_fault_ = FaultCode::image_missing;
   } else {
-    model::ImageCapacity capacity;
-    capacity.max_training_points = kMaxTrainingPoints;
-    capacity.max_segments = kMaxSegments;
-    capacity.max_variance_rank = kMaxVarianceRank;
-    const model::ImageStatus parsed = model::parse_image(region.data, region.size_bytes, image_, capacity);
+    const model::ImageStatus parsed = parse_model(source, image_);
     if (parsed != model::ImageStatus::ok) {
       boot_fault_ = FaultCode::image_invalid;
       boot_fault_detail_ = FaultDetail(parsed);

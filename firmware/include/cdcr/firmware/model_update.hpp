@@ -10,8 +10,10 @@
 //                 is checked (number, length, CRC), held in RAM, programmed,
 //                 then its progress byte; UPDATE_REPORT acknowledges the
 //                 blocks in flash cumulatively.
-//   COMMIT        hash the slot's image (kUpdateHashBytesPerCycle a cycle),
-//                 compare with the announced SHA-256, parse it and check its
+//   COMMIT        hash the slot's image (kUpdateHashBytesPerCycle a cycle,
+//                 its CRC-32 in the same pass), compare with the announced
+//                 SHA-256, parse it (with that CRC: no whole-image sum in
+//                 one cycle) and check its
 //                 geometry against the running model's, then write the slot
 //                 header with a sequence one above the active slot's: the
 //                 commit point. The runtime then loads it, and if it cannot,
@@ -137,6 +139,7 @@ class ModelUpdate {
   // Verification, and what is written at the commit point.
   Sha256 hash_;
   std::uint32_t hashed_ = 0;
+  std::uint32_t crc_ = 0;  // CRC-32 of the hashed image's bytes before its trailer
   std::uint32_t committed_sequence_ = 0;
   int rollback_slot_ = -1;
   SlotHeader rollback_header_;
