@@ -6,18 +6,15 @@
 
 namespace cdcr::firmware {
 
-// A slot's image with the CRC computed when it was hashed: the switch to it
-// runs no whole-image sum in its cycle.
+// A slot's image with the checks scanned when it was hashed: the switch to
+// it reads no whole image in its cycle.
 model::ImageStatus Runtime::parse_model(const SlotImage& source, model::ImageView& view) const {
   model::ImageCapacity capacity;
   capacity.max_training_points = kMaxTrainingPoints;
   capacity.max_segments = kMaxSegments;
   capacity.max_variance_rank = kMaxVarianceRank;
   const hal::MemoryRegion& region = source.region;
-  if (source.crc_known && region.size_bytes >= model::kImageTrailerSize) {
-    const model::ImageCrc crc{source.crc, static_cast<std::uint32_t>(region.size_bytes - model::kImageTrailerSize)};
-    return model::parse_image(region.data, region.size_bytes, view, capacity, crc);
-  }
+  if (source.scan.done()) return model::parse_image(region.data, region.size_bytes, view, capacity, source.scan);
   return model::parse_image(region.data, region.size_bytes, view, capacity);
 }
 
