@@ -444,6 +444,7 @@ class ImageScan {
   }
 
   bool done() const { return bytes_ != nullptr && at_ == end_; }
+  const std::uint8_t* bytes() const { return bytes_; }
   std::uint32_t crc() const { return crc_; }
   std::uint32_t crc_bytes() const { return end_; }
   // Whether the scan checked `count` floats at `values` and found them all
@@ -533,7 +534,7 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   if (total_holds_trailer && declared_total <= size) {
     const std::uint32_t stored_crc = read_u32(bytes + declared_total - kImageTrailerSize);
     const std::uint32_t covered = declared_total - kImageTrailerSize;
-    const bool scanned = scan != nullptr && scan->done() && scan->crc_bytes() == covered;
+    const bool scanned = scan != nullptr && scan->done() && scan->bytes() == bytes && scan->crc_bytes() == covered;
     const std::uint32_t computed_crc = scanned ? scan->crc() : crc32(bytes, covered);
     if (!run.expect(stored_crc == computed_crc, Check::checksum, Status::checksum_mismatch, "crc32", -1, stored_crc,
                     computed_crc, Expect::equal)) {
