@@ -119,8 +119,9 @@ inline constexpr int kUpdateWindowBlocks = 8;
 // An acknowledgement goes out after this many blocks reached the flash (and
 // whenever the runtime has caught up with what it received).
 inline constexpr int kUpdateAckEveryBlocks = 4;
-// Bytes of the new image hashed per cycle while it is verified, at most:
-// 1 KiB of SHA-256 is about 25 % of a Cortex-M7 cycle's budget. The update's
+// Bytes of the new image hashed per cycle while it is verified, at most
+// (1 KiB of SHA-256 and scan is about 64,000 instructions on a Cortex-M7,
+// four fifths of its cycle's budget). The update's
 // work is charged in work units and comes out of IK's share of the cycle,
 // which keeps at least kMinIkUnitsPerCycle while a request runs; the slice
 // shrinks (in steps of 64 bytes) to what is left. Charges, measured under
