@@ -331,7 +331,9 @@ std::uint32_t ModelUpdate::step(std::uint32_t cycle, const Geometry& geometry, s
   cycle_ = cycle;
   const std::uint32_t frame_units = frames_ * kUpdateFrameUnits;
   frames_ = 0;
-  if (!enabled_ || phase_ == Phase::idle || phase_ == Phase::committed || phase_ == Phase::failed) return frame_units;
+  const bool resting = phase_ == Phase::idle || phase_ == Phase::committed || phase_ == Phase::failed;
+  // An operation that outlived an abort is still polled to its end.
+  if (!enabled_ || (resting && !operation_running_)) return frame_units;
   const std::uint32_t spent = frame_units + kUpdateStepUnits;
   if (operation_running_) {
     const hal::FlashStatus status = flash_->poll();
