@@ -133,6 +133,7 @@ void ModelUpdate::fail(UpdateReason reason) {
 
 void ModelUpdate::handle_frame(const hal::CanFrame& frame, std::uint32_t cycle) {
   cycle_ = cycle;
+  frames_ += 1;
   if (protocol::update_data::kMessage.carries(frame.id)) {
     handle_data(frame);
   } else if (protocol::update_block::kMessage.carries(frame.id)) {
@@ -193,6 +194,7 @@ void ModelUpdate::handle_command(const protocol::UpdateCommandFrame& command) {
         last_reason_ = UpdateReason::none;
         hash_.reset();
         hashed_ = 0;
+        scan_.begin(flash_->read() + target_.image_offset(), record_.image_size);
         report(UpdateReason::none);
       }
       return;
@@ -211,6 +213,7 @@ void ModelUpdate::handle_command(const protocol::UpdateCommandFrame& command) {
       last_reason_ = UpdateReason::none;
       hash_.reset();
       hashed_ = 0;
+      scan_.begin(flash_->read() + slot_geometry(*flash_, other).image_offset(), rollback_header_.image_size);
       phase_ = Phase::rollback_verifying;
       report(UpdateReason::none);
       return;
@@ -324,16 +327,21 @@ void ModelUpdate::handle_data(const hal::CanFrame& frame) {
   last_activity_cycle_ = cycle_;
 }
 
-void ModelUpdate::step(std::uint32_t cycle, const Geometry& geometry) {
+std::uint32_t ModelUpdate::step(std::uint32_t cycle, const Geometry& geometry, std::uint32_t units) {
   cycle_ = cycle;
-  if (!enabled_) return;
+  const std::uint32_t frame_units = frames_ * kUpdateFrameUnits;
+  frames_ = 0;
+  const bool resting = phase_ == Phase::idle || phase_ == Phase::committed || phase_ == Phase::failed;
+  // An operation that outlived an abort is still polled to its end.
+  if (!enabled_ || (resting && !operation_running_)) return frame_units;
+  const std::uint32_t spent = frame_units + kUpdateStepUnits;
   if (operation_running_) {
     const hal::FlashStatus status = flash_->poll();
-    if (status == hal::FlashStatus::busy) return;
+    if (status == hal::FlashStatus::busy) return spent;
     operation_running_ = false;
     if (status != hal::FlashStatus::ok) {
       fail(UpdateReason::flash_failed);
-      return;
+      return spent;
     }
     operation_done();
   }
@@ -341,9 +349,12 @@ void ModelUpdate::step(std::uint32_t cycle, const Geometry& geometry) {
        phase_ == Phase::write_record) &&
       cycle_ - last_activity_cycle_ > kUpdateTimeoutCycles) {
     fail(UpdateReason::timeout);
-    return;
+    return spent;
   }
-  if (!operation_running_) start_work(geometry);
+  if (operation_running_) return spent;
+  const std::uint32_t hash_units = units > spent ? units - spent : 0;
+  start_work(geometry, hash_units);
+  return spent + hash_units_spent_;
 }
 
 void ModelUpdate::start_operation(hal::FlashStatus started) {
@@ -389,7 +400,8 @@ void ModelUpdate::operation_done() {
         if (candidates_[i].slot == active_slot_) running = candidates_[i];
       }
       candidates_[0] = SlotImage{target_slot_, committed_sequence_,
-                                 {flash_->read() + target_.image_offset(), record_.image_size}};
+                                 {flash_->read() + target_.image_offset(), record_.image_size},
+                                 scan_};
       candidate_count_ = 1;
       if (running.slot >= 0 && running.slot == active_slot_) candidates_[candidate_count_++] = running;
       switch_slot_ = target_slot_;
@@ -403,7 +415,8 @@ void ModelUpdate::operation_done() {
         // The rolled-back-to image is the only candidate now.
         candidates_[0] = SlotImage{rollback_slot_, rollback_header_.sequence,
                                    {flash_->read() + slot_geometry(*flash_, rollback_slot_).image_offset(),
-                                    rollback_header_.image_size}};
+                                    rollback_header_.image_size},
+                                   scan_};
         candidate_count_ = 1;
         switch_slot_ = rollback_slot_;
         rollback_slot_ = -1;
@@ -427,7 +440,8 @@ void ModelUpdate::operation_done() {
   }
 }
 
-void ModelUpdate::start_work(const Geometry& geometry) {
+void ModelUpdate::start_work(const Geometry& geometry, std::uint32_t units) {
+  hash_units_spent_ = 0;
   switch (phase_) {
     case Phase::erase_metadata:
       start_operation(flash_->start_erase(target_.offset / target_.sector_bytes));
@@ -460,8 +474,15 @@ void ModelUpdate::start_work(const Geometry& geometry) {
       const int slot = rollback ? rollback_slot_ : target_slot_;
       const std::uint32_t size = rollback ? rollback_header_.image_size : record_.image_size;
       const std::uint8_t* image = flash_->read() + slot_geometry(*flash_, slot).image_offset();
-      const std::uint32_t take = size - hashed_ < kUpdateHashBytesPerCycle ? size - hashed_ : kUpdateHashBytesPerCycle;
+      // As many 64-byte pieces as the units allow: none leaves it for the
+      // next cycle.
+      std::uint32_t slice = units / kUpdateHashUnitsPer64Bytes * 64;
+      if (slice > kUpdateHashBytesPerCycle) slice = kUpdateHashBytesPerCycle;
+      if (slice == 0) return;
+      const std::uint32_t take = size - hashed_ < slice ? size - hashed_ : slice;
+      hash_units_spent_ = (take + 63) / 64 * kUpdateHashUnitsPer64Bytes;
       hash_.update(image + hashed_, take);
+      scan_.step(take);  // the parser's whole-image checks, on the same bytes
       hashed_ += take;
       if (hashed_ < size) return;
       std::uint8_t digest[kSha256Bytes];
@@ -528,7 +549,7 @@ void ModelUpdate::finish_verification(const Geometry& geometry) {
   capacity.max_training_points = kMaxTrainingPoints;
   capacity.max_segments = kMaxSegments;
   capacity.max_variance_rank = model::kMaxVarianceRank;
-  const model::ImageStatus parsed = model::parse_image(image, record_.image_size, view, capacity);
+  const model::ImageStatus parsed = model::parse_image(image, record_.image_size, view, capacity, scan_);
   if (parsed == model::ImageStatus::unsupported_version) {
     fail(UpdateReason::unsupported_version);
     return;

@@ -65,16 +65,13 @@ RuntimeState Runtime::init() {
 
   boot_fault_ = FaultCode::none;
   boot_fault_detail_ = FaultDetail();
-  const hal::MemoryRegion region = model_region();
+  const SlotImage source = model_source();
+  const hal::MemoryRegion region = source.region;
   geometry_ = fallback_geometry_;
   if (region.data == nullptr || region.size_bytes == 0) {
     boot_fault_ = FaultCode::image_missing;
   } else {
-    model::ImageCapacity capacity;
-    capacity.max_training_points = kMaxTrainingPoints;
-    capacity.max_segments = kMaxSegments;
-    capacity.max_variance_rank = kMaxVarianceRank;
-    const model::ImageStatus parsed = model::parse_image(region.data, region.size_bytes, image_, capacity);
+    const model::ImageStatus parsed = parse_model(source, image_);
     if (parsed != model::ImageStatus::ok) {
       boot_fault_ = FaultCode::image_invalid;
       boot_fault_detail_ = FaultDetail(parsed);
@@ -218,7 +215,11 @@ void Runtime::run_cycle(const hal::TimerTick& tick) {
   if (variance_slice) continue_uncertainty();
   ik_units_per_cycle_ = variance_slice ? ik_units_beside_variance_ : ik_units_alone_;
   if (cycle_ % kStatusEveryCycles == 0) publish_status();
-  update_.step(cycle_, geometry_);
+  // The update's work comes out of IK's share, short of IK's smallest step.
+  const std::uint32_t ik_floor = solving_ ? kMinIkUnitsPerCycle : 0;
+  const std::uint32_t update_units =
+      update_.step(cycle_, geometry_, ik_units_per_cycle_ > ik_floor ? ik_units_per_cycle_ - ik_floor : 0);
+  ik_units_per_cycle_ = ik_units_per_cycle_ > update_units + ik_floor ? ik_units_per_cycle_ - update_units : ik_floor;
   if (update_.switch_pending()) reload_model();
   // IK last: the pose, STATUS and the staleness check never wait for it.
   if (solving_) continue_solve();

@@ -6,30 +6,40 @@
 
 namespace cdcr::firmware {
 
-bool Runtime::image_loads(const hal::MemoryRegion& region) {
-  if (region.data == nullptr || region.size_bytes == 0) return false;
+// A slot's image with the checks scanned when it was hashed: the switch to
+// it reads no whole image in its cycle.
+model::ImageStatus Runtime::parse_model(const SlotImage& source, model::ImageView& view) const {
   model::ImageCapacity capacity;
   capacity.max_training_points = kMaxTrainingPoints;
   capacity.max_segments = kMaxSegments;
   capacity.max_variance_rank = kMaxVarianceRank;
+  const hal::MemoryRegion& region = source.region;
+  if (source.scan.done()) return model::parse_image(region.data, region.size_bytes, view, capacity, source.scan);
+  return model::parse_image(region.data, region.size_bytes, view, capacity);
+}
+
+bool Runtime::image_loads(const SlotImage& source) {
+  if (source.region.data == nullptr || source.region.size_bytes == 0) return false;
   model::ImageView view;
   Geometry geometry;
-  return model::parse_image(region.data, region.size_bytes, view, capacity) == model::ImageStatus::ok &&
+  return parse_model(source, view) == model::ImageStatus::ok &&
          model::geometry_from_image(view, geometry) == model::Status::ok &&
          geometry.validate() == model::Status::ok && correction_.bind(view) == model::Status::ok &&
          uncertainty_.bind(view) == model::Status::ok;
 }
 
-hal::MemoryRegion Runtime::model_region() {
+SlotImage Runtime::model_source() {
   if (!update_.booted()) update_.boot();
   for (int i = 0; i < update_.candidate_count(); ++i) {
-    if (image_loads(update_.candidate(i).region)) {
+    if (image_loads(update_.candidate(i))) {
       update_.set_active(i);
-      return update_.candidate(i).region;
+      return update_.candidate(i);
     }
   }
   update_.set_active(-1);
-  return hal_.model_storage.model_region();
+  SlotImage storage;
+  storage.region = hal_.model_storage.model_region();
+  return storage;
 }
 
 // Between two cycles' work: the request being solved was for the old

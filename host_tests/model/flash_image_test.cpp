@@ -95,11 +95,26 @@ ImageStatus parse_reporting(const Bytes& image, Findings& findings, const ImageC
   return parse_image(image.data(), image.size(), view, capacity, &findings);
 }
 
-// The plain verdict, after checking that the reporting mode reaches the same
-// one, and that its first failed finding is the one that decided it.
+// The verdict with the whole-image checks scanned first, `slice` bytes at a
+// time (as the firmware's model update scans beside its hash).
+ImageStatus parse_scanned(const Bytes& image, std::uint32_t slice, const ImageCapacity& capacity = {}) {
+  ImageScan scan;
+  scan.begin(image.data(), image.size());
+  for (std::size_t i = 0; i <= image.size() / slice + 1 && !scan.step(slice); ++i) {
+  }
+  ImageView view{};
+  return parse_image(image.data(), image.size(), view, capacity, scan);
+}
+
+// The plain verdict, after checking that the reporting mode and the scanned
+// parse reach the same one, and that the reporting mode's first failed
+// finding is the one that decided it.
 ImageStatus parse(const Bytes& image, const ImageCapacity& capacity = {}) {
   ImageView view{};
   const ImageStatus status = parse_image(image.data(), image.size(), view, capacity);
+  for (std::uint32_t slice : {4u, 64u, 1024u}) {
+    EXPECT_EQ(parse_scanned(image, slice, capacity), status) << "the parse scanned " << slice << " bytes at a time disagrees";
+  }
   Findings findings;
   EXPECT_EQ(parse_reporting(image, findings, capacity), status) << "the reporting parse disagrees";
   const ImageFinding* first = findings.first_failure();
@@ -1038,6 +1053,44 @@ TEST_F(FlashImage, AHugeVarianceRankIsRefusedWithoutReadingPastTheImage) {
     EXPECT_NE(parse(bad, ImageCapacity{1024, 8, 65535}), ImageStatus::ok) << rank;
     EXPECT_EQ(parse(bad), ImageStatus::over_capacity) << rank;
   }
+}
+
+// --- the whole-image checks scanned a slice at a time ---------------------------
+
+// The parse takes the CRC and the finite payload from the scan: it reads no
+// payload again, so bytes changed after the scan go unseen (what keeps the
+// firmware's parse of a scanned image short). Without the scan they are.
+TEST_F(FlashImage, AScannedParseTakesTheScansVerdicts) {
+  Bytes changed = image;
+  ImageScan scan;
+  scan.begin(changed.data(), changed.size());
+  while (!scan.step(64)) {
+  }
+  put<float>(changed, layout.inputs_offset, std::numeric_limits<float>::quiet_NaN());
+  ImageView view{};
+  EXPECT_EQ(parse_image(changed.data(), changed.size(), view, ImageCapacity{}, scan), ImageStatus::ok);
+  EXPECT_EQ(parse_image(changed.data(), changed.size(), view, ImageCapacity{}), ImageStatus::checksum_mismatch);
+}
+
+// A scan of other bytes, or one not finished, is not used.
+TEST_F(FlashImage, AScanOfOtherBytesOrUnfinishedIsNotUsed) {
+  Bytes bad = image;
+  put<float>(bad, layout.alpha_offset + 4, std::numeric_limits<float>::infinity());
+  reseal(bad);
+  ImageScan of_image;
+  of_image.begin(image.data(), image.size());
+  while (!of_image.step(1024)) {
+  }
+  ImageView view{};
+  EXPECT_EQ(parse_image(bad.data(), bad.size(), view, ImageCapacity{}, of_image), ImageStatus::non_finite_payload);
+
+  Bytes damaged = image;
+  damaged[layout.inputs_offset + 1] ^= 0x10;
+  ImageScan half;
+  half.begin(damaged.data(), damaged.size());
+  half.step(static_cast<std::uint32_t>(damaged.size() / 2) & ~3u);
+  ASSERT_FALSE(half.done());
+  EXPECT_EQ(parse_image(damaged.data(), damaged.size(), view, ImageCapacity{}, half), ImageStatus::checksum_mismatch);
 }
 
 }  // namespace

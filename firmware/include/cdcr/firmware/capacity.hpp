@@ -119,9 +119,20 @@ inline constexpr int kUpdateWindowBlocks = 8;
 // An acknowledgement goes out after this many blocks reached the flash (and
 // whenever the runtime has caught up with what it received).
 inline constexpr int kUpdateAckEveryBlocks = 4;
-// Bytes of the new image hashed per cycle while it is verified: 1 KiB of
-// SHA-256 is about 25 % of a Cortex-M7 cycle's budget.
+// Bytes of the new image hashed per cycle while it is verified, at most
+// (1 KiB of SHA-256 and scan is about 64,000 instructions on a Cortex-M7,
+// four fifths of its cycle's budget). The update's
+// work is charged in work units and comes out of IK's share of the cycle,
+// which keeps at least kMinIkUnitsPerCycle while a request runs; the slice
+// shrinks (in steps of 64 bytes) to what is left. Charges, measured under
+// QEMU by qemu.update_budget_<board> (instructions per unit: the mean
+// point's, 47 on the M7 and 54 on the M4F): each update frame received, a
+// step's fixed work (a flash operation started or polled, a report), and 64
+// bytes hashed (SHA-256 and model::ImageScan).
 inline constexpr std::uint32_t kUpdateHashBytesPerCycle = 1024;
+inline constexpr std::uint32_t kUpdateFrameUnits = 3;
+inline constexpr std::uint32_t kUpdateStepUnits = 100;
+inline constexpr std::uint32_t kUpdateHashUnitsPer64Bytes = 90;
 // A transfer without a valid frame for this many cycles (a minute at 1 kHz)
 // is dropped with reason timeout; the host may resume it with START.
 inline constexpr std::uint32_t kUpdateTimeoutCycles = 60'000;

@@ -24,6 +24,7 @@
 #include "cdcr/firmware/sha256.hpp"
 #include "cdcr/hal/flash.hpp"
 #include "cdcr/hal/model_storage.hpp"
+#include "cdcr/model/flash_image.hpp"
 
 namespace cdcr::firmware {
 
@@ -72,10 +73,15 @@ struct SlotImage {
   int slot = -1;  // 0: A, 1: B
   std::uint32_t sequence = 0;
   hal::MemoryRegion region;
+  // The image's CRC-32 and finite payload, checked when it was hashed
+  // (boot, commit, rollback) so that loading it reads no whole image in one
+  // cycle; not done(): not scanned.
+  model::ImageScan scan;
 };
 
 // The slots whose header is intact and unrevoked and whose image matches
-// its SHA-256, newest first. Hashes every candidate: boot time only.
+// its SHA-256, newest first. Hashes (and scans) every candidate: boot time
+// only.
 int committed_slots(const hal::Flash& flash, SlotImage (&out)[kModelSlots]);
 // The same without the hash: what a header says (for the running system,
 // whose images were hashed when they were committed or at boot).

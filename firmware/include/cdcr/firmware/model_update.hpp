@@ -10,8 +10,11 @@
 //                 is checked (number, length, CRC), held in RAM, programmed,
 //                 then its progress byte; UPDATE_REPORT acknowledges the
 //                 blocks in flash cumulatively.
-//   COMMIT        hash the slot's image (kUpdateHashBytesPerCycle a cycle),
-//                 compare with the announced SHA-256, parse it and check its
+//   COMMIT        hash the slot's image (kUpdateHashBytesPerCycle a cycle,
+//                 and in the same pass the parser's CRC-32 and finite
+//                 payload checks, model::ImageScan), compare with the
+//                 announced SHA-256, parse it (with that scan: no cycle
+//                 reads the whole image) and check its
 //                 geometry against the running model's, then write the slot
 //                 header with a sequence one above the active slot's: the
 //                 commit point. The runtime then loads it, and if it cannot,
@@ -29,6 +32,7 @@
 #include "cdcr/firmware/protocol.hpp"
 #include "cdcr/hal/can_bus.hpp"
 #include "cdcr/hal/flash.hpp"
+#include "cdcr/model/flash_image.hpp"
 #include "cdcr/model/geometry.hpp"
 
 namespace cdcr::firmware {
@@ -54,9 +58,11 @@ class ModelUpdate {
 
   static bool carries(std::uint32_t frame_id) { return protocol::passes(protocol::kUpdateRequestFrames, frame_id); }
   void handle_frame(const hal::CanFrame& frame, std::uint32_t cycle);
-  // One bounded step of flash and hash work; `geometry` is the running
-  // model's, which a new image must match.
-  void step(std::uint32_t cycle, const Geometry& geometry);
+  // One bounded step of flash and hash work, hashing only as much as
+  // `units` allow (capacity.hpp, kUpdate*Units); `geometry` is the running
+  // model's, which a new image must match. Returns the units the update
+  // spent since the last step, its frames included.
+  std::uint32_t step(std::uint32_t cycle, const Geometry& geometry, std::uint32_t units);
   // A committed or rolled-back-to image waits for the runtime to load it.
   bool switch_pending() const { return switch_pending_; }
 
@@ -88,7 +94,7 @@ class ModelUpdate {
   void handle_block(const hal::CanFrame& frame);
   void handle_data(const hal::CanFrame& frame);
   void operation_done();
-  void start_work(const Geometry& geometry);
+  void start_work(const Geometry& geometry, std::uint32_t units);
   void start_operation(hal::FlashStatus started);
   void finish_verification(const Geometry& geometry);
   void fail(protocol::UpdateReason reason);
@@ -109,6 +115,7 @@ class ModelUpdate {
   protocol::UpdateReason last_reason_ = protocol::UpdateReason::none;
   bool operation_running_ = false;
   std::uint32_t last_activity_cycle_ = 0;
+  std::uint32_t frames_ = 0;  // update frames since the last step
   std::uint32_t cycle_ = 0;
 
   // The transfer.
@@ -137,6 +144,8 @@ class ModelUpdate {
   // Verification, and what is written at the commit point.
   Sha256 hash_;
   std::uint32_t hashed_ = 0;
+  std::uint32_t hash_units_spent_ = 0;
+  model::ImageScan scan_;  // parse_image()'s whole-image checks, beside the hash
   std::uint32_t committed_sequence_ = 0;
   int rollback_slot_ = -1;
   SlotHeader rollback_header_;

@@ -188,8 +188,9 @@ class Runtime {
 
  private:
   // runtime_update.cpp: the image init() loads, and the switch to a new one.
-  hal::MemoryRegion model_region();
-  bool image_loads(const hal::MemoryRegion& region);
+  SlotImage model_source();
+  model::ImageStatus parse_model(const SlotImage& source, model::ImageView& view) const;
+  bool image_loads(const SlotImage& source);
   void reload_model();
   void handle_frame(const hal::CanFrame& frame);
   void handle_cable_frame(const hal::CanFrame& frame);

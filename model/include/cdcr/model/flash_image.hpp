@@ -388,6 +388,94 @@ bool expect_each(Run& run, const float* values, std::uint32_t count, Good good, 
 
 inline bool is_finite(float value) { return std::isfinite(value); }
 inline bool is_positive(float value) { return value > 0.0f; }
+}  // namespace detail
+
+// The checks of parse_image() that read every byte of an image (its CRC-32
+// and the finite payload), run a slice at a time by a caller that must keep
+// each step short: the firmware's model update scans beside the SHA-256, a
+// slice a cycle. parse_image(..., scan) then runs every other check and takes
+// these two verdicts from the scan. The scan reads the header only to find
+// the payload's blocks; parse_image() uses its finite verdict only for
+// blocks where it has verified them to lie, and its CRC only when it covers
+// exactly the bytes before the trailer, and otherwise computes them itself.
+class ImageScan {
+ public:
+  static constexpr int kBlocks = 5;  // geometry, parameters, inputs, alpha, variance
+
+  void begin(const std::uint8_t* bytes, std::size_t size) {
+    *this = ImageScan{};
+    bytes_ = bytes;
+    if (bytes == nullptr || size < kImageHeaderSize) return;
+    using namespace image_field;
+    const std::uint32_t total = detail::read_u32(bytes + total_size);
+    end_ = total >= kImageHeaderSize + kImageTrailerSize && total <= size ? total - kImageTrailerSize
+                                                                          : static_cast<std::uint32_t>(size);
+    const std::uint16_t major = detail::read_u16(bytes + version_major);
+    const std::uint32_t n = detail::read_u32(bytes + training_points);
+    const std::uint32_t d = detail::read_u16(bytes + input_dims);
+    const std::uint32_t rank = major == 1 ? 0 : detail::read_u16(bytes + variance_rank);
+    const std::uint64_t floats[kBlocks] = {3u * std::uint64_t{detail::read_u16(bytes + segment_count)},
+                                           image_parameter_floats(d, major), std::uint64_t{n} * d,
+                                           std::uint64_t{n} * kImageOutputs,
+                                           rank > 0 ? image_variance_floats(rank, d) : 0};
+    const std::size_t offsets[kBlocks] = {geometry_offset, parameters_offset, inputs_offset, alpha_offset,
+                                          variance_offset};
+    for (int i = 0; i < kBlocks; ++i) {
+      const std::uint32_t at = detail::read_u32(bytes + offsets[i]);
+      // Blocks the scan cannot check (outside the bytes, misaligned) stay
+      // empty: parse_image() then checks them itself, or refuses the image.
+      if (floats[i] == 0 || at % alignof(float) != 0 || at > end_ || 4 * floats[i] > end_ - at) continue;
+      first_[i] = at;
+      floats_[i] = static_cast<std::uint32_t>(floats[i]);
+    }
+  }
+
+  // Up to max_bytes more; true once every byte is scanned. A slice ends on a
+  // float boundary when max_bytes is a multiple of 4.
+  bool step(std::uint32_t max_bytes) {
+    const std::uint32_t to = end_ - at_ < max_bytes ? end_ : at_ + max_bytes;
+    crc_ = crc32(bytes_ + at_, to - at_, crc_);
+    for (int i = 0; i < kBlocks; ++i) {
+      const std::uint32_t last = first_[i] + 4 * floats_[i];
+      std::uint32_t from = at_ > first_[i] ? at_ : first_[i];
+      from += (from - first_[i]) % 4 == 0 ? 0 : 4 - (from - first_[i]) % 4;
+      for (std::uint32_t byte = from; byte + 4 <= to && byte < last; byte += 4) {
+        float value;
+        std::memcpy(&value, bytes_ + byte, 4);
+        finite_[i] = finite_[i] && std::isfinite(value);
+      }
+    }
+    at_ = to;
+    return done();
+  }
+
+  bool done() const { return bytes_ != nullptr && at_ == end_; }
+  const std::uint8_t* bytes() const { return bytes_; }
+  std::uint32_t crc() const { return crc_; }
+  std::uint32_t crc_bytes() const { return end_; }
+  // Whether the scan checked `count` floats at `values` and found them all
+  // finite (checked: false when it did not scan exactly that block).
+  bool covers(const float* values, std::uint32_t count, bool& finite) const {
+    for (int i = 0; i < kBlocks; ++i) {
+      if (done() && floats_[i] == count && reinterpret_cast<const std::uint8_t*>(values) == bytes_ + first_[i]) {
+        finite = finite_[i];
+        return true;
+      }
+    }
+    return false;
+  }
+
+ private:
+  const std::uint8_t* bytes_ = nullptr;
+  std::uint32_t end_ = 0;  // the bytes before the trailer
+  std::uint32_t at_ = 0;
+  std::uint32_t crc_ = 0;
+  std::uint32_t first_[kBlocks] = {};
+  std::uint32_t floats_[kBlocks] = {};
+  bool finite_[kBlocks] = {true, true, true, true, true};
+};
+
+namespace detail {
 
 // Checks run from what is needed to read the rest (size, magic, version,
 // header) to the integrity check and then to the meaning of the payload, so
@@ -396,7 +484,7 @@ inline bool is_positive(float value) { return value > 0.0f; }
 // the buffer (and floats only where they are aligned).
 template <typename Run>
 ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& view, const ImageCapacity& capacity,
-                        Run& run) {
+                        Run& run, const ImageScan* scan = nullptr) {
   using namespace image_field;
   using Check = ImageCheckId;
   using Status = ImageStatus;
@@ -451,7 +539,9 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
 
   if (total_holds_trailer && declared_total <= size) {
     const std::uint32_t stored_crc = read_u32(bytes + declared_total - kImageTrailerSize);
-    const std::uint32_t computed_crc = crc32(bytes, declared_total - kImageTrailerSize);
+    const std::uint32_t covered = declared_total - kImageTrailerSize;
+    const bool scanned = scan != nullptr && scan->done() && scan->bytes() == bytes && scan->crc_bytes() == covered;
+    const std::uint32_t computed_crc = scanned ? scan->crc() : crc32(bytes, covered);
     if (!run.expect(stored_crc == computed_crc, Check::checksum, Status::checksum_mismatch, "crc32", -1, stored_crc,
                     computed_crc, Expect::equal)) {
       return run.status;
@@ -603,6 +693,14 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
                  {Run::name("alpha"), alpha, n * kImageOutputs},
                  {Run::name("variance"), variance, static_cast<std::uint32_t>(variance_floats)}};
   for (const auto& values : payload) {
+    bool finite = true;
+    if (values.values != nullptr && scan != nullptr && scan->covers(values.values, values.count, finite)) {
+      if (!run.expect(finite, Check::finite, Status::non_finite_payload, values.name, -1, 0.0, 0.0, Expect::finite,
+                      values.count)) {
+        return run.status;
+      }
+      continue;
+    }
     if (values.values != nullptr && !expect_each(run, values.values, values.count, is_finite, Check::finite,
                                                  Status::non_finite_payload, values.name, Expect::finite)) {
       return run.status;
@@ -769,6 +867,16 @@ inline ImageStatus parse_image(const std::uint8_t* bytes, std::size_t size, Imag
                                const ImageCapacity& capacity = {}) {
   detail::StopAtFirstFailure run;
   return detail::check_image(bytes, size, view, capacity, run);
+}
+
+// The same verdict, with the checks that read every byte taken from `scan`
+// (ImageScan: run over these bytes, a slice at a time, by the caller) where
+// it covers them; what is left is independent of the image's size but for
+// the variance block's diagonals and the few parameter arrays.
+inline ImageStatus parse_image(const std::uint8_t* bytes, std::size_t size, ImageView& view,
+                               const ImageCapacity& capacity, const ImageScan& scan) {
+  detail::StopAtFirstFailure run;
+  return detail::check_image(bytes, size, view, capacity, run, &scan);
 }
 
 // The same verdict; with a sink, every check that can be evaluated is, and

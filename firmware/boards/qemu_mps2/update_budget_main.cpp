@@ -1,0 +1,452 @@
+// The cycle budget during model updates, on the board: the runtime with a
+// RAM flash of two slots (hal/cortexm's RamFlash) takes whole transfers over
+// the mailbox bus while the drives keep sending cable lengths every cycle and
+// pose targets keep IK busy, and every Runtime::run_cycle is counted in
+// instructions (QEMU -icount, as cycle_budget_main):
+//   1. the model storage's image (the golden model) into slot A: transfer,
+//      COMMIT (hash, CRC and parse a slice a cycle), the switch to slot A;
+//   2. a second image (the same model with another creation time, hence
+//      another digest) into slot B, committed and switched to;
+//   3. ROLLBACK to slot A: its hash, the revoke, the switch.
+// Prints the worst cycle of each phase and `worst cycle: N instructions over
+// C cycles (budget B)`, and fails when a cycle exceeds the board's budget
+// (80,000 instructions on the Cortex-M7, 120,000 on the Cortex-M4F), a
+// cycle in RUN publishes no pose, or an update does not end on the slot it
+// should.
+
+#include <algorithm>
+#include <cstring>
+
+#include <cdcr/cortexm/ram_flash.hpp>
+#include <cdcr/cortexm/semihosting.hpp>
+#include <cdcr/firmware/runtime.hpp>
+#include <cdcr/firmware/sha256.hpp>
+#include <cdcr/model/crc32.hpp>
+
+#include "board.hpp"
+#include "golden_check.hpp"
+
+namespace {
+
+namespace console = cdcr::cortexm;
+namespace model = cdcr::model;
+namespace firmware = cdcr::firmware;
+namespace protocol = cdcr::firmware::protocol;
+
+#if defined(__ARM_FP) && !(__ARM_FP & 0x8)
+constexpr std::uint32_t kBudgetInstructions = 120'000;  // Cortex-M4F
+#else
+constexpr std::uint32_t kBudgetInstructions = 80'000;  // Cortex-M7
+#endif
+constexpr int kIcountShift = 10;
+constexpr std::int64_t kCountingPeriodNs = 600'000'000;
+
+// Two slots, each a metadata sector and 16 image sectors of 4 KiB: room for
+// a 64 KiB image (the golden one is about 57 KiB). 136 KiB of the board's
+// 4 MiB of RAM; a board with a flash controller has its flash instead.
+constexpr std::uint32_t kSectorBytes = 4096;
+constexpr std::uint32_t kSlotSectors = 1 + 16;
+cdcr::cortexm::RamFlash<kSectorBytes, 2 * kSlotSectors> flash;
+
+cdcr::boards::mps2::Board board;
+cdcr::hal::Hal hal_with_flash() {
+  cdcr::hal::Hal hal = board.hal();
+  hal.flash = &flash;
+  return hal;
+}
+firmware::Runtime runtime(hal_with_flash(), cdcr::boards::mps2::golden_geometry());
+firmware::Correction correction;
+
+std::uint64_t overhead_ticks = 0;
+
+std::uint32_t ticks_to_instructions(std::uint64_t ticks) {
+  const std::uint64_t ns = ticks * (1'000'000'000u / cdcr::boards::mps2::kCoreClockHz);
+  return static_cast<std::uint32_t>((ns + (1u << (kIcountShift - 1))) >> kIcountShift);
+}
+
+__attribute__((noinline)) void run_cycle_opaque(const cdcr::hal::TimerTick& tick) { runtime.run_cycle(tick); }
+
+std::uint32_t counted_cycle() {
+  const cdcr::hal::TimerTick tick{board.timer.now_ns(), 0};
+  asm volatile("" ::: "memory");
+  const std::uint64_t start = board.timer.now_ticks();
+  asm volatile("" ::: "memory");
+  run_cycle_opaque(tick);
+  asm volatile("" ::: "memory");
+  const std::uint64_t end = board.timer.now_ticks();
+  asm volatile("" ::: "memory");
+  const std::uint64_t ticks = end - start;
+  return ticks_to_instructions(ticks > overhead_ticks ? ticks - overhead_ticks : 0);
+}
+
+// Instructions of one call of work(), as counted_cycle() counts a cycle.
+template <typename Work>
+std::uint32_t counted(Work&& work) {
+  asm volatile("" ::: "memory");
+  const std::uint64_t start = board.timer.now_ticks();
+  asm volatile("" ::: "memory");
+  work();
+  asm volatile("" ::: "memory");
+  const std::uint64_t end = board.timer.now_ticks();
+  asm volatile("" ::: "memory");
+  const std::uint64_t ticks = end - start;
+  return ticks_to_instructions(ticks > overhead_ticks ? ticks - overhead_ticks : 0);
+}
+
+// What the update's charges stand for on this core: 64 bytes of the
+// verification pass (SHA-256 and the parser's scan), the most of 16 such.
+void report_update_costs(const std::uint8_t* image, std::uint32_t size) {
+  firmware::Sha256 hash;
+  model::ImageScan scan;
+  scan.begin(image, size);
+  std::uint32_t most = 0;
+  for (std::uint32_t at = 0; at + 64 <= 1024 && at + 64 <= size; at += 64) {
+    most = std::max(most, counted([&] {
+      hash.update(image + at, 64);
+      scan.step(64);
+    }));
+  }
+  console::console_write("update costs (instructions): 64 bytes hashed and scanned ");
+  console::console_write_int(static_cast<std::int32_t>(most));
+  console::console_write(" (charged ");
+  console::console_write_int(static_cast<std::int32_t>(firmware::kUpdateHashUnitsPer64Bytes));
+  console::console_write(" units)\n");
+}
+
+// xorshift32: the same workload on every run and both boards.
+std::uint32_t rng_state = 0x9E3779B9u;
+float uniform(float lo, float hi) {
+  rng_state ^= rng_state << 13;
+  rng_state ^= rng_state >> 17;
+  rng_state ^= rng_state << 5;
+  return lo + (hi - lo) * float(rng_state >> 8) * (1.0f / 16777216.0f);
+}
+
+int segments = 0;
+float drive_lengths_mm[firmware::kMaxSegments][4];
+
+// The host's side of the transfer (as tools/cdcr/deploy_sender.hpp, without
+// its heap): go-back-N over the window the last report granted.
+class Sender {
+ public:
+  void begin(const std::uint8_t* image, std::uint32_t size) {
+    image_ = image;
+    size_ = size;
+    firmware::sha256(image, size, digest_);
+    transfer_id_ = static_cast<std::uint16_t>(digest_[0] | (digest_[1] << 8));
+    total_ = (size + protocol::kUpdateBlockBytes - 1) / protocol::kUpdateBlockBytes;
+    next_ = base_ = window_ = 0;
+    acknowledged_ = 0;
+    commit_sent_ = committed_ = refused_ = false;
+    silent_cycles_ = 0;
+    start();
+  }
+  bool committed() const { return committed_; }
+  bool refused() const { return refused_; }
+
+  void on_report(const cdcr::hal::CanFrame& frame) {
+    protocol::UpdateReport report;
+    if (protocol::decode(frame, report) != protocol::DecodeStatus::ok) return;
+    silent_cycles_ = 0;
+    switch (report.reason) {
+      case protocol::UpdateReason::none:
+      case protocol::UpdateReason::duplicate:
+        break;
+      case protocol::UpdateReason::corrupted:
+      case protocol::UpdateReason::out_of_order:
+      case protocol::UpdateReason::missing_block:
+        next_ = report.next_block;
+        break;
+      default:
+        refused_ = true;
+        return;
+    }
+    if (report.state == protocol::UpdateState::committed) {
+      committed_ = true;
+      return;
+    }
+    if (report.state != protocol::UpdateState::receiving) return;
+    acknowledged_ = std::max<std::uint32_t>(acknowledged_, report.next_block);
+    base_ = report.next_block;
+    window_ = report.window;
+    if (next_ < base_) next_ = base_;
+    if (acknowledged_ == total_ && !commit_sent_) {
+      protocol::UpdateCommandFrame command;
+      command.command = protocol::UpdateCommand::commit;
+      command.transfer_id = transfer_id_;
+      send(command);
+      commit_sent_ = true;
+    }
+  }
+
+  // The blocks the window allows, at most `frames` frames this cycle.
+  void pump(int frames) {
+    if (committed_ || refused_) return;
+    if (++silent_cycles_ > 200) {
+      // Silence: from the last acknowledged block again.
+      silent_cycles_ = 0;
+      commit_sent_ = false;
+      next_ = acknowledged_;
+      start();
+      return;
+    }
+    constexpr int kFramesPerBlock = 1 + protocol::kUpdateDataFramesPerBlock;
+    while (next_ < total_ && next_ < base_ + window_ && frames >= kFramesPerBlock) {
+      send_block(next_++);
+      frames -= kFramesPerBlock;
+    }
+  }
+
+ private:
+  template <typename Message>
+  static void send(const Message& message) {
+    cdcr::hal::CanFrame frame;
+    protocol::encode(message, frame);
+    board.can.deliver(frame);
+  }
+  void start() {
+    for (std::uint8_t part = 0; part < 8; ++part) {
+      protocol::UpdateDigest digest;
+      digest.part = part;
+      std::memcpy(digest.bytes, digest_ + 4 * part, 4);
+      send(digest);
+    }
+    protocol::UpdateCommandFrame command;
+    command.command = protocol::UpdateCommand::start;
+    command.transfer_id = transfer_id_;
+    command.image_size = size_;
+    send(command);
+  }
+  void send_block(std::uint32_t block) {
+    const std::uint32_t at = block * protocol::kUpdateBlockBytes;
+    const std::uint32_t length = std::min<std::uint32_t>(protocol::kUpdateBlockBytes, size_ - at);
+    protocol::UpdateBlock header;
+    header.block = static_cast<std::uint16_t>(block);
+    header.length = static_cast<std::uint8_t>(length);
+    header.crc = protocol::update_block_crc(header.block, image_ + at, length);
+    send(header);
+    for (std::uint32_t offset = 0; offset < length; offset += 8) {
+      protocol::UpdateData data;
+      std::memcpy(data.bytes, image_ + at + offset, std::min<std::uint32_t>(8, length - offset));
+      send(data);
+    }
+  }
+
+  const std::uint8_t* image_ = nullptr;
+  std::uint32_t size_ = 0;
+  std::uint8_t digest_[firmware::kSha256Bytes] = {};
+  std::uint16_t transfer_id_ = 0;
+  std::uint32_t total_ = 0, next_ = 0, base_ = 0, window_ = 0, acknowledged_ = 0;
+  bool commit_sent_ = false, committed_ = false, refused_ = false;
+  int silent_cycles_ = 0;
+};
+
+Sender sender;
+
+// The ideal drives: the last setpoint of each segment, reported every
+// cycle; the runtime's reports go to the sender.
+void exchange() {
+  cdcr::hal::CanFrame frame;
+  while (board.can.take_transmitted(frame)) {
+    if (protocol::update_report::kMessage.carries(frame.id)) {
+      sender.on_report(frame);
+      continue;
+    }
+    protocol::CableSetpoint setpoint;
+    if (protocol::decode(frame, setpoint) != protocol::DecodeStatus::ok) continue;
+    for (int k = 0; k < 4; ++k) drive_lengths_mm[setpoint.segment][k] = float(setpoint.lengths_mm[k]);
+  }
+  for (int s = 0; s < segments; ++s) {
+    protocol::CableFeedback feedback{s, {drive_lengths_mm[s][0], drive_lengths_mm[s][1], drive_lengths_mm[s][2],
+                                         drive_lengths_mm[s][3]}};
+    if (protocol::encode(feedback, frame)) board.can.deliver(frame);
+  }
+}
+
+// A pose target at random joints, through the runtime's compensated model.
+std::uint8_t next_sequence = 0;
+void deliver_target() {
+  model::JointVector<float> joints(2 * segments);
+  for (int s = 0; s < segments; ++s) {
+    joints[2 * s] = uniform(-3.14159f, 3.14159f);
+    joints[2 * s + 1] = uniform(0.0f, std::min(0.2f, runtime.geometry().segments[s].theta_max_rad));
+  }
+  const model::JointVector<float> bend = model::bend_from_joints(joints);
+  const model::Pose<float> target =
+      model::exp(correction.predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
+  Eigen::Quaternion<float> q(target.rotation);
+  q.normalize();
+  cdcr::hal::CanFrame frame;
+  protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, frame);
+  board.can.deliver(frame);
+  protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
+  board.can.deliver(frame);
+  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), protocol::TargetMode::pose, false, next_sequence++},
+                   frame);
+  board.can.deliver(frame);
+}
+
+enum Phase { kTransfer, kCommit, kSwitch, kOther, kPhases };
+const char* const kPhaseNames[kPhases] = {"transfer", "commit (hash, CRC, parse, header)", "switch", "other"};
+std::uint32_t worst_of[kPhases] = {};
+std::uint32_t cycles_of[kPhases] = {};
+std::uint32_t worst = 0;
+std::uint32_t cycles_run = 0;
+std::uint32_t over_budget = 0;
+std::uint32_t poses_missing = 0;
+std::uint32_t switches = 0;
+
+// One counted cycle: the drives' frames, the sender's (what the mailbox has
+// room for beside them and a target's), a target every 40 cycles.
+void cycle() {
+  exchange();
+  if (cycles_run % 40 == 0) deliver_target();
+  sender.pump(32 - segments - 3);
+  const firmware::ModelUpdate& update = runtime.model_update();
+  const protocol::UpdateState before = update.state();
+  const int slot_before = update.active_slot();
+  const std::uint32_t sequence_before = update.active_sequence();
+  const std::uint32_t published = runtime.statistics().poses_published;
+  const std::uint32_t instructions = counted_cycle();
+  Phase phase = kOther;
+  if (update.active_slot() != slot_before || update.active_sequence() != sequence_before) {
+    phase = kSwitch;
+    ++switches;
+  } else if (before == protocol::UpdateState::preparing || before == protocol::UpdateState::receiving) {
+    phase = kTransfer;
+  } else if (before == protocol::UpdateState::verifying) {
+    phase = kCommit;
+  }
+  worst_of[phase] = std::max(worst_of[phase], instructions);
+  cycles_of[phase] += 1;
+  worst = std::max(worst, instructions);
+  if (instructions > kBudgetInstructions && ++over_budget <= 12) {
+    console::console_write("over budget: cycle ");
+    console::console_write_int(static_cast<std::int32_t>(cycles_run));
+    console::console_write(" (");
+    console::console_write(kPhaseNames[phase]);
+    console::console_write(", update state ");
+    console::console_write_int(static_cast<std::int32_t>(before));
+    console::console_write("), ");
+    console::console_write_int(static_cast<std::int32_t>(instructions));
+    console::console_write(" instructions, IK units ");
+    console::console_write_int(static_cast<std::int32_t>(runtime.ik_units_last_cycle()));
+    console::console_write("\n");
+  }
+  if (runtime.state() == firmware::RuntimeState::run && runtime.statistics().poses_published != published + 1) {
+    ++poses_missing;
+  }
+  ++cycles_run;
+}
+
+// Cycles until the sender is done (committed and switched) or refused.
+bool transfer(const std::uint8_t* image, std::uint32_t size, int expected_slot) {
+  sender.begin(image, size);
+  for (int i = 0; i < 20'000 && !sender.committed() && !sender.refused(); ++i) cycle();
+  for (int i = 0; i < 20; ++i) cycle();
+  const bool ok = sender.committed() && runtime.model_update().active_slot() == expected_slot &&
+                  runtime.state() == firmware::RuntimeState::run;
+  console::console_write(ok ? "update into slot " : "FAIL: update into slot ");
+  console::console_write_int(expected_slot);
+  console::console_write(ok ? " committed and running\n" : " did not commit or does not run\n");
+  return ok;
+}
+
+// The second image: the golden one with another creation time (and its CRC
+// trailer made again), so that its digest differs.
+alignas(8) std::uint8_t second_image[64 * 1024];
+
+}  // namespace
+
+int main() {
+  cdcr::cortexm::attach_systick(board.timer);
+  board.timer.start(kCountingPeriodNs);
+  if (runtime.init() != firmware::RuntimeState::run || !runtime.model_update().enabled()) {
+    console::console_write("FAIL: the runtime did not boot into RUN with model updates enabled\n");
+    return 1;
+  }
+  const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
+  model::ImageView image{};
+  if (model::parse_image(region.data, region.size_bytes, image, model::ImageCapacity{}) != model::ImageStatus::ok ||
+      correction.bind(image) != model::Status::ok || region.size_bytes > sizeof(second_image)) {
+    console::console_write("FAIL: cannot bind the image\n");
+    return 1;
+  }
+  segments = runtime.geometry().segment_count;
+  {
+    asm volatile("" ::: "memory");
+    const std::uint64_t start = board.timer.now_ticks();
+    asm volatile("" ::: "memory");
+    const std::uint64_t end = board.timer.now_ticks();
+    overhead_ticks = end - start;
+  }
+  for (int s = 0; s < segments; ++s) {
+    for (int k = 0; k < 4; ++k) drive_lengths_mm[s][k] = float(cdcr::qemu_golden::kCablesMm[0][4 * s + k]);
+  }
+  const std::uint32_t size = static_cast<std::uint32_t>(region.size_bytes);
+  console::console_write("image: ");
+  console::console_write_int(static_cast<std::int32_t>(size));
+  console::console_write(" bytes, ");
+  console::console_write_int(static_cast<std::int32_t>(image.training_points));
+  console::console_write(" training points\n");
+
+  report_update_costs(region.data, size);
+
+  std::memcpy(second_image, region.data, size);
+  std::uint32_t metadata = 0;
+  std::memcpy(&metadata, second_image + model::image_field::metadata_offset, 4);
+  second_image[metadata + model::image_metadata_field::created_unix_s] ^= 0x01;
+  const std::uint32_t crc = model::crc32(second_image, size - model::kImageTrailerSize);
+  std::memcpy(second_image + size - model::kImageTrailerSize, &crc, 4);
+
+  for (int i = 0; i < 100; ++i) cycle();
+  bool ok = transfer(region.data, size, 0);
+  ok = transfer(second_image, size, 1) && ok;
+
+  // Rollback to slot A: its hash a slice a cycle, the revoke, the switch.
+  cdcr::hal::CanFrame frame;
+  protocol::UpdateCommandFrame rollback;
+  rollback.command = protocol::UpdateCommand::rollback;
+  protocol::encode(rollback, frame);
+  board.can.deliver(frame);
+  for (int i = 0; i < 500 && runtime.model_update().active_slot() != 0; ++i) cycle();
+  for (int i = 0; i < 20; ++i) cycle();
+  const bool rolled_back = runtime.model_update().active_slot() == 0 && runtime.state() == firmware::RuntimeState::run;
+  console::console_write(rolled_back ? "rollback to slot 0: running\n" : "FAIL: rollback to slot 0\n");
+  ok = ok && rolled_back;
+
+  for (int p = 0; p < kPhases; ++p) {
+    console::console_write("worst ");
+    console::console_write(kPhaseNames[p]);
+    console::console_write(" cycle: ");
+    console::console_write_int(static_cast<std::int32_t>(worst_of[p]));
+    console::console_write(" instructions over ");
+    console::console_write_int(static_cast<std::int32_t>(cycles_of[p]));
+    console::console_write(" cycles\n");
+  }
+  console::console_write("worst cycle: ");
+  console::console_write_int(static_cast<std::int32_t>(worst));
+  console::console_write(" instructions over ");
+  console::console_write_int(static_cast<std::int32_t>(cycles_run));
+  console::console_write(" cycles (budget ");
+  console::console_write_int(static_cast<std::int32_t>(kBudgetInstructions));
+  console::console_write(")\n");
+  if (over_budget > 0) {
+    console::console_write("FAIL: cycles over budget: ");
+    console::console_write_int(static_cast<std::int32_t>(over_budget));
+    console::console_write("\n");
+    ok = false;
+  }
+  if (poses_missing > 0) {
+    console::console_write("FAIL: cycles in RUN without a pose: ");
+    console::console_write_int(static_cast<std::int32_t>(poses_missing));
+    console::console_write("\n");
+    ok = false;
+  }
+  if (switches != 3) {
+    console::console_write("FAIL: expected 3 switches\n");
+    ok = false;
+  }
+  console::console_write(ok ? "PASS\n" : "FAIL\n");
+  return ok ? 0 : 1;
+}
