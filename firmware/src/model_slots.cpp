@@ -94,7 +94,7 @@ int committed_slots(const hal::Flash& flash, SlotImage (&out)[kModelSlots]) {
     std::uint8_t digest[kSha256Bytes];
     sha256(image, header.image_size, digest);
     if (std::memcmp(digest, header.digest, kSha256Bytes) != 0) continue;
-    out[count] = SlotImage{slot, header.sequence, {image, header.image_size}};
+    out[count] = SlotImage{slot, header.sequence, {image, header.image_size}, {}};
     out[count].scan.begin(image, header.image_size);
     out[count].scan.step(header.image_size);
     count += 1;

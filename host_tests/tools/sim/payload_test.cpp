@@ -193,7 +193,9 @@ TEST(SimulatorPayload, MorePayloadSagsTheTipFurtherAlongGravity) {
         EXPECT_GT(along, previous_sag) << step;
         // The end disk turns towards the ground; far out in the wide
         // workspace it can face the ground already and turn past it.
-        if (paper_workspace) EXPECT_GT(tilt, previous_tilt) << step;
+        if (paper_workspace) {
+          EXPECT_GT(tilt, previous_tilt) << step;
+        }
         // Within the paper's workspace mostly downwards; a robot bent far
         // sideways also swings about its base (the lever arms turn with it).
         EXPECT_GT(along, (paper_workspace ? 0.8 : 0.3) * moved.norm()) << step;

@@ -557,13 +557,14 @@ TEST(TrainEndToEnd, SimulateWritesThePayloadColumn) {
       std::string::npos);
 }
 
-// Until the model takes the payload as an input, training and evaluation
-// read a dataset with the column as they read one without.
+// A small data set with the column trains and evaluates on every row. (Its
+// files are its own: ctest runs this file's tests in parallel, in one
+// temporary directory.)
 TEST(TrainEndToEnd, TrainAndEvalReadAPayloadColumn) {
   const std::string dir = testing::TempDir();
-  const std::string train = "'" + dir + "payload_train.csv'";
-  const std::string test = "'" + dir + "payload_test.csv'";
-  const std::string image = "'" + dir + "payload_model.img'";
+  const std::string train = "'" + dir + "payload_column_train.csv'";
+  const std::string test = "'" + dir + "payload_column_test.csv'";
+  const std::string image = "'" + dir + "payload_column_model.img'";
   ASSERT_EQ(run_cdcr("simulate --samples 150 --seed 5 --payload-range 0,1 --out " + train).exit_code, 0);
   ASSERT_EQ(run_cdcr("simulate --samples 60 --seed 5 --session 2 --payload-range 0,1 --out " + test).exit_code, 0);
   CliRun run = run_cdcr("train --data " + train + " --out " + image + " --restarts 0 --json");
