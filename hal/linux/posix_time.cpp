@@ -36,11 +36,16 @@ hal::TimerTick PosixPeriodicTimer::wait_next() {
     tick.missed_releases = behind > 0xFFFFFFFF ? 0xFFFFFFFFu : std::uint32_t(behind);
   }
   overruns_ += tick.missed_releases;
-  const timespec deadline{static_cast<time_t>(next_release_ns_ / kNanosecondsPerSecond),
-                          static_cast<long>(next_release_ns_ % kNanosecondsPerSecond)};
-  // The deadline is absolute, so a sleep cut short by a signal resumes to the
-  // same instant.
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
+  if (wait_ == ReleaseWait::spin) {
+    while (clock_.now_ns() < next_release_ns_) {
+    }
+  } else {
+    const timespec deadline{static_cast<time_t>(next_release_ns_ / kNanosecondsPerSecond),
+                            static_cast<long>(next_release_ns_ % kNanosecondsPerSecond)};
+    // The deadline is absolute, so a sleep cut short by a signal resumes to
+    // the same instant.
+    while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &deadline, nullptr) == EINTR) {
+    }
   }
   tick.release_ns = next_release_ns_;
   next_release_ns_ += period_ns_;

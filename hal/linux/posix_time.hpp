@@ -1,7 +1,8 @@
 #pragma once
 // Time on a Linux host: CLOCK_MONOTONIC, and periodic releases slept to with
 // clock_nanosleep(TIMER_ABSTIME) so that neither the work nor the sleep's own
-// latency accumulates into drift.
+// latency accumulates into drift; or spun to, for a core given to the
+// runtime alone.
 
 #include <cstdint>
 
@@ -14,9 +15,19 @@ class PosixMonotonicClock final : public hal::MonotonicClock {
   std::int64_t now_ns() const override;
 };
 
+// How a release is waited for. sleep gives the core away between cycles;
+// on a virtual machine, or a core that other threads share, the cycle after
+// the sleep then often starts on a cold cache or a descheduled core, which
+// on the README's benchmark host tripled a cycle's p99 at 1 kHz. spin reads
+// the clock until the release, keeping the core and its caches: for a core
+// reserved for the runtime (isolcpus, or a dedicated board computer), at
+// the price of the whole core.
+enum class ReleaseWait { sleep, spin };
+
 class PosixPeriodicTimer final : public hal::PeriodicTimer {
  public:
-  explicit PosixPeriodicTimer(const hal::MonotonicClock& clock) : clock_(clock) {}
+  explicit PosixPeriodicTimer(const hal::MonotonicClock& clock, ReleaseWait wait = ReleaseWait::sleep)
+      : clock_(clock), wait_(wait) {}
 
   // Release 1 is one period after start().
   void start(std::int64_t period_ns) override;
@@ -26,6 +37,7 @@ class PosixPeriodicTimer final : public hal::PeriodicTimer {
 
  private:
   const hal::MonotonicClock& clock_;
+  ReleaseWait wait_;
   std::int64_t period_ns_ = 0;
   std::int64_t next_release_ns_ = 0;
   std::uint32_t overruns_ = 0;

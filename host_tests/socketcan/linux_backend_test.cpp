@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <fstream>
 #include <string>
+#include <time.h>
 #include <unistd.h>
 
 #include <gtest/gtest.h>
@@ -52,14 +53,25 @@ TEST(MappedModelStorage, MissingFileIsAnErrorWithoutARegion) {
   EXPECT_EQ(storage.model_region().data, nullptr);
 }
 
-TEST(PosixPeriodicTimer, ReleasesOnAbsoluteDeadlines) {
+std::int64_t thread_cpu_ns() {
+  timespec t{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &t);
+  return std::int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
+}
+
+class PosixPeriodicTimerWaits : public ::testing::TestWithParam<ReleaseWait> {};
+INSTANTIATE_TEST_SUITE_P(Waits, PosixPeriodicTimerWaits, ::testing::Values(ReleaseWait::sleep, ReleaseWait::spin),
+                         [](const auto& info) { return info.param == ReleaseWait::sleep ? "sleep" : "spin"; });
+
+TEST_P(PosixPeriodicTimerWaits, ReleasesOnAbsoluteDeadlines) {
   PosixMonotonicClock clock;
-  PosixPeriodicTimer timer(clock);
+  PosixPeriodicTimer timer(clock, GetParam());
   constexpr std::int64_t kPeriodNs = 2'000'000;
   timer.start(kPeriodNs);
   const hal::TimerTick first = timer.wait_next();
   EXPECT_GE(clock.now_ns(), first.release_ns);
   std::int64_t releases = 0;
+  const std::int64_t cpu_begin_ns = thread_cpu_ns();
   for (int k = 1; k <= 5; ++k) {
     const hal::TimerTick tick = timer.wait_next();
     // On the period grid, whatever the sleep's own latency was (a busy host
@@ -68,11 +80,19 @@ TEST(PosixPeriodicTimer, ReleasesOnAbsoluteDeadlines) {
     EXPECT_EQ(tick.release_ns - first.release_ns, releases * kPeriodNs);
     EXPECT_GE(clock.now_ns(), tick.release_ns);
   }
+  // Sleeping gives the core away; spinning keeps it (a loaded machine still
+  // takes part of it from the spinning thread, hence the wide margin).
+  const double cpu_share = double(thread_cpu_ns() - cpu_begin_ns) / double(releases * kPeriodNs);
+  if (GetParam() == ReleaseWait::sleep) {
+    EXPECT_LT(cpu_share, 0.25);
+  } else {
+    EXPECT_GT(cpu_share, 0.25);
+  }
 }
 
-TEST(PosixPeriodicTimer, CountsEveryMissedRelease) {
+TEST_P(PosixPeriodicTimerWaits, CountsEveryMissedRelease) {
   PosixMonotonicClock clock;
-  PosixPeriodicTimer timer(clock);
+  PosixPeriodicTimer timer(clock, GetParam());
   constexpr std::int64_t kPeriodNs = 2'000'000;
   timer.start(kPeriodNs);
   const hal::TimerTick first = timer.wait_next();

@@ -446,14 +446,15 @@ void print_cycle_statistics(const fw::Runtime& runtime, const cdcr::hal::CanErro
 // The runtime on a real bus: the same object the board runs, on the Linux
 // backends, until the duration ends or a signal asks it to stop.
 int run_on_socketcan(const std::string& image_path, const std::string& interface_name, double rate_hz,
-                     double seconds, const std::string& flash_dir) {
+                     double seconds, const std::string& flash_dir, bool spin) {
   if (!(rate_hz > 0) || !(rate_hz <= 100000)) throw std::invalid_argument("--rate must be in (0, 100000] Hz");
   if (seconds != 0 && (!(seconds > 0) || !(seconds <= 86400))) {
     throw std::invalid_argument("--seconds must be in (0, 86400]");
   }
   static cdcr::linux_host::SocketCanBus bus;
   static cdcr::linux_host::PosixMonotonicClock clock;
-  static cdcr::linux_host::PosixPeriodicTimer timer{clock};
+  static cdcr::linux_host::PosixPeriodicTimer timer{
+      clock, spin ? cdcr::linux_host::ReleaseWait::spin : cdcr::linux_host::ReleaseWait::sleep};
   static cdcr::linux_host::MappedModelStorage storage;
   static cdcr::linux_host::StdioConsole console{stderr};
   std::string error;
@@ -488,7 +489,7 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   return 0;
 }
 #else
-int run_on_socketcan(const std::string&, const std::string&, double, double, const std::string&) {
+int run_on_socketcan(const std::string&, const std::string&, double, double, const std::string&, bool) {
   throw InputError("--can needs a Linux host (SocketCAN)");
 }
 #endif
@@ -513,6 +514,10 @@ int main(int argc, char** argv) {
   auto* sim_option = app.add_flag("--sim", run_sim, "close the loop with the simulated robot");
   auto* can_option = app.add_option("--can", can_interface,
                                     "run on this SocketCAN interface in real time (until --seconds or SIGINT/SIGTERM)");
+  bool spin = false;
+  auto* spin_option = app.add_flag("--spin", spin,
+                                   "with --can: spin to each release instead of sleeping (a core reserved for the "
+                                   "runtime: no wake-up on a cold core, the whole core used)");
   app.add_option("--rate", rate_hz, "cycle rate for --sim, Hz")->capture_default_str();
   app.add_option("--seconds", seconds, "simulated duration for --sim")->capture_default_str();
   app.add_flag("--ideal-robot", ideal_robot, "--sim with every simulated error source off (the nominal model)");
@@ -529,6 +534,7 @@ int main(int argc, char** argv) {
     }
     if (circle && !run_sim) throw CLI::ValidationError("--circle needs --sim");
     if (!flash_dir.empty() && can_interface.empty()) throw CLI::ValidationError("--flash-dir needs --can");
+    if (spin_option->count() > 0 && can_interface.empty()) throw CLI::ValidationError("--spin needs --can");
     if (!replay_path.empty() && (image_path.empty() || out_path.empty())) {
       throw CLI::ValidationError("--replay needs --image and --out");
     }
@@ -541,7 +547,7 @@ int main(int argc, char** argv) {
   try {
     if (!can_interface.empty()) {
       return run_on_socketcan(image_path, can_interface, rate_hz, app.count("--seconds") > 0 ? seconds : 0.0,
-                              flash_dir);
+                              flash_dir, spin);
     }
     if (run_sim && circle) return follow_circle(image_path, rate_hz, circle_radius_mm, circle_speed_mm_s, ideal_robot);
     return run_sim ? simulate(image_path, rate_hz, seconds, ideal_robot) : replay(image_path, replay_path, out_path);

@@ -277,6 +277,12 @@ class GpCorrection {
     for (int d = 0; d < dims; ++d) query[d] = z[d];
     const float* zi = inputs_ + std::size_t(first) * std::size_t(dims);
     const float* a = alpha_ + std::size_t(first) * kImageOutputs;
+    if constexpr (Arch::template has_vector_loops<S, Accumulator>()) {
+      if (Arch::vector_loops_available()) {
+        Arch::template mean_range<Dims>(query, dims, zi, a, count, sums);
+        return;
+      }
+    }
     const std::uint32_t full_blocks = count / kBlockPoints;
     if constexpr (Arch::template has_mean_blocks<Dims, S, Accumulator, kBlockPoints>()) {
       if (full_blocks > 0) Arch::mean_blocks(query, zi, a, full_blocks, sums);
@@ -312,24 +318,24 @@ class GpCorrection {
 #pragma GCC unroll 16
       for (int d = 0; d < Dims; ++d) {
         const S difference = query[d] - row[d];
-        distance_sq = multiply_add(difference, difference, distance_sq);
+        distance_sq = Arch::multiply_add(difference, difference, distance_sq);
       }
     } else {
       for (int d = 0; d < dims; ++d) {
         const S difference = query[d] - S(zi[d]);
-        distance_sq = multiply_add(difference, difference, distance_sq);
+        distance_sq = Arch::multiply_add(difference, difference, distance_sq);
       }
       zi += dims;
     }
-    const S r = gaussian(distance_sq);
+    const S r = Arch::gaussian(distance_sq);
     if constexpr (Arch::kBlockLoads && std::is_same_v<S, float>) {
       float alpha[kImageOutputs];
       Arch::template load_block<kImageOutputs>(a, alpha);
 #pragma GCC unroll 16
-      for (int k = 0; k < kImageOutputs; ++k) block[k] = multiply_add(r, alpha[k], block[k]);
+      for (int k = 0; k < kImageOutputs; ++k) block[k] = Arch::multiply_add(r, alpha[k], block[k]);
     } else {
 #pragma GCC unroll 16
-      for (int k = 0; k < kImageOutputs; ++k) block[k] = multiply_add(r, S(a[k]), block[k]);
+      for (int k = 0; k < kImageOutputs; ++k) block[k] = Arch::multiply_add(r, S(a[k]), block[k]);
       a += kImageOutputs;
     }
     return r;
@@ -347,6 +353,12 @@ class GpCorrection {
     const int dims = Dims > 0 ? Dims : input_dims_;
     const float* zi = inputs_ + std::size_t(first_point) * std::size_t(dims);
     const float* a = alpha_ + std::size_t(first_point) * kImageOutputs;
+    if constexpr (Arch::template has_vector_loops<S, Accumulator>()) {
+      if (Arch::vector_loops_available()) {
+        Arch::template mean_and_gradient_range<Dims>(query, dims, zi, a, points, sums, &weighted[0][0], kMaxInputs);
+        return;
+      }
+    }
     const std::uint32_t end_point = first_point + points;
     for (std::uint32_t begin = first_point; begin < end_point; begin += kChunkPoints) {
       const std::uint32_t count = end_point - begin < kChunkPoints ? end_point - begin : kChunkPoints;
@@ -377,13 +389,13 @@ class GpCorrection {
             Arch::template load_block<Dims>(row_pointer, row);
 #pragma GCC unroll 16
             for (int d = 0; d < Dims; ++d) {
-              first[d] = multiply_add(w_first, row[d], first[d]);
-              second[d] = multiply_add(w_second, row[d], second[d]);
+              first[d] = Arch::multiply_add(w_first, row[d], first[d]);
+              second[d] = Arch::multiply_add(w_second, row[d], second[d]);
             }
           } else {
             for (int d = 0; d < dims; ++d) {
-              first[d] = multiply_add(w_first, S(row_pointer[d]), first[d]);
-              second[d] = multiply_add(w_second, S(row_pointer[d]), second[d]);
+              first[d] = Arch::multiply_add(w_first, S(row_pointer[d]), first[d]);
+              second[d] = Arch::multiply_add(w_second, S(row_pointer[d]), second[d]);
             }
             row_pointer += dims;
           }

@@ -4,12 +4,18 @@
 // for bit, and what every host build runs. An architecture may replace
 //   - load_block: a training point's floats (or its alphas) into registers;
 //   - mean_blocks: the mean's whole loop over full blocks of training points,
-//     for the configurations has_mean_blocks() names.
-// Here there is no hand-written mean loop, so GpCorrection's own C++ loop
-// runs: that loop is the reference.
+//     for the configurations has_mean_blocks() names;
+//   - mean_range and mean_and_gradient_range: the whole loops over a range of
+//     points, for the types has_vector_loops() names, on a CPU where
+//     vector_loops_available();
+//   - multiply_add and gaussian: the arithmetic of a point in the C++ loops.
+// Here there is no hand-written loop, so GpCorrection's own C++ loop runs:
+// that loop is the reference, with kernel_exp.hpp's arithmetic for the core
+// it is built for (fused and polynomial on a Cortex-M FPU).
 
 #include <cstdint>
 
+#include "cdcr/model/kernel_exp.hpp"
 #include "cdcr/model/work_costs.hpp"
 
 namespace cdcr::model::arch {
@@ -32,6 +38,26 @@ struct Portable {
   template <int Dims, typename S, typename Accumulator, std::uint32_t BlockPoints>
   static constexpr bool has_mean_blocks() {
     return false;
+  }
+
+  template <typename S, typename Accumulator>
+  static constexpr bool has_vector_loops() {
+    return false;
+  }
+  static bool vector_loops_available() { return false; }
+  template <int Dims>
+  static void mean_range(const float*, int, const float*, const float*, std::uint32_t, double*) {}
+  template <int Dims>
+  static void mean_and_gradient_range(const float*, int, const float*, const float*, std::uint32_t, double*, float*,
+                                      int) {}
+
+  template <typename S>
+  static S multiply_add(S a, S b, S c) {
+    return model::multiply_add(a, b, c);
+  }
+  template <typename S>
+  static S gaussian(S distance_sq) {
+    return model::gaussian(distance_sq);
   }
 };
 
