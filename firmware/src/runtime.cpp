@@ -215,14 +215,20 @@ void Runtime::run_cycle(const hal::TimerTick& tick) {
   if (variance_slice) continue_uncertainty();
   ik_units_per_cycle_ = variance_slice ? ik_units_beside_variance_ : ik_units_alone_;
   if (cycle_ % kStatusEveryCycles == 0) publish_status();
-  // The update's work comes out of IK's share, short of IK's smallest step.
-  const std::uint32_t ik_floor = solving_ ? kMinIkUnitsPerCycle : 0;
+  // The update's work comes out of IK's share, short of IK's smallest step;
+  // a verification that gets nothing from that has a turn of its own every
+  // few cycles (capacity.hpp).
+  std::uint32_t ik_floor = solving_ ? kMinIkUnitsPerCycle : 0;
+  const bool update_turn = solving_ && update_.verifying() &&
+                           ik_units_per_cycle_ < ik_floor + kUpdateStepUnits + kUpdateHashUnitsPer64Bytes &&
+                           cycle_ % kUpdateTurnEveryCyclesWhileSolving == 0;
+  if (update_turn) ik_floor = 0;
   const std::uint32_t update_units =
       update_.step(cycle_, geometry_, ik_units_per_cycle_ > ik_floor ? ik_units_per_cycle_ - ik_floor : 0);
   ik_units_per_cycle_ = ik_units_per_cycle_ > update_units + ik_floor ? ik_units_per_cycle_ - update_units : ik_floor;
   if (update_.switch_pending()) reload_model();
   // IK last: the pose, STATUS and the staleness check never wait for it.
-  if (solving_) continue_solve();
+  if (solving_ && !update_turn) continue_solve();
 
   const std::int64_t end_ns = hal_.clock.now_ns();
   const std::int64_t execution_ns = end_ns - start_ns;

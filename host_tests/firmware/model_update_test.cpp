@@ -2,6 +2,8 @@
 // commit and rollback with the runtime running, and every kind of bad input
 // refused with its reason while the active model keeps running.
 
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
@@ -395,6 +397,69 @@ TEST_F(RefusedImageTest, TooLargeForTheSlot) {
   std::vector<std::uint8_t> image(firmware::slot_geometry(flash, 1).image_capacity() + 8, 0);
   std::memcpy(image.data(), new_image.data(), 64);
   expect_refused(image, UpdateReason::too_large);
+}
+
+// A payload model of 500 points (3 work units a point) leaves IK only its
+// floor, and a target streamed every cycle keeps IK running: the update's
+// verification gets nothing beside IK and must still finish, in the turns
+// it gets every kUpdateTurnEveryCyclesWhileSolving cycles.
+TEST(ModelUpdateWhileSolving, VerificationFinishesUnderAStreamOfTargets) {
+  sim::SimFlash flash{1024, 64, 256};
+  SyntheticModelOptions options;
+  options.training_points = 500;
+  options.seed = 3;
+  options.payload_input = true;
+  training::TrainedModel heavy = synthetic_trained_model(options);
+  for (int k = 0; k < 6; ++k) {
+    heavy.output_mean[k] *= k < 3 ? 0.1 : 0.001;
+    heavy.output_scale[k] *= k < 3 ? 0.1 : 0.001;
+  }
+  provision_slot(flash, 0, exporting::write_image(heavy), 1);
+  UpdateBoard board(flash, {});
+  ASSERT_EQ(board.runtime->state(), firmware::RuntimeState::run);
+  board.cycle();
+  const firmware::Pose start_pose = board.runtime->latest_pose().pose;
+
+  deploy::UpdateSender sender(update_test_image(60, 2));
+  std::vector<hal::CanFrame> out;
+  sender.start(out);
+  int cycles = 0, cycles_verifying = 0, cycles_verifying_with_ik = 0;
+  bool starved = false;
+  while (cycles < 20000 && sender.outcome() == deploy::UpdateSender::Outcome::running) {
+    sender.pump(board.now_ms(), out, 45);
+    // A TRACKING position target every cycle, circling the start pose.
+    hal::CanFrame frame;
+    const double angle = 0.002 * cycles;
+    firmware::protocol::encode(firmware::protocol::TargetPositionXy{start_pose.position_mm.x() + 2.0 * std::cos(angle),
+                                                                    start_pose.position_mm.y() + 2.0 * std::sin(angle)},
+                               frame);
+    out.push_back(frame);
+    firmware::protocol::encode(firmware::protocol::TargetPositionZ{start_pose.position_mm.z(),
+                                                                   firmware::protocol::TargetMode::position, true,
+                                                                   static_cast<std::uint8_t>(cycles)},
+                               frame);
+    out.push_back(frame);
+    const bool verifying = board.runtime->model_update().verifying();
+    board.cycle(out);
+    out.clear();
+    if (verifying) {
+      ++cycles_verifying;
+      if (board.runtime->ik_running()) ++cycles_verifying_with_ik;
+      starved = starved || board.runtime->ik_units_per_cycle() < firmware::kMinIkUnitsPerCycle +
+                                                                      firmware::kUpdateStepUnits +
+                                                                      firmware::kUpdateHashUnitsPer64Bytes;
+    }
+    for (const hal::CanFrame& report : board.take_reports()) sender.on_report(report, board.now_ms(), out);
+    ++cycles;
+  }
+  // The premise: IK ran through the verification, at a share that left the
+  // update nothing.
+  ASSERT_GT(cycles_verifying, 0);
+  EXPECT_EQ(cycles_verifying_with_ik, cycles_verifying);
+  EXPECT_TRUE(starved);
+  EXPECT_EQ(sender.outcome(), deploy::UpdateSender::Outcome::committed);
+  EXPECT_EQ(board.runtime->statistics().overruns, 0u);
+  std::printf("[ figures  ] verification under a target stream: %d cycles of %d\n", cycles_verifying, cycles);
 }
 
 }  // namespace

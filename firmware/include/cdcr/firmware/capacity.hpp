@@ -133,6 +133,11 @@ inline constexpr std::uint32_t kUpdateHashBytesPerCycle = 1024;
 inline constexpr std::uint32_t kUpdateFrameUnits = 3;
 inline constexpr std::uint32_t kUpdateStepUnits = 100;
 inline constexpr std::uint32_t kUpdateHashUnitsPer64Bytes = 90;
+// When what IK's share leaves above its floor cannot hash one 64-byte piece
+// (a model near the cycle's capacity with targets streaming), every this
+// many cycles the update's verification gets IK's whole share and IK waits
+// that cycle: a stream of targets cannot hold a verification up for ever.
+inline constexpr int kUpdateTurnEveryCyclesWhileSolving = 8;
 // A transfer without a valid frame for this many cycles (a minute at 1 kHz)
 // is dropped with reason timeout; the host may resume it with START.
 inline constexpr std::uint32_t kUpdateTimeoutCycles = 60'000;

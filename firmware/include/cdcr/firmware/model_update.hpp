@@ -63,6 +63,8 @@ class ModelUpdate {
   // model's, which a new image must match. Returns the units the update
   // spent since the last step, its frames included.
   std::uint32_t step(std::uint32_t cycle, const Geometry& geometry, std::uint32_t units);
+  // Hashing an image, whose pace is the units each step gets.
+  bool verifying() const { return phase_ == Phase::verifying || phase_ == Phase::rollback_verifying; }
   // A committed or rolled-back-to image waits for the runtime to load it.
   bool switch_pending() const { return switch_pending_; }
 
