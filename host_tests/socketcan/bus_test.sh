@@ -41,25 +41,6 @@ poses_wanted=30
 # cycles) at 100 Hz.
 runtime_rate_hz=100
 feeder_gap_ms=10
-feeders=""
-start_feeders() {
-  feeders=""
-  segment=0
-  while [ "$segment" -lt "$SEGMENTS" ]; do
-    data=""
-    eval "data=\$FEEDBACK_$segment"
-    cangen vcan0 -I "10$segment" -L 8 -D "$data" -g "$feeder_gap_ms" &
-    feeders="$feeders $!"
-    segment=$((segment + 1))
-  done
-}
-stop_feeders() {
-  # shellcheck disable=SC2086
-  kill $feeders 2>/dev/null
-  # shellcheck disable=SC2086
-  wait $feeders 2>/dev/null
-  feeders=""
-}
 
 "$CDCR_CHECK" image "$image" || fail "cannot write the model image"
 eval "$("$CDCR_CHECK" frames "$image")" || fail "cannot compute the frames"

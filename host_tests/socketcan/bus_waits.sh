@@ -1,8 +1,31 @@
-# Sourced by bus_test.sh: waiting for what the runtime sent, sending, and
-# the capture's markers, inside the guest. Needs `log` (the candump capture,
+# Sourced by bus_test.sh, deploy_test.sh and the deploy bench's guest script:
+# waiting for what the runtime sent, sending, the capture's markers, and the
+# simulated drives, inside the guest. Needs `log` (the candump capture,
 # line-buffered), `work` and `capture_dir`, and sets `wait_seconds` from
 # CDCR_WAIT_SECONDS (60): how long one wait may take before the test fails.
 wait_seconds=${CDCR_WAIT_SECONDS:-60}
+
+# The drives: one cangen per segment sending its FEEDBACK_<segment> frame
+# (from socketcan_check frames) every feeder_gap_ms (10 unless set).
+feeders=""
+start_feeders() {
+  feeders=""
+  segment=0
+  while [ "$segment" -lt "$SEGMENTS" ]; do
+    data=""
+    eval "data=\$FEEDBACK_$segment"
+    cangen vcan0 -I "10$segment" -L 8 -D "$data" -g "${feeder_gap_ms:-10}" &
+    feeders="$feeders $!"
+    segment=$((segment + 1))
+  done
+}
+stop_feeders() {
+  # shellcheck disable=SC2086
+  kill $feeders 2>/dev/null
+  # shellcheck disable=SC2086
+  wait $feeders 2>/dev/null
+  feeders=""
+}
 
 # Frames the guest's receive backlog dropped (for every listener at once).
 report_drops() {

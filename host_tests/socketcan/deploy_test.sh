@@ -23,14 +23,7 @@ rm -rf "$flash" "$work"/runtime.err.* "$work"/deploy.*
 "$CDCR_CHECK" image "$work/big.img" 1000 3 || fail "cannot write the large image"
 eval "$("$CDCR_CHECK" frames "$work/old.img")" || fail "cannot compute the frames"
 
-feeders=""
-segment=0
-while [ "$segment" -lt "$SEGMENTS" ]; do
-  eval "data=\$FEEDBACK_$segment"
-  cangen vcan0 -I "10$segment" -L 8 -D "$data" -g 10 &
-  feeders="$feeders $!"
-  segment=$((segment + 1))
-done
+start_feeders
 stdbuf -oL candump -L -r 4194304 vcan0,130:7F8,150:7FF,178:7FF,7F0:7FF > "$log" &
 candump_pid=$!
 

@@ -14,14 +14,7 @@ rm -rf "$flash"
 . "$(dirname "$0")/../../host_tests/socketcan/bus_waits.sh"
 "$CDCR_CHECK" image "$work/old.img" 24 1 || fail "cannot write the old image"
 eval "$("$CDCR_CHECK" frames "$work/old.img")" || fail "cannot compute the frames"
-feeders=""
-segment=0
-while [ "$segment" -lt "$SEGMENTS" ]; do
-  eval "data=\$FEEDBACK_$segment"
-  cangen vcan0 -I "10$segment" -L 8 -D "$data" -g 10 &
-  feeders="$feeders $!"
-  segment=$((segment + 1))
-done
+start_feeders
 stdbuf -oL candump -L -r 4194304 vcan0,170:7F8,178:7FF > "$log" &
 candump_pid=$!
 "$CDCR_RUNTIME" --image "$work/old.img" --can vcan0 --flash-dir "$flash" --rate 1000 > /dev/null 2> "$work/runtime.err" &

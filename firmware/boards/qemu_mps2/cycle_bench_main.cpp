@@ -24,6 +24,7 @@
 #include <cdcr/model/work_costs.hpp>
 
 #include "board.hpp"
+#include "instruction_count.hpp"
 #include "golden_check.hpp"
 
 namespace {
@@ -32,15 +33,12 @@ namespace golden = cdcr::qemu_golden;
 namespace console = cdcr::cortexm;
 namespace model = cdcr::model;
 
-constexpr int kIcountShift = 10;
 #if defined(__ARM_FP) && !(__ARM_FP & 0x8)
 constexpr model::ForwardCycleInstructions kForwardCycle = model::kCortexM4fForwardCycle;
 #else
 constexpr model::ForwardCycleInstructions kForwardCycle = model::kCortexM7ForwardCycle;
 #endif
-// A period far longer than anything measured keeps SysTick exceptions (and
-// their instructions) out of the counts.
-constexpr std::int64_t kCountingPeriodNs = 600'000'000;
+using cdcr::boards::mps2::kCountingPeriodNs;
 
 cdcr::boards::mps2::Board board;
 cdcr::firmware::Runtime runtime(board.hal(), cdcr::boards::mps2::golden_geometry());
@@ -49,11 +47,6 @@ model::ForwardResult<float> forward_result;
 model::IkResult<float> ik_result;
 model::Twist<float> predicted;
 model::Pose<float> nominal_pose;
-
-std::uint32_t ticks_to_instructions(std::uint64_t ticks) {
-  const std::uint64_t ns = ticks * (1'000'000'000u / cdcr::boards::mps2::kCoreClockHz);
-  return static_cast<std::uint32_t>((ns + (1u << (kIcountShift - 1))) >> kIcountShift);
-}
 
 // A result the compiler must assume is read, so the work behind it stays.
 template <typename T>
@@ -68,24 +61,11 @@ __attribute__((noinline)) void run_opaque(Work& work) {
   work();
 }
 
-template <typename Work>
-std::uint64_t count_ticks(Work&& work) {
-  asm volatile("" ::: "memory");
-  const std::uint64_t start = board.timer.now_ticks();
-  asm volatile("" ::: "memory");
-  run_opaque(work);
-  asm volatile("" ::: "memory");
-  const std::uint64_t end = board.timer.now_ticks();
-  asm volatile("" ::: "memory");
-  return end - start;
-}
-
-std::uint64_t overhead_ticks = 0;
+cdcr::boards::mps2::InstructionCounter counter{board.timer};
 
 template <typename Work>
 std::uint32_t count_instructions(Work&& work) {
-  const std::uint64_t ticks = count_ticks(work);
-  return ticks_to_instructions(ticks > overhead_ticks ? ticks - overhead_ticks : 0);
+  return counter.instructions([&] { run_opaque(work); });
 }
 
 void report(const char* name, std::uint32_t* counts, int count) {
@@ -159,7 +139,9 @@ int main() {
   console::console_write_int(image.segment_count);
   console::console_write(" segments\n");
 
-  overhead_ticks = count_ticks([] {});
+  // The opaque call is part of every count here, so part of the overhead.
+  auto nothing = [] {};
+  counter.calibrate([&] { run_opaque(nothing); });
   const cdcr::firmware::Geometry& geometry = runtime.geometry();
   constexpr int kCases = golden::kCases;
   std::uint32_t forward_cycle[kCases], compensated[kCases], gp[kCases], nominal[kCases], ik[kCases],

@@ -20,6 +20,7 @@
 #include <cdcr/firmware/runtime.hpp>
 
 #include "board.hpp"
+#include "instruction_count.hpp"
 #include "golden_check.hpp"
 
 namespace {
@@ -29,52 +30,26 @@ namespace model = cdcr::model;
 namespace firmware = cdcr::firmware;
 namespace protocol = cdcr::firmware::protocol;
 
-#if defined(__ARM_FP) && !(__ARM_FP & 0x8)
-constexpr std::uint32_t kBudgetInstructions = 120'000;  // Cortex-M4F
-#else
-constexpr std::uint32_t kBudgetInstructions = 80'000;  // Cortex-M7
-#endif
-constexpr int kIcountShift = 10;
-constexpr std::int64_t kCountingPeriodNs = 600'000'000;
+using cdcr::boards::mps2::kCountingPeriodNs;
+constexpr std::uint32_t kBudgetInstructions = cdcr::boards::mps2::kCycleBudgetInstructions;
 
 cdcr::boards::mps2::Board board;
 firmware::Runtime runtime(board.hal(), cdcr::boards::mps2::golden_geometry());
 firmware::Correction correction;
 
-std::uint64_t overhead_ticks = 0;
-
-std::uint32_t ticks_to_instructions(std::uint64_t ticks) {
-  const std::uint64_t ns = ticks * (1'000'000'000u / cdcr::boards::mps2::kCoreClockHz);
-  return static_cast<std::uint32_t>((ns + (1u << (kIcountShift - 1))) >> kIcountShift);
-}
+cdcr::boards::mps2::InstructionCounter counter{board.timer};
 
 __attribute__((noinline)) void run_cycle_opaque(const cdcr::hal::TimerTick& tick) { runtime.run_cycle(tick); }
 
 std::uint32_t counted_cycle() {
   const cdcr::hal::TimerTick tick{board.timer.now_ns(), 0};
-  asm volatile("" ::: "memory");
-  const std::uint64_t start = board.timer.now_ticks();
-  asm volatile("" ::: "memory");
-  run_cycle_opaque(tick);
-  asm volatile("" ::: "memory");
-  const std::uint64_t end = board.timer.now_ticks();
-  asm volatile("" ::: "memory");
-  const std::uint64_t ticks = end - start;
-  return ticks_to_instructions(ticks > overhead_ticks ? ticks - overhead_ticks : 0);
+  return counter.instructions([&] { run_cycle_opaque(tick); });
 }
 
 // Instructions of one call of work(), as counted_cycle() counts a cycle.
 template <typename Work>
 std::uint32_t counted(Work&& work) {
-  asm volatile("" ::: "memory");
-  const std::uint64_t start = board.timer.now_ticks();
-  asm volatile("" ::: "memory");
-  work();
-  asm volatile("" ::: "memory");
-  const std::uint64_t end = board.timer.now_ticks();
-  asm volatile("" ::: "memory");
-  const std::uint64_t ticks = end - start;
-  return ticks_to_instructions(ticks > overhead_ticks ? ticks - overhead_ticks : 0);
+  return counter.instructions(work);
 }
 
 // xorshift32: the same workload on every run and both boards.
@@ -341,15 +316,7 @@ int main() {
     return 1;
   }
   segments = runtime.geometry().segment_count;
-  {
-    const cdcr::hal::TimerTick tick{0, 0};
-    (void)tick;
-    asm volatile("" ::: "memory");
-    const std::uint64_t start = board.timer.now_ticks();
-    asm volatile("" ::: "memory");
-    const std::uint64_t end = board.timer.now_ticks();
-    overhead_ticks = end - start;
-  }
+  counter.calibrate();
   console::console_write("model: ");
   console::console_write_int(static_cast<std::int32_t>(image.training_points));
   console::console_write(" training points; IK work per cycle ");

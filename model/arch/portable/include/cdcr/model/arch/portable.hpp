@@ -40,16 +40,11 @@ struct Portable {
     return false;
   }
 
+  // Only where this is true are the other three hooks called.
   template <typename S, typename Accumulator>
   static constexpr bool has_vector_loops() {
     return false;
   }
-  static bool vector_loops_available() { return false; }
-  template <int Dims>
-  static void mean_range(const float*, int, const float*, const float*, std::uint32_t, double*) {}
-  template <int Dims>
-  static void mean_and_gradient_range(const float*, int, const float*, const float*, std::uint32_t, double*, float*,
-                                      int) {}
 
   template <typename S>
   static S multiply_add(S a, S b, S c) {

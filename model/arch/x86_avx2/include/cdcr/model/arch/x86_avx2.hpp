@@ -37,6 +37,7 @@
 #include <type_traits>
 
 #include "cdcr/model/arch/portable.hpp"
+#include "cdcr/model/flash_image.hpp"
 #include "cdcr/model/kernel_exp.hpp"
 #include "cdcr/model/work_costs.hpp"
 
@@ -47,7 +48,6 @@ namespace cdcr::model::arch {
 namespace detail {
 
 inline constexpr int kLanes = 8;
-inline constexpr int kOutputs = 6;  // an error twist's six sums (kImageOutputs)
 
 CDCR_AVX2_FMA inline __m256i first_lanes_mask(int count) {
   const __m256i lane = _mm256_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7);
@@ -155,7 +155,7 @@ template <int Dims>
 CDCR_AVX2_FMA void mean_range(const float* query, int dims, const float* inputs, const float* alpha,
                               std::uint32_t count, double* sums) {
   const int n = Dims > 0 ? Dims : dims;
-  const __m256i alpha_lanes = first_lanes_mask(kOutputs);
+  const __m256i alpha_lanes = first_lanes_mask(kImageOutputs);
   DoubleSums total = load_sums(sums);
   for (std::uint32_t first = 0; first < count; first += kLanes) {
     const int points = count - first < std::uint32_t(kLanes) ? int(count - first) : kLanes;
@@ -163,7 +163,7 @@ CDCR_AVX2_FMA void mean_range(const float* query, int dims, const float* inputs,
     __m256 block = _mm256_setzero_ps();
     for (int j = 0; j < points; ++j) {
       block = _mm256_fmadd_ps(broadcast_lane(r, j), _mm256_maskload_ps(alpha, alpha_lanes), block);
-      alpha += kOutputs;
+      alpha += kImageOutputs;
     }
     add_block(block, total);
     inputs += std::size_t(kLanes) * std::size_t(n);
@@ -185,7 +185,7 @@ CDCR_AVX2_FMA void mean_and_gradient_range(const float* query, int dims, const f
   constexpr int kChunkPoints = 64;
   const int n = Dims > 0 ? Dims : dims;
   const int vectors = (n + kLanes - 1) / kLanes;
-  const __m256i alpha_lanes = first_lanes_mask(kOutputs);
+  const __m256i alpha_lanes = first_lanes_mask(kImageOutputs);
   DoubleSums total = load_sums(sums);
   alignas(32) float r_alpha[kChunkPoints][kLanes];
   for (std::uint32_t first = 0; first < count; first += kChunkPoints) {
@@ -195,7 +195,7 @@ CDCR_AVX2_FMA void mean_and_gradient_range(const float* query, int dims, const f
       const __m256 r = kernel_lanes<Dims>(query, n, inputs + std::size_t(b) * std::size_t(n), block_points);
       __m256 block = _mm256_setzero_ps();
       for (int j = 0; j < block_points; ++j) {
-        const __m256 a = _mm256_maskload_ps(alpha + (b + j) * kOutputs, alpha_lanes);
+        const __m256 a = _mm256_maskload_ps(alpha + (b + j) * kImageOutputs, alpha_lanes);
         const __m256 rj = broadcast_lane(r, j);
         block = _mm256_fmadd_ps(rj, a, block);
         _mm256_store_ps(r_alpha[b + j], _mm256_mul_ps(rj, a));
@@ -230,7 +230,7 @@ CDCR_AVX2_FMA void mean_and_gradient_range(const float* query, int dims, const f
       _mm256_maskstore_ps(row_sums + 5 * row_stride, input_lanes, w5);
     }
     inputs += std::size_t(points) * std::size_t(n);
-    alpha += std::size_t(points) * kOutputs;
+    alpha += std::size_t(points) * kImageOutputs;
   }
   store_sums(total, sums);
 }
