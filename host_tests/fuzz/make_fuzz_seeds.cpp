@@ -14,7 +14,7 @@
 
 #include "dataset/csv_dataset.hpp"
 #include "export/image_writer.hpp"
-#include "train/trained_model.hpp"
+#include "trained_model/trained_model.hpp"
 
 #include "../support/v1_image.hpp"
 

@@ -4,7 +4,12 @@
 # and a file may include headers of its own layer and of the layers below it,
 # never of one above: the model includes no HAL, firmware or tool header, the
 # HAL no firmware or tool header, the firmware no tool header, and the
-# simulated robot no other tool's.
+# simulated robot no other tool's. Beside the chain, two pairs keep apart:
+# the trainer (tools/train) and the image writer (tools/export) include
+# nothing of each other (what they share is tools/trained_model, and
+# tools/pipeline uses both), and only the tools' own tests (host_tests/tools)
+# include the CLI's files (tools/cdcr): a firmware, model or bus test that
+# needs a sender or a report uses the layer that has it, not the CLI.
 #
 # Every #include of every source file under the four folders is resolved the
 # way the compiler would find it in this tree (next to the including file, or
@@ -30,25 +35,60 @@ layer_of() {
   esac
 }
 
-mapfile -t sources < <(find model hal firmware tools -type f \
-  \( -name '*.hpp' -o -name '*.h' -o -name '*.cpp' -o -name '*.c' -o -name '*.inc' \) | LC_ALL=C sort)
+source_files() {
+  find "$@" -type f \( -name '*.hpp' -o -name '*.h' -o -name '*.cpp' -o -name '*.c' -o -name '*.inc' \) | LC_ALL=C sort
+}
+mapfile -t sources < <(source_files model hal firmware tools)
+mapfile -t tests < <(source_files host_tests)
 if ((${#sources[@]} == 0)); then
   echo "no sources found below $(pwd)"
   exit 1
 fi
 
 # Every tail of every source path ("cdcr/hal/can_bus.hpp", "hal/can_bus.hpp",
-# "can_bus.hpp") names the layers of the files it can reach.
+# "can_bus.hpp") names the layers of the files it can reach, and the tools'
+# folders they lie in.
 declare -A lowest_layer
+declare -A tool_folders
 for file in "${sources[@]}"; do
   layer_of "$file"
+  tool_folder=
+  if [[ $file == tools/*/* ]]; then
+    tool_folder=${file#tools/}
+    tool_folder=tools/${tool_folder%%/*}
+  fi
   tail=$file
   while [[ $tail == */* ]]; do
     tail=${tail#*/}
     if [[ -z ${lowest_layer[$tail]:-} ]] || ((rank < lowest_layer[$tail])); then
       lowest_layer[$tail]=$rank
     fi
+    if [[ -n $tool_folder && " ${tool_folders[$tail]:-} " != *" $tool_folder "* ]]; then
+      tool_folders[$tail]="${tool_folders[$tail]:-} $tool_folder"
+    fi
   done
+done
+
+# Sets `reached` to the tools' folders an include can resolve to.
+folders_reached() {
+  local file=$1 included=$2 beside=${1%/*}/$2
+  if [[ -f $beside ]]; then
+    beside=$(realpath -m --relative-to=. "$beside")
+    reached=
+    if [[ $beside == tools/*/* ]]; then
+      reached=${beside#tools/}
+      reached=tools/${reached%%/*}
+    fi
+  else
+    reached=${tool_folders[$included]:-}
+  fi
+}
+
+# "A B": files under A include nothing under B.
+kept_apart=("tools/train tools/export" "tools/export tools/train")
+for folder in host_tests/*/; do
+  folder=${folder%/}
+  [[ $folder == host_tests/tools ]] || kept_apart+=("$folder tools/cdcr")
 done
 
 violations=0
@@ -61,6 +101,16 @@ while IFS= read -r match; do
   [[ $line =~ ^[[:space:]]*#[[:space:]]*include[[:space:]]*[\"\<]([^\"\>]+)[\"\>] ]] || continue
   included=${BASH_REMATCH[1]}
   checked=$((checked + 1))
+  folders_reached "$file" "$included"
+  for pair in "${kept_apart[@]}"; do
+    from=${pair% *}
+    to=${pair#* }
+    if [[ $file == "$from"/* && " $reached " == *" $to "* ]]; then
+      echo "$file:$line_number: includes $included, from $to, which $from keeps apart from"
+      violations=$((violations + 1))
+    fi
+  done
+  [[ $file == host_tests/* ]] && continue
   layer_of "$file"
   own=$rank
   beside=${file%/*}/$included
@@ -77,10 +127,10 @@ while IFS= read -r match; do
     echo "$file:$line_number: includes $included, a ${layer_names[target]} header, from ${layer_names[own]}"
     violations=$((violations + 1))
   fi
-done < <(grep -nH -E '^[[:space:]]*#[[:space:]]*include' "${sources[@]}")
+done < <(grep -nH -E '^[[:space:]]*#[[:space:]]*include' "${sources[@]}" "${tests[@]}")
 
 if ((violations > 0)); then
-  echo "$violations include(s) go up the chain model <- hal <- firmware <- tools/sim <- tools"
+  echo "$violations include(s) go up the chain model <- hal <- firmware <- tools/sim <- tools or join what is kept apart"
   exit 1
 fi
-echo "${#sources[@]} files, $checked includes: none goes up the chain model <- hal <- firmware <- tools/sim <- tools"
+echo "$((${#sources[@]} + ${#tests[@]})) files, $checked includes: none goes up the chain model <- hal <- firmware <- tools/sim <- tools, tools/train and tools/export include nothing of each other, no test but the tools' includes tools/cdcr"

@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "train/trained_model.hpp"
+#include "trained_model/trained_model.hpp"
 
 namespace cdcr::test_support {
 

@@ -19,7 +19,7 @@
 #include "number_list.hpp"
 #include "svg_chart.hpp"
 #include "train/learning_curve.hpp"
-#include "train/pipeline.hpp"
+#include "pipeline/train_and_export.hpp"
 #include "training_options.hpp"
 
 namespace cdcr::cli {

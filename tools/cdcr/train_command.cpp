@@ -15,7 +15,7 @@
 #include "export/binary_file.hpp"
 #include "json_output.hpp"
 #include "train/calibration.hpp"
-#include "train/pipeline.hpp"
+#include "pipeline/train_and_export.hpp"
 #include "training_options.hpp"
 
 namespace cdcr::cli {

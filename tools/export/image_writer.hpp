@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <vector>
 
-#include "train/trained_model.hpp"
+#include "trained_model/trained_model.hpp"
 
 namespace cdcr::exporting {
 

@@ -6,7 +6,7 @@
 #include <stdexcept>
 #include <string>
 
-#include "pipeline.hpp"
+#include "training_set.hpp"
 
 namespace cdcr::training {
 

@@ -10,7 +10,7 @@
 
 #include <Eigen/Core>
 
-#include "trained_model.hpp"
+#include "trained_model/trained_model.hpp"
 #include "training_set.hpp"
 
 namespace cdcr::training {

@@ -11,7 +11,7 @@
 #include "gaussian_process.hpp"
 #include "hyperparameter_search.hpp"
 #include "model_selection.hpp"
-#include "trained_model.hpp"
+#include "trained_model/trained_model.hpp"
 #include "training_set.hpp"
 
 namespace cdcr::training {

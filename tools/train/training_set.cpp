@@ -1,5 +1,8 @@
 #include "training_set.hpp"
 
+#include <algorithm>
+#include <numeric>
+#include <random>
 #include <stdexcept>
 #include <string>
 
@@ -78,6 +81,23 @@ TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGe
   if (data.has_payload && with_payload) s.payload_kg = data.payload_kg;
   s.inputs = model_inputs(s.bends, s.payload_kg, encoding);
   return s;
+}
+
+Split random_split(int samples, int test_count, std::uint64_t seed) {
+  if (test_count < 0 || test_count >= samples) {
+    throw std::invalid_argument("cannot hold out " + std::to_string(test_count) + " of " + std::to_string(samples) +
+                                " samples");
+  }
+  std::vector<int> order(static_cast<std::size_t>(samples));
+  std::iota(order.begin(), order.end(), 0);
+  std::mt19937_64 rng(seed);
+  std::shuffle(order.begin(), order.end(), rng);
+  Split split;
+  split.test.assign(order.begin(), order.begin() + test_count);
+  split.train.assign(order.begin() + test_count, order.end());
+  std::sort(split.test.begin(), split.test.end());
+  std::sort(split.train.begin(), split.train.end());
+  return split;
 }
 
 }  // namespace cdcr::training

@@ -5,6 +5,7 @@
 // with a payload column gives one more input, the payload (kg), after the
 // encoded joints.
 
+#include <cstdint>
 #include <vector>
 
 #include <Eigen/Core>
@@ -29,6 +30,15 @@ struct TrainingSet {
   bool has_payload() const { return payload_kg.size() > 0; }
   TrainingSet subset(const std::vector<int>& rows) const;
 };
+
+// Rows held out for validation and the rest for training, both sorted.
+struct Split {
+  std::vector<int> train;
+  std::vector<int> test;
+};
+
+// test_count samples drawn at random (seeded), the rest in order for training.
+Split random_split(int samples, int test_count, std::uint64_t seed);
 
 // Throws std::invalid_argument naming the sample (1-based data row) whose
 // cables the nominal model rejects, or if the dataset has no poses or a

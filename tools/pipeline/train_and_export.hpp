@@ -1,27 +1,21 @@
 #pragma once
-// The training PC's job end to end: split, train, evaluate on held-out data,
-// fit the exported model on every row, export the image, and measure the
-// float32 firmware path against the double-precision trainer.
+// The training PC's job end to end: train, evaluate on held-out data, fit
+// the exported model on every row, export the image, and measure the float32
+// firmware path against the double-precision trainer. It sits above both the
+// trainer (train/) and the image writer (export/), which know nothing of
+// each other: the model they share is trained_model/.
 
 #include <cstdint>
 #include <utility>
 #include <vector>
 
-#include "evaluation.hpp"
-#include "trainer.hpp"
-#include "training_set.hpp"
+#include "train/evaluation.hpp"
+#include "train/trainer.hpp"
+#include "train/training_set.hpp"
 
 namespace cdcr::training {
 
-struct Split {
-  std::vector<int> train;
-  std::vector<int> test;
-};
-
-// test_count samples drawn at random (seeded), the rest in order for training.
-Split random_split(int samples, int test_count, std::uint64_t seed);
-
-// The targets of the float32 export (issue: firmware fidelity).
+// The float32 image path against the double-precision trainer: the most it may differ.
 inline constexpr double kFidelityTargetPositionMm = 0.01;
 inline constexpr double kFidelityTargetOrientationDeg = 0.001;
 
