@@ -24,7 +24,9 @@ set(_cdcr_arch_flags "-mcpu=${CDCR_CORTEXM_CPU} -mthumb -mfpu=${CDCR_CORTEXM_FPU
 # lets sqrtf compile to one instruction instead of a libm call.
 set(_cdcr_common_flags "${_cdcr_arch_flags} -fno-math-errno -ffunction-sections -fdata-sections")
 set(CMAKE_C_FLAGS_INIT "${_cdcr_common_flags}")
-set(CMAKE_CXX_FLAGS_INIT "${_cdcr_common_flags} -fno-exceptions -fno-rtti -fno-use-cxa-atexit -fno-threadsafe-statics")
+# Eigen's assertions go to the board's handler, not newlib's allocating
+# assert (bare_metal_eigen_config.hpp).
+set(CMAKE_CXX_FLAGS_INIT "${_cdcr_common_flags} -fno-exceptions -fno-rtti -fno-use-cxa-atexit -fno-threadsafe-statics -include ${CMAKE_CURRENT_LIST_DIR}/bare_metal_eigen_config.hpp")
 set(CMAKE_ASM_FLAGS_INIT "${_cdcr_arch_flags}")
 # nano newlib; the project's startup code replaces crt0, and its system calls
 # go through semihosting, so libnosys only fills in the stubs nothing uses.

@@ -3,7 +3,7 @@
 #   lib/libcdcr_runtime.a, libcdcr_firmware.a
 #   lib/cdcr/...                           (cross builds) the MPS2 board's startup objects
 #   lib/cmake/cdcr/cdcrConfig.cmake, ...   the package find_package(cdcr) reads
-#   share/cdcr/toolchains/*.cmake          the toolchain files a cross consumer configures with
+#   share/cdcr/toolchains/*                the toolchain files a cross consumer configures with
 #   share/cdcr/mps2.ld                     (cross builds) the MPS2 boards' linker script
 # Each target installs itself where it is defined (install(TARGETS ...
 # EXPORT cdcrTargets)); this file writes the package around them.
@@ -24,4 +24,5 @@ install(FILES
   ${PROJECT_SOURCE_DIR}/toolchains/arm-none-eabi-common.cmake
   ${PROJECT_SOURCE_DIR}/toolchains/arm-none-eabi-cortex-m7.cmake
   ${PROJECT_SOURCE_DIR}/toolchains/arm-none-eabi-cortex-m4f.cmake
+  ${PROJECT_SOURCE_DIR}/toolchains/bare_metal_eigen_config.hpp
   DESTINATION ${CMAKE_INSTALL_DATADIR}/cdcr/toolchains)

@@ -10,9 +10,9 @@
 
 #include <gtest/gtest.h>
 
-#include "linux/mapped_model_storage.hpp"
-#include "linux/posix_time.hpp"
-#include "linux/socketcan_bus.hpp"
+#include "cdcr/linux/mapped_model_storage.hpp"
+#include "cdcr/linux/posix_time.hpp"
+#include "cdcr/linux/socketcan_bus.hpp"
 
 namespace cdcr::linux_host {
 namespace {

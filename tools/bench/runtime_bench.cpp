@@ -49,7 +49,7 @@
 #include <cdcr/sim/virtual_can.hpp>
 
 #include "export/binary_file.hpp"
-#include "linux/posix_time.hpp"
+#include "cdcr/linux/posix_time.hpp"
 #include "sim/simulated_platform.hpp"
 #include "sim/simulated_robot.hpp"
 #include "sim/workspace_sampler.hpp"

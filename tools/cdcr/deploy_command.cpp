@@ -14,7 +14,7 @@
 #include "deploy_sender.hpp"
 #include "cli_errors.hpp"
 #include "export/binary_file.hpp"
-#include "linux/socketcan_bus.hpp"
+#include "cdcr/linux/socketcan_bus.hpp"
 
 namespace cdcr::cli {
 

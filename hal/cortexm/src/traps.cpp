@@ -7,7 +7,7 @@
 
 using cdcr::cortexm::ExitCode;
 
-extern "C" [[noreturn]] void cdcr_cortexm_assert_failed(const char* expression, const char* file, int line) {
+extern "C" [[noreturn]] void cdcr_assert_failed(const char* expression, const char* file, int line) {
   cdcr::cortexm::console_write("ASSERTION FAILED: ");
   cdcr::cortexm::console_write(expression);
   cdcr::cortexm::console_write(" at ");
@@ -22,7 +22,7 @@ extern "C" [[noreturn]] void cdcr_cortexm_assert_failed(const char* expression, 
 // allocates.
 extern "C" [[noreturn]] void __assert_func(const char* file, int line, const char* /*function*/,
                                            const char* expression) {
-  cdcr_cortexm_assert_failed(expression, file, line);
+  cdcr_assert_failed(expression, file, line);
 }
 
 // A virtual destructor references operator delete even when nothing is ever

@@ -1,4 +1,4 @@
-#include "linux/posix_time.hpp"
+#include "cdcr/linux/posix_time.hpp"
 
 #include <cerrno>
 #include <ctime>

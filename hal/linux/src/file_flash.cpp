@@ -1,4 +1,4 @@
-#include "linux/file_flash.hpp"
+#include "cdcr/linux/file_flash.hpp"
 
 #include <cerrno>
 #include <cstring>

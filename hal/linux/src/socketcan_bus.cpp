@@ -1,4 +1,4 @@
-#include "linux/socketcan_bus.hpp"
+#include "cdcr/linux/socketcan_bus.hpp"
 
 #include <cerrno>
 #include <cstring>

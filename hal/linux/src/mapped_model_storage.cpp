@@ -1,4 +1,4 @@
-#include "linux/mapped_model_storage.hpp"
+#include "cdcr/linux/mapped_model_storage.hpp"
 
 #include <cerrno>
 #include <cstring>

@@ -1,0 +1,88 @@
+// cdcr-runtime --replay: the forward path over recorded cable lengths.
+
+#include <cstdio>
+#include <stdexcept>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include <cdcr/firmware/runtime.hpp>
+
+#include "cdcr/cli_errors.hpp"
+#include "dataset/csv_dataset.hpp"
+#include "export/binary_file.hpp"
+#include "runtime_modes.hpp"
+#include "sim/simulated_platform.hpp"
+
+namespace cdcr::runtime_host {
+
+namespace fw = cdcr::firmware;
+namespace model = cdcr::model;
+namespace protocol = cdcr::firmware::protocol;
+namespace sim = cdcr::sim;
+using cli::InputError;
+
+void require_rate(double rate_hz) {
+  if (!(rate_hz > 0) || !(rate_hz <= 100000)) throw std::invalid_argument("--rate must be in (0, 100000] Hz");
+}
+
+int replay(const std::string& image_path, const std::string& cables_path, const std::string& out_path) {
+  sim::SimulatedPlatform platform;
+  platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
+  fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
+  if (runtime.init() != fw::RuntimeState::run) {
+    std::string message = std::string("image ") + image_path + ": " + fw::to_string(runtime.boot_fault());
+    if (runtime.boot_fault() == fw::FaultCode::image_invalid) {
+      message += std::string(" (") + model::to_string(runtime.boot_fault_detail().image_status()) + ")";
+    }
+    throw InputError(message);
+  }
+  cdcr::dataset::Dataset data;
+  try {
+    data = cdcr::dataset::read_dataset_csv(cables_path);
+  } catch (const std::exception& e) {
+    throw InputError(e.what());
+  }
+  if (data.segment_count != runtime.geometry().segment_count) {
+    throw InputError(cables_path + ": " + std::to_string(data.segment_count) + " segments, the image has " +
+                     std::to_string(runtime.geometry().segment_count));
+  }
+  // A payload model takes each row's payload as if it had come in a PAYLOAD
+  // frame with the row's cables; a model without the input ignores the column.
+  const bool payload_input = runtime.correction().has_payload_input();
+  if (payload_input && !data.has_payload) {
+    throw InputError(cables_path + ": the image takes a payload input and the data have no payload_kg column");
+  }
+  if (!payload_input && data.has_payload) {
+    std::fprintf(stderr, "note: %s: the payload_kg column is ignored: the image has no payload input\n",
+                 cables_path.c_str());
+  }
+  std::FILE* out = std::fopen(out_path.c_str(), "w");
+  if (out == nullptr) throw InputError("cannot write " + out_path);
+  std::fprintf(out, "x,y,z,qw,qx,qy,qz,r95_mm,r95_deg,extrapolating\n");
+  for (Eigen::Index i = 0; i < data.cables_mm.rows(); ++i) {
+    const fw::Cables cables = data.cables_mm.row(i).transpose().cast<float>();
+    if (payload_input && !runtime.set_payload_kg(static_cast<float>(data.payload_kg[i]))) {
+      std::fclose(out);
+      throw InputError(cables_path + ": sample " + std::to_string(i + 1) + ": payload " +
+                       std::to_string(data.payload_kg[i]) + " kg is beyond what the PAYLOAD frame carries");
+    }
+    fw::PoseEstimate estimate;
+    if (const model::Status s = runtime.estimate_pose(cables, estimate); s != model::Status::ok) {
+      std::fclose(out);
+      throw InputError(cables_path + ": sample " + std::to_string(i + 1) + ": " + model::to_string(s));
+    }
+    const model::Pose<double> pose = estimate.pose.cast<double>();
+    Eigen::Quaterniond q(pose.rotation);
+    q.normalize();
+    if (q.w() < 0) q.coeffs() *= -1.0;
+    const model::PoseUncertainty<fw::Scalar> uncertainty = runtime.estimate_uncertainty(estimate);
+    std::fprintf(out, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", pose.position_mm.x(), pose.position_mm.y(),
+                 pose.position_mm.z(), q.w(), q.x(), q.y(), q.z(), static_cast<double>(uncertainty.r95_mm),
+                 static_cast<double>(uncertainty.r95_deg), uncertainty.extrapolating ? 1 : 0);
+  }
+  if (std::fclose(out) != 0) throw InputError("cannot write " + out_path);
+  return 0;
+}
+
+}  // namespace cdcr::runtime_host

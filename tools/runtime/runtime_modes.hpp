@@ -1,0 +1,30 @@
+#pragma once
+// cdcr-runtime's three ways of running the firmware's cycle code on the host,
+// one file each; main.cpp picks one from the command line. Each throws
+// std::invalid_argument for an option value out of range (a usage error) and
+// cli::InputError for input it cannot use (cli_errors.hpp).
+
+#include <string>
+
+namespace cdcr::runtime_host {
+
+// --replay: the forward path over recorded cable lengths, as fast as
+// possible, into a pose CSV.
+int replay(const std::string& image_path, const std::string& cables_path, const std::string& out_path);
+
+// --sim: the closed loop with simulated drives and robot over the virtual
+// bus, at a fixed rate in lockstep simulated time; the six demo targets.
+int simulate(const std::string& image_path, double rate_hz, double seconds, bool ideal_robot);
+// --sim --circle: the same loop following a streamed circle.
+int follow_circle(const std::string& image_path, double rate_hz, double radius_mm, double speed_mm_s,
+                  bool ideal_robot);
+
+// --can: the runtime itself on a SocketCAN interface, in real time, until
+// `seconds` have passed (0: no limit) or SIGINT/SIGTERM.
+int run_on_socketcan(const std::string& image_path, const std::string& interface_name, double rate_hz,
+                     double seconds, const std::string& flash_dir, bool spin);
+
+// The cycle rate every mode accepts: (0, 100000] Hz.
+void require_rate(double rate_hz);
+
+}  // namespace cdcr::runtime_host
