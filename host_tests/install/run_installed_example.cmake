@@ -1,9 +1,10 @@
-# cmake -DSOURCE_DIR= -DWORK_DIR= -DCDCR= [-DMODEL_IMAGE=model.img]
-#       [-DBUILD_DIR=<host build>] | [-DTOOLCHAIN=<file> -DQEMU= -DMACHINE= -DCPU=]
-#       -P run_installed_example.cmake
+# cmake -DSOURCE_DIR= -DWORK_DIR= -DCDCR= -DBUILD_DIR= [-DMODEL_IMAGE=model.img]
+#       [-DTOOLCHAIN=<file> -DQEMU= -DMACHINE= -DCPU=] -P run_installed_example.cmake
 # What a board integrator does, from a clean prefix:
-#   1. install cdcr under WORK_DIR/prefix: the host build BUILD_DIR as it is,
-#      or, with TOOLCHAIN, a cross build of the tree's libraries first;
+#   1. install cdcr under WORK_DIR/prefix from the build BUILD_DIR as it is:
+#      the host build, or with TOOLCHAIN a cross build of the tree made with
+#      that toolchain file (the QEMU tests' own, which has built the
+#      libraries that install: cdcr_runtime, cdcr_cortexm, cdcr_mps2);
 #   2. export the model image as C with `cdcr export --format c` (MODEL_IMAGE,
 #      or one trained here on a small simulated data set);
 #   3. configure firmware/examples/c_main_loop out of tree against the prefix
@@ -11,14 +12,11 @@
 #      there), build it;
 #   4. run it, on the host or under QEMU: it must boot into RUN, print
 #      compensated poses and PASS, and exit with 0.
-foreach(variable SOURCE_DIR WORK_DIR CDCR)
+foreach(variable SOURCE_DIR WORK_DIR CDCR BUILD_DIR)
   if(NOT ${variable})
     message(FATAL_ERROR "run_installed_example.cmake: ${variable} is not set")
   endif()
 endforeach()
-if(NOT BUILD_DIR AND NOT TOOLCHAIN)
-  message(FATAL_ERROR "run_installed_example.cmake: BUILD_DIR (host) or TOOLCHAIN (cross) is needed")
-endif()
 
 function(run)
   execute_process(COMMAND ${ARGN} RESULT_VARIABLE status OUTPUT_VARIABLE output ERROR_VARIABLE output)
@@ -34,11 +32,6 @@ file(REMOVE_RECURSE ${prefix} ${example_build})
 file(MAKE_DIRECTORY ${WORK_DIR})
 
 # 1. The prefix.
-if(TOOLCHAIN)
-  set(BUILD_DIR ${WORK_DIR}/cdcr)
-  run(${CMAKE_COMMAND} -S ${SOURCE_DIR} -B ${BUILD_DIR} -DCMAKE_TOOLCHAIN_FILE=${TOOLCHAIN} -DCMAKE_BUILD_TYPE=Release)
-  run(${CMAKE_COMMAND} --build ${BUILD_DIR} --target cdcr_runtime cdcr_cortexm cdcr_mps2 -j2)
-endif()
 run(${CMAKE_COMMAND} --install ${BUILD_DIR} --prefix ${prefix})
 foreach(installed include/cdcr/cdcr.h lib/cmake/cdcr/cdcrConfig.cmake)
   if(NOT EXISTS ${prefix}/${installed})
