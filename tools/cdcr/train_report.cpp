@@ -1,0 +1,156 @@
+#include "train_report.hpp"
+
+#include <vector>
+
+#include <fmt/format.h>
+
+#include "json_output.hpp"
+
+namespace cdcr::cli {
+namespace {
+
+std::string check_mark(bool ok) { return ok ? "meets target" : "MISSES target"; }
+
+Json errors_json(const training::MeanErrors& e) {
+  Json j;
+  j["position_mm"] = e.position_mm;
+  j["orientation_deg"] = e.orientation_deg;
+  return j;
+}
+
+}  // namespace
+
+std::string train_report_json(const TrainRun& run) {
+  const training::ExportResult& r = *run.result;
+  const training::TrainedModel& m = r.model;
+  Json j;
+  j["training_samples"] = run.train_rows;
+  j["validation_samples"] = run.validation_rows;
+  j["fitted_rows"] = r.fitted_rows;
+  const training::ModelSelection& selection = r.report.selection;
+  j["model"] = {{"kind", training::to_string(selection.kind)},
+                {"points", selection.points},
+                {"largest_points", selection.largest_points},
+                {"image_bytes", selection.image_bytes},
+                {"forward_cycle_instructions_m7", selection.forward_cycle_instructions},
+                {"reason", selection.reason}};
+  j["search_rows"] = r.report.search_rows;
+  if (run.calibration) {
+    Json segments = Json::array();
+    for (int i = 0; i < run.geometry.segment_count; ++i) {
+      segments.push_back({{"backbone_length_mm", run.geometry.segments[i].backbone_length_mm},
+                          {"anchor_radius_mm", run.geometry.segments[i].anchor_radius_mm}});
+    }
+    j["calibration"] = {{"segments", segments},
+                        {"nominal_before", errors_json(run.calibration->before)},
+                        {"nominal_after", errors_json(run.calibration->after)},
+                        {"evaluations", run.calibration->evaluations}};
+  } else {
+    j["calibration"] = nullptr;
+  }
+  j["calibration_skipped"] = run.calibration_skipped.empty() ? Json(nullptr) : Json(run.calibration_skipped);
+  j["encoding"] = model::to_string(m.encoding);
+  j["payload_input"] = m.has_payload_input();
+  j["default_payload_kg"] = m.has_payload_input() ? Json(m.default_payload_kg) : Json(nullptr);
+  j["kernel"] = run.kernel;
+  j["length_scales"] = std::vector<double>(m.length_scales.data(), m.length_scales.data() + m.length_scales.size());
+  j["signal_variance"] = m.signal_variance[0];
+  j["noise_variance"] = m.noise_variance[0];
+  j["log_marginal_likelihood"] = r.report.log_marginal_likelihood;
+  j["likelihood_evaluations"] = r.report.likelihood_evaluations;
+  j["seconds"] = run.seconds;
+  if (r.validation.samples > 0) {
+    j["validation"] = {{"initial", errors_json(r.validation.initial)},
+                       {"compensated", errors_json(r.validation.compensated)},
+                       {"compensated_float32_image", errors_json(r.firmware.compensated)}};
+  } else {
+    j["validation"] = nullptr;
+  }
+  Json fidelity = Json::object();
+  for (const auto& [accumulator, f] : r.fidelity_by_accumulator) {
+    fidelity[training::to_string(accumulator)] = {{"max_position_mm", f.max_position_mm},
+                                                  {"mean_position_mm", f.mean_position_mm},
+                                                  {"max_orientation_deg", f.max_orientation_deg},
+                                                  {"mean_orientation_deg", f.mean_orientation_deg},
+                                                  {"target_met", training::ExportResult::meets_target(f)}};
+  }
+  j["float32_fidelity"] = fidelity;
+  j["float32_fidelity_target_met"] = r.fidelity_met();
+  j["image"] = {{"path", run.out_path}, {"bytes", r.image.size()}};
+  return j.dump() + "\n";
+}
+
+std::string train_report_text(const TrainRun& run) {
+  const training::ExportResult& r = *run.result;
+  const training::TrainedModel& m = r.model;
+  std::string t;
+  if (run.validation_rows > 0) {
+    t += fmt::format("trained on {} samples, validated on {} held-out samples ({:.1f} s)\n", run.train_rows,
+                     run.validation_rows, run.seconds);
+  } else {
+    t += fmt::format("trained on {} samples, none held out ({:.1f} s)\n", run.train_rows, run.seconds);
+  }
+  const training::ModelSelection& selection = r.report.selection;
+  t += fmt::format("  model: {}\n", selection.reason);
+  t += fmt::format("  image {} bytes (budget {}), Cortex-M7 forward cycle about {} instructions (budget {})\n",
+                   selection.image_bytes, run.board.flash_budget_bytes, selection.forward_cycle_instructions,
+                   run.board.forward_cycle_instructions);
+  if (r.report.search_rows < run.train_rows) {
+    t += fmt::format("  hyperparameters searched on {} of the {} rows\n", r.report.search_rows, run.train_rows);
+  }
+  if (run.calibration) {
+    t += fmt::format("  geometry calibrated on the {} training rows: nominal model {:.3f} mm, {:.3f} deg -> {:.3f} mm, "
+                     "{:.3f} deg\n    (L, r) per segment in mm:",
+                     run.train_rows, run.calibration->before.position_mm, run.calibration->before.orientation_deg,
+                     run.calibration->after.position_mm, run.calibration->after.orientation_deg);
+    for (int i = 0; i < run.geometry.segment_count; ++i) {
+      t += fmt::format(" ({:.2f}, {:.2f})", run.geometry.segments[i].backbone_length_mm,
+                       run.geometry.segments[i].anchor_radius_mm);
+    }
+    t += "\n";
+  } else if (!run.calibration_skipped.empty()) {
+    t += fmt::format("  design geometry: not calibrated ({})\n", run.calibration_skipped);
+  }
+  t += fmt::format("  encoding {}, kernel {} squared exponential, hyperparameters shared by the 6 outputs\n",
+                   model::to_string(m.encoding), run.kernel);
+  if (m.has_payload_input()) {
+    t += fmt::format("  inputs: the bend vector and the payload (the last length scale; {:.3f} kg until the "
+                     "runtime receives one)\n",
+                     m.default_payload_kg);
+  } else if (run.data_has_payload) {
+    t += "  inputs: the bend vector; the payload_kg column is ignored (--ignore-payload)\n";
+  }
+  t += "  length scales (normalised inputs):";
+  for (Eigen::Index i = 0; i < m.length_scales.size(); ++i) t += fmt::format(" {:.4g}", m.length_scales[i]);
+  t += fmt::format("\n  signal variance {:.4g}, noise variance {:.4g} (normalised outputs)\n",
+                   m.signal_variance[0], m.noise_variance[0]);
+  t += fmt::format("  log marginal likelihood {:.6g} after {} evaluations\n", r.report.log_marginal_likelihood,
+                   r.report.likelihood_evaluations);
+  if (r.validation.samples > 0) {
+    t += "held-out mean error          position (mm)   orientation (deg)\n";
+    t += fmt::format("  nominal model              {:13.4f}   {:17.4f}\n", r.validation.initial.position_mm,
+                     r.validation.initial.orientation_deg);
+    t += fmt::format("  compensated (double)       {:13.4f}   {:17.4f}\n", r.validation.compensated.position_mm,
+                     r.validation.compensated.orientation_deg);
+    t += fmt::format("  compensated (float32 image){:13.4f}   {:17.4f}\n", r.firmware.compensated.position_mm,
+                     r.firmware.compensated.orientation_deg);
+  } else {
+    t += "no held-out figures (--holdout 0): measure the image with cdcr eval on data collected apart\n";
+  }
+  if (run.validation_rows > 0 && run.validation_path.empty()) {
+    t += fmt::format("exported model fitted on all {} rows, the held-out ones included\n", r.fitted_rows);
+  }
+  t += fmt::format("float32 fidelity on the {} (image path vs double trainer; target 0.01 mm, 0.001 deg):\n",
+                   run.validation_rows > 0 ? "held-out samples" : "fitted rows");
+  for (const auto& [accumulator, f] : r.fidelity_by_accumulator) {
+    const bool firmware = accumulator != training::FirmwareAccumulator::float32;
+    t += fmt::format("  {:<31} max {:.2e} mm, mean {:.2e} mm, max {:.2e} deg, mean {:.2e} deg: {}\n",
+                     training::to_string(accumulator), f.max_position_mm, f.mean_position_mm,
+                     f.max_orientation_deg, f.mean_orientation_deg,
+                     firmware ? check_mark(training::ExportResult::meets_target(f)) : "(not used by firmware)");
+  }
+  t += fmt::format("wrote {} ({} bytes)\n", run.out_path, r.image.size());
+  return t;
+}
+
+}  // namespace cdcr::cli
