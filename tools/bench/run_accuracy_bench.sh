@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The paper's protocol on the simulated robot, as reported in the README:
+# The paper's protocol on the simulated robot, as reported in tools/bench/README.md:
 # 750 samples, 50 held out, learning curve at N = 100..700 for both input
 # encodings, then shared against per-output hyperparameters. Writes the
 # figures to tools/bench/figures/ and the tables to $BUILD_DIR/accuracy_bench/.

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Learning curves beyond the paper's workspace, as reported in the README:
+# Learning curves beyond the paper's workspace, as reported in tools/bench/README.md:
 # 4,000 rows of the simulated robot with bends up to 0.7 rad and a 200-row
 # test set from another session of the same robot; the exact GP and the
 # sparse GP (M = 1,024, the runtime's capacity, or N if fewer) against N,

@@ -1,7 +1,7 @@
 #pragma once
 // A dataset of the robot: commanded cable lengths, optionally the payload the
 // end platform carried, and, when measured, the end-platform pose in the base
-// frame. The CSV layout is documented in the README ("Dataset format").
+// frame. The CSV layout is documented in tools/README.md ("Dataset format").
 
 #include <cstdint>
 #include <string>

@@ -40,8 +40,8 @@ using hal::kMaxCanFilters;
 // costliest single step, so that a request advances in every cycle even at
 // the full kMaxTrainingPoints. The qemu.cycle_budget_* tests hold the
 // defaults to 80,000 instructions per cycle on the Cortex-M7 and 120,000 on
-// the Cortex-M4F with the demo's model; the README gives the figures at the
-// full capacity. A board build may set its own budget with
+// the Cortex-M4F with the demo's model; tools/bench/README.md gives the
+// figures at the full capacity. A board build may set its own budget with
 // -DCDCR_CYCLE_WORK_UNITS=...
 inline constexpr model::WorkCosts kWorkCosts = model::arch::Selected::kWorkCosts;
 #ifdef CDCR_CYCLE_WORK_UNITS

@@ -4,7 +4,7 @@
 // frames through. Acceptance filters, queue limits and error counters behave
 // as a controller's would, so the runtime cannot tell the difference; a
 // board with a real controller implements hal::CanBus on its peripheral
-// instead (see the README).
+// instead (hal/README.md, "On a real board").
 
 #include <cstddef>
 #include <cstdint>

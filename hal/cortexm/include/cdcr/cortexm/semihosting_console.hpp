@@ -1,6 +1,6 @@
 #pragma once
 // The runtime's log lines over semihosting. On a board without a debugger
-// attached, a UART console takes its place (see the README).
+// attached, a UART console takes its place (hal/README.md).
 
 #include <cdcr/hal/console.hpp>
 
