@@ -1,5 +1,6 @@
 // cdcr-runtime --sim: the closed loop with the simulated drives and robot.
 
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <random>
@@ -8,6 +9,7 @@
 #include <vector>
 
 #include <Eigen/Geometry>
+#include <fmt/format.h>
 
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/model/compensation.hpp>
@@ -343,5 +345,6 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
               setpoints_checked > 0 ? setpoint_target_error_sum_mm / double(setpoints_checked) : 0.0,
               nominal_target_error_max_mm, setpoint_target_error_max_mm);
   return 0;
+}
 
 }  // namespace cdcr::runtime_host

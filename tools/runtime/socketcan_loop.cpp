@@ -24,7 +24,6 @@ namespace fw = cdcr::firmware;
 namespace model = cdcr::model;
 using cli::InputError;
 
-
 #if CDCR_HAVE_LINUX_PLATFORM
 namespace {
 
@@ -98,7 +97,5 @@ int run_on_socketcan(const std::string&, const std::string&, double, double, con
   throw InputError("--can needs a Linux host (SocketCAN)");
 }
 #endif
-
-}  // namespace
 
 }  // namespace cdcr::runtime_host
