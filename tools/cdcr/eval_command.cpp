@@ -1,4 +1,4 @@
-#include "eval_command.hpp"
+#include "training_commands.hpp"
 
 #include <memory>
 #include <string>

@@ -1,4 +1,4 @@
-#include "learning_curve_command.hpp"
+#include "training_commands.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -18,9 +18,7 @@
 #include "deploy_command.hpp"
 #endif
 #include "ik_command.hpp"
-#include "train_command.hpp"
-#include "eval_command.hpp"
-#include "learning_curve_command.hpp"
+#include "training_commands.hpp"
 #include "import_mocap_command.hpp"
 #include "inspect_command.hpp"
 #include "export_command.hpp"

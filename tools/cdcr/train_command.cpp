@@ -1,4 +1,4 @@
-#include "train_command.hpp"
+#include "training_commands.hpp"
 
 #include <chrono>
 #include <cstdint>

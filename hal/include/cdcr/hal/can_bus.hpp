@@ -4,6 +4,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "cdcr/hal/interface.hpp"
+
 namespace cdcr::hal {
 
 struct CanFrame {
@@ -45,7 +47,7 @@ struct CanErrorCounters {
   std::uint32_t bus_errors = 0;   // error frames seen by the controller
 };
 
-class CanBus {
+class CanBus : public Interface {
  public:
   virtual CanStatus send(const CanFrame& frame) = 0;
   virtual CanStatus receive(CanFrame& frame) = 0;
@@ -54,10 +56,7 @@ class CanBus {
   virtual CanErrorCounters error_counters() const = 0;
 
  protected:
-  CanBus() = default;
   ~CanBus() = default;
-  CanBus(const CanBus&) = default;
-  CanBus& operator=(const CanBus&) = default;
 };
 
 }  // namespace cdcr::hal

@@ -5,18 +5,17 @@
 
 #include <cstdint>
 
+#include "cdcr/hal/interface.hpp"
+
 namespace cdcr::hal {
 
 // Nanoseconds since an arbitrary epoch; never goes backwards.
-class MonotonicClock {
+class MonotonicClock : public Interface {
  public:
   virtual std::int64_t now_ns() const = 0;
 
  protected:
-  MonotonicClock() = default;
   ~MonotonicClock() = default;
-  MonotonicClock(const MonotonicClock&) = default;
-  MonotonicClock& operator=(const MonotonicClock&) = default;
 };
 
 struct TimerTick {
@@ -26,7 +25,7 @@ struct TimerTick {
 
 // Absolute-time periodic releases: release k is start + k * period, so lateness
 // in one cycle never shifts the following ones (no drift).
-class PeriodicTimer {
+class PeriodicTimer : public Interface {
  public:
   virtual void start(std::int64_t period_ns) = 0;
   // Blocks until the next release that is still in the future, and reports
@@ -37,10 +36,7 @@ class PeriodicTimer {
   virtual std::uint32_t overruns() const = 0;
 
  protected:
-  PeriodicTimer() = default;
   ~PeriodicTimer() = default;
-  PeriodicTimer(const PeriodicTimer&) = default;
-  PeriodicTimer& operator=(const PeriodicTimer&) = default;
 };
 
 }  // namespace cdcr::hal

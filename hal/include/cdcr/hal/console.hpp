@@ -1,18 +1,17 @@
 #pragma once
 // Human-readable log lines (a UART on a board, stderr on the host).
 
+#include "cdcr/hal/interface.hpp"
+
 namespace cdcr::hal {
 
-class Console {
+class Console : public Interface {
  public:
   // `line` is NUL-terminated and carries no newline; the backend ends the line.
   virtual void write_line(const char* line) = 0;
 
  protected:
-  Console() = default;
   ~Console() = default;
-  Console(const Console&) = default;
-  Console& operator=(const Console&) = default;
 };
 
 // Drops every line: for a platform with nowhere to write them (the simulated

@@ -22,6 +22,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "cdcr/hal/interface.hpp"
+
 namespace cdcr::hal {
 
 enum class FlashStatus : std::uint8_t {
@@ -41,7 +43,7 @@ constexpr const char* to_string(FlashStatus status) {
   return "unknown flash status";
 }
 
-class Flash {
+class Flash : public Interface {
  public:
   virtual std::uint32_t sector_bytes() const = 0;
   virtual std::uint32_t sector_count() const = 0;
@@ -58,10 +60,7 @@ class Flash {
   std::uint32_t size_bytes() const { return sector_bytes() * sector_count(); }
 
  protected:
-  Flash() = default;
   ~Flash() = default;
-  Flash(const Flash&) = default;
-  Flash& operator=(const Flash&) = default;
 };
 
 }  // namespace cdcr::hal

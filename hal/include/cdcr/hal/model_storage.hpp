@@ -5,6 +5,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "cdcr/hal/interface.hpp"
+
 namespace cdcr::hal {
 
 struct MemoryRegion {
@@ -12,15 +14,12 @@ struct MemoryRegion {
   std::size_t size_bytes = 0;
 };
 
-class ModelStorage {
+class ModelStorage : public Interface {
  public:
   virtual MemoryRegion model_region() const = 0;
 
  protected:
-  ModelStorage() = default;
   ~ModelStorage() = default;
-  ModelStorage(const ModelStorage&) = default;
-  ModelStorage& operator=(const ModelStorage&) = default;
 };
 
 }  // namespace cdcr::hal
