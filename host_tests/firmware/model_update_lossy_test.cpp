@@ -145,10 +145,10 @@ std::string faults_name(const ::testing::TestParamInfo<Faults>& info) { return i
 
 INSTANTIATE_TEST_SUITE_P(Link, LossyTransferTest, ::testing::ValuesIn(kFaults), faults_name);
 
-// The cause of "refused: malformed" on a busy bus: a START whose digest
-// frames did not all arrive (one lost, or START repeated, or ahead of its
-// last digest frame).
-class StartWithoutDigestTest : public ::testing::Test {
+// Single frames lost or repeated. The cause of "refused: malformed" on a
+// busy bus: a START whose digest frames did not all arrive (one lost, or
+// START repeated, or ahead of its last digest frame).
+class LostFrameTest : public ::testing::Test {
  protected:
   void SetUp() override {
     provision_slot(flash, 0, update_test_image(40, 1), 1);
@@ -170,7 +170,7 @@ class StartWithoutDigestTest : public ::testing::Test {
   SentImage sent{update_test_image(60, 2)};
 };
 
-TEST_F(StartWithoutDigestTest, ANewTransferAsksForTheDigestAgain) {
+TEST_F(LostFrameTest, ANewTransferAsksForTheDigestAgain) {
   FrameQueue out;
   sent.sender.start(out, board->now_ms());
   out.frames.erase(out.frames.begin() + 3);  // digest part 3 lost
@@ -187,7 +187,7 @@ TEST_F(StartWithoutDigestTest, ANewTransferAsksForTheDigestAgain) {
   EXPECT_EQ(board->runtime->model_update().state(), UpdateState::preparing);
 }
 
-TEST_F(StartWithoutDigestTest, ARepeatedStartGoesOnWithTheTransfer) {
+TEST_F(LostFrameTest, ARepeatedStartGoesOnWithTheTransfer) {
   FrameQueue out;
   sent.sender.start(out, board->now_ms());
   out.frames.push_back(out.frames.back());  // START twice
@@ -202,6 +202,23 @@ TEST_F(StartWithoutDigestTest, ARepeatedStartGoesOnWithTheTransfer) {
   board->cycle(out.take());
   EXPECT_EQ(reasons(), std::vector<UpdateReason>{UpdateReason::none});
   EXPECT_EQ(board->runtime->model_update().state(), UpdateState::receiving);
+}
+
+// A block header repeated before its data: the block is taken once, and
+// no block is called missing.
+TEST_F(LostFrameTest, ARepeatedBlockHeaderIsNotAMissingBlock) {
+  FrameQueue out;
+  sent.sender.start(out, board->now_ms());
+  board->cycle(out.take());
+  for (int i = 0; i < 100 && board->runtime->model_update().state() != UpdateState::receiving; ++i) board->cycle();
+  ASSERT_EQ(board->runtime->model_update().state(), UpdateState::receiving);
+  board->take_reports();
+  sent.sender.send_block(0, out);
+  out.frames.insert(out.frames.begin() + 1, out.frames.front());
+  board->cycle(out.take());
+  for (int i = 0; i < 20; ++i) board->cycle();
+  for (UpdateReason reason : reasons()) EXPECT_EQ(reason, UpdateReason::none);
+  EXPECT_EQ(board->runtime->model_update().blocks_in_flash(), 1u);
 }
 
 }  // namespace
