@@ -108,10 +108,10 @@ void ModelUpdate::start_transfer(const protocol::UpdateCommandFrame& command) {
   const bool named = command.transfer_id == record.transfer_id && command.image_size == record.image_size;
   if (!receiver_.digest_complete()) {
     // A digest frame lost, or START repeated or ahead of its digest: not a
-    // malformed image. The transfer under way (or just committed) goes on
-    // if this names it; anything else needs the digest and START again.
-    const bool under_way = named && (transferring() || phase_ == Phase::committed);
-    report(under_way ? UpdateReason::none : UpdateReason::no_transfer);
+    // malformed image. The transfer under way goes on if this names it
+    // (its digest is in the record); anything else, a committed image
+    // included, needs the digest and START again to be told apart.
+    report(named && transferring() ? UpdateReason::none : UpdateReason::no_transfer);
     return;
   }
   if (command.image_size < model::kImageHeaderSize) {
