@@ -2,7 +2,7 @@
 // A board on the simulated bus with a simulated flash, for the model update
 // tests: the runtime can be reset (rebuilt on the same flash, as after a
 // power loss), the drives keep sending cable lengths, and a host sends a
-// model with the deploy tool's sender.
+// model with the firmware's UpdateSender (the one `cdcr deploy` uses).
 
 #include <cstring>
 #include <memory>
@@ -10,12 +10,43 @@
 
 #include <cdcr/firmware/model_slots.hpp>
 #include <cdcr/firmware/runtime.hpp>
+#include <cdcr/firmware/update/update_sender.hpp>
 #include <cdcr/sim/sim_flash.hpp>
 
-#include "cdcr/deploy_sender.hpp"
 #include "runtime_fixture.hpp"
 
 namespace cdcr::test_support {
+
+using firmware::UpdateSender;
+
+// The frames a sender hands over, kept until the test sends them (or
+// changes them first).
+class FrameQueue final : public hal::CanBus {
+ public:
+  std::vector<hal::CanFrame> frames;
+
+  hal::CanStatus send(const hal::CanFrame& frame) override {
+    frames.push_back(frame);
+    return hal::CanStatus::ok;
+  }
+  hal::CanStatus receive(hal::CanFrame&) override { return hal::CanStatus::empty; }
+  bool set_filters(const hal::CanFilter*, std::size_t) override { return true; }
+  hal::CanErrorCounters error_counters() const override { return {}; }
+
+  std::vector<hal::CanFrame> take() {
+    std::vector<hal::CanFrame> taken;
+    taken.swap(frames);
+    return taken;
+  }
+};
+
+// An image the sender sends from: the sender keeps a pointer to the bytes.
+struct SentImage {
+  std::vector<std::uint8_t> bytes;
+  UpdateSender sender;
+  explicit SentImage(std::vector<std::uint8_t> image)
+      : bytes(std::move(image)), sender(bytes.data(), static_cast<std::uint32_t>(bytes.size())) {}
+};
 
 // Writes `image` into `slot` as committed with `sequence`, as a programmer
 // would (no flash operations counted).
@@ -108,15 +139,14 @@ struct UpdateBoard {
   std::int64_t now_ms() const { return clock.now_ns() / 1'000'000; }
 
   // Drives `sender` until it is done, the flash loses power or `limit`
-  // cycles pass; returns the cycles run.
-  int run_sender(deploy::UpdateSender& sender, int limit, bool start = true) {
-    std::vector<hal::CanFrame> out;
-    if (start) sender.start(out);
+  // cycles pass; returns the cycles run. Up to 4 blocks a cycle.
+  int run_sender(UpdateSender& sender, int limit, bool start = true) {
+    FrameQueue out;
+    if (start) sender.start(out, now_ms());
     int count = 0;
-    while (count < limit && sender.outcome() == deploy::UpdateSender::Outcome::running && !flash.power_lost()) {
-      sender.pump(now_ms(), out, 45);
-      cycle(out);
-      out.clear();
+    while (count < limit && sender.outcome() == UpdateSender::Outcome::running && !flash.power_lost()) {
+      sender.pump(now_ms(), out, 44);
+      cycle(out.take());
       for (const hal::CanFrame& report : take_reports()) sender.on_report(report, now_ms(), out);
       ++count;
     }

@@ -173,10 +173,10 @@ class ModelUpdateTest : public ::testing::Test {
   }
 
   // START a transfer and run until the runtime grants the first window.
-  void start(deploy::UpdateSender& sender) {
-    std::vector<hal::CanFrame> out;
-    sender.start(out);
-    board->cycle(out);
+  void start(UpdateSender& sender) {
+    FrameQueue out;
+    sender.start(out, board->now_ms());
+    board->cycle(out.frames);
     for (int i = 0; i < 100 && board->runtime->model_update().state() != UpdateState::receiving; ++i) board->cycle();
     ASSERT_EQ(board->runtime->model_update().state(), UpdateState::receiving);
     board->take_reports();
@@ -209,9 +209,10 @@ class ModelUpdateTest : public ::testing::Test {
 TEST_F(ModelUpdateTest, TransferCommitsWhilePosesKeepComing) {
   const std::uint32_t poses_before = board->poses_seen;
   const firmware::Pose pose_before = board->runtime->latest_pose().pose;
-  deploy::UpdateSender sender(new_image);
+  SentImage sender_image(new_image);
+  UpdateSender& sender = sender_image.sender;
   const int cycles = board->run_sender(sender, 5000);
-  ASSERT_EQ(sender.outcome(), deploy::UpdateSender::Outcome::committed);
+  ASSERT_EQ(sender.outcome(), UpdateSender::Outcome::committed);
   // A pose in every cycle, the transfer's included.
   EXPECT_EQ(board->poses_seen, poses_before + std::uint32_t(cycles));
   EXPECT_EQ(board->runtime->state(), firmware::RuntimeState::run);
@@ -246,47 +247,51 @@ TEST_F(ModelUpdateTest, TransferCommitsWhilePosesKeepComing) {
 }
 
 TEST_F(ModelUpdateTest, CorruptedBlockIsRefusedAndResent) {
-  deploy::UpdateSender sender(new_image);
+  SentImage sender_image(new_image);
+  UpdateSender& sender = sender_image.sender;
   start(sender);
-  std::vector<hal::CanFrame> out;
+  FrameQueue out;
   sender.send_block(0, out);
-  out[1].data[3] ^= 0x10;
-  board->cycle(out);
+  out.frames[1].data[3] ^= 0x10;
+  board->cycle(out.frames);
   EXPECT_TRUE(has_reason(UpdateReason::corrupted));
   EXPECT_EQ(board->runtime->model_update().blocks_in_flash(), 0u);
   expect_old_model_running();
 }
 
 TEST_F(ModelUpdateTest, DuplicateBlockIsRefused) {
-  deploy::UpdateSender sender(new_image);
+  SentImage sender_image(new_image);
+  UpdateSender& sender = sender_image.sender;
   start(sender);
-  std::vector<hal::CanFrame> out;
+  FrameQueue out;
   sender.send_block(0, out);
   sender.send_block(0, out);
-  board->cycle(out);
+  board->cycle(out.frames);
   EXPECT_TRUE(has_reason(UpdateReason::duplicate));
   expect_old_model_running();
 }
 
 TEST_F(ModelUpdateTest, OutOfOrderBlockIsRefused) {
-  deploy::UpdateSender sender(new_image);
+  SentImage sender_image(new_image);
+  UpdateSender& sender = sender_image.sender;
   start(sender);
-  std::vector<hal::CanFrame> out;
+  FrameQueue out;
   sender.send_block(2, out);
-  board->cycle(out);
+  board->cycle(out.frames);
   EXPECT_TRUE(has_reason(UpdateReason::out_of_order));
   EXPECT_EQ(board->runtime->model_update().blocks_in_flash(), 0u);
   expect_old_model_running();
 }
 
 TEST_F(ModelUpdateTest, MissingDataAndMissingBlocksAreRefused) {
-  deploy::UpdateSender sender(new_image);
+  SentImage sender_image(new_image);
+  UpdateSender& sender = sender_image.sender;
   start(sender);
-  std::vector<hal::CanFrame> out;
+  FrameQueue out;
   sender.send_block(0, out);
-  out.pop_back();  // the block's last data frame lost
+  out.frames.pop_back();  // the block's last data frame lost
   sender.send_block(1, out);
-  board->cycle(out);
+  board->cycle(out.frames);
   EXPECT_TRUE(has_reason(UpdateReason::missing_block));
   // COMMIT with blocks missing.
   hal::CanFrame commit;
@@ -298,11 +303,12 @@ TEST_F(ModelUpdateTest, MissingDataAndMissingBlocksAreRefused) {
 }
 
 TEST_F(ModelUpdateTest, TransferLeftHalfWayTimesOutAndResumes) {
-  deploy::UpdateSender sender(new_image);
+  SentImage sender_image(new_image);
+  UpdateSender& sender = sender_image.sender;
   start(sender);
-  std::vector<hal::CanFrame> out;
+  FrameQueue out;
   for (std::uint32_t b = 0; b < 4; ++b) sender.send_block(b, out);
-  board->cycle(out);
+  board->cycle(out.frames);
   for (std::uint32_t i = 0; i < firmware::kUpdateTimeoutCycles + 2; ++i) board->runtime->run_cycle(board->timer.wait_next());
   board->cycle();
   EXPECT_TRUE(has_reason(UpdateReason::timeout));
@@ -310,20 +316,23 @@ TEST_F(ModelUpdateTest, TransferLeftHalfWayTimesOutAndResumes) {
   EXPECT_EQ(board->runtime->model_update().blocks_in_flash(), 4u);
   expect_old_model_running();
   // START again resumes after the four blocks in flash.
-  deploy::UpdateSender again(new_image);
+  SentImage again_image(new_image);
+  UpdateSender& again = again_image.sender;
   board->run_sender(again, 5000);
-  EXPECT_EQ(again.outcome(), deploy::UpdateSender::Outcome::committed);
+  EXPECT_EQ(again.outcome(), UpdateSender::Outcome::committed);
   EXPECT_LT(again.frames_sent(), sender.frames_sent() + (again.total_blocks() - 3) * 9 + 20);
   EXPECT_EQ(board->active_image(), new_image);
 }
 
 TEST_F(ModelUpdateTest, SecondTransferOverTheFirstIsRefused) {
-  deploy::UpdateSender sender(new_image);
+  SentImage sender_image(new_image);
+  UpdateSender& sender = sender_image.sender;
   start(sender);
-  deploy::UpdateSender other(update_test_image(30, 3));
-  std::vector<hal::CanFrame> out;
-  other.start(out);
-  board->cycle(out);
+  SentImage other_image(update_test_image(30, 3));
+  UpdateSender& other = other_image.sender;
+  FrameQueue out;
+  other.start(out, board->now_ms());
+  board->cycle(out.frames);
   EXPECT_TRUE(has_reason(UpdateReason::busy));
   EXPECT_EQ(board->runtime->model_update().state(), UpdateState::receiving);
   expect_old_model_running();
@@ -332,21 +341,22 @@ TEST_F(ModelUpdateTest, SecondTransferOverTheFirstIsRefused) {
 // Blocks whose SHA-256 is not the one START announced: refused at COMMIT,
 // before anything is made active.
 TEST_F(ModelUpdateTest, DigestMismatchIsRefusedAtCommit) {
-  deploy::UpdateSender sender(new_image);
-  std::vector<hal::CanFrame> out;
-  sender.start(out);
-  out[0].data[1] ^= 0x01;  // the first digest byte, as announced
-  board->cycle(out);
+  SentImage sender_image(new_image);
+  UpdateSender& sender = sender_image.sender;
+  FrameQueue out;
+  sender.start(out, board->now_ms());
+  out.frames[0].data[1] ^= 0x01;  // the first digest byte, as announced
+  board->cycle(out.frames);
   for (int i = 0; i < 100 && board->runtime->model_update().state() != UpdateState::receiving; ++i) board->cycle();
   ASSERT_EQ(board->runtime->model_update().state(), UpdateState::receiving);
   std::uint32_t next = 0;
   for (int i = 0; i < 2000 && board->runtime->model_update().blocks_in_flash() < sender.total_blocks(); ++i) {
-    out.clear();
+    out.frames.clear();
     while (next < sender.total_blocks() &&
            next < board->runtime->model_update().blocks_in_flash() + firmware::kUpdateWindowBlocks) {
       sender.send_block(next++, out);
     }
-    board->cycle(out);
+    board->cycle(out.frames);
   }
   board->take_reports();
   hal::CanFrame commit;
@@ -365,9 +375,10 @@ TEST_F(ModelUpdateTest, DigestMismatchIsRefusedAtCommit) {
 class RefusedImageTest : public ModelUpdateTest {
  protected:
   void expect_refused(const std::vector<std::uint8_t>& image, UpdateReason reason) {
-    deploy::UpdateSender sender(image);
+    SentImage sender_image(image);
+  UpdateSender& sender = sender_image.sender;
     board->run_sender(sender, 5000);
-    EXPECT_EQ(sender.outcome(), deploy::UpdateSender::Outcome::refused);
+    EXPECT_EQ(sender.outcome(), UpdateSender::Outcome::refused);
     EXPECT_EQ(sender.refusal(), reason) << "reason " << int(sender.refusal());
     expect_old_model_running();
     board->boot();
@@ -420,28 +431,29 @@ TEST(ModelUpdateWhileSolving, VerificationFinishesUnderAStreamOfTargets) {
   board.cycle();
   const firmware::Pose start_pose = board.runtime->latest_pose().pose;
 
-  deploy::UpdateSender sender(update_test_image(60, 2));
-  std::vector<hal::CanFrame> out;
-  sender.start(out);
+  SentImage sender_image(update_test_image(60, 2));
+  UpdateSender& sender = sender_image.sender;
+  FrameQueue out;
+  sender.start(out, board.now_ms());
   int cycles = 0, cycles_verifying = 0, cycles_verifying_with_ik = 0;
   bool starved = false;
-  while (cycles < 20000 && sender.outcome() == deploy::UpdateSender::Outcome::running) {
-    sender.pump(board.now_ms(), out, 45);
+  while (cycles < 20000 && sender.outcome() == UpdateSender::Outcome::running) {
+    sender.pump(board.now_ms(), out, 44);
     // A TRACKING position target every cycle, circling the start pose.
     hal::CanFrame frame;
     const double angle = 0.002 * cycles;
     firmware::protocol::encode(firmware::protocol::TargetPositionXy{start_pose.position_mm.x() + 2.0 * std::cos(angle),
                                                                     start_pose.position_mm.y() + 2.0 * std::sin(angle)},
                                frame);
-    out.push_back(frame);
+    out.frames.push_back(frame);
     firmware::protocol::encode(firmware::protocol::TargetPositionZ{start_pose.position_mm.z(),
                                                                    firmware::protocol::TargetMode::position, true,
                                                                    static_cast<std::uint8_t>(cycles)},
                                frame);
-    out.push_back(frame);
+    out.frames.push_back(frame);
     const bool verifying = board.runtime->model_update().verifying();
-    board.cycle(out);
-    out.clear();
+    board.cycle(out.frames);
+    out.frames.clear();
     if (verifying) {
       ++cycles_verifying;
       if (board.runtime->ik_running()) ++cycles_verifying_with_ik;
@@ -457,7 +469,7 @@ TEST(ModelUpdateWhileSolving, VerificationFinishesUnderAStreamOfTargets) {
   ASSERT_GT(cycles_verifying, 0);
   EXPECT_EQ(cycles_verifying_with_ik, cycles_verifying);
   EXPECT_TRUE(starved);
-  EXPECT_EQ(sender.outcome(), deploy::UpdateSender::Outcome::committed);
+  EXPECT_EQ(sender.outcome(), UpdateSender::Outcome::committed);
   EXPECT_EQ(board.runtime->statistics().overruns, 0u);
   std::printf("[ figures  ] verification under a target stream: %d cycles of %d\n", cycles_verifying, cycles);
 }

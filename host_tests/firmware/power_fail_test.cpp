@@ -52,9 +52,10 @@ TEST(PowerFail, EveryFlashOperationOfAnUpdate) {
     sim::SimFlash flash(kSectorBytes, kSectors, 256, kTiming);
     std::memcpy(flash.raw(), snapshot.data(), snapshot.size());
     UpdateBoard board(flash, {});
-    deploy::UpdateSender sender(new_image);
+    SentImage sender_image(new_image);
+    UpdateSender& sender = sender_image.sender;
     board.run_sender(sender, 20000);
-    ASSERT_EQ(sender.outcome(), deploy::UpdateSender::Outcome::committed);
+    ASSERT_EQ(sender.outcome(), UpdateSender::Outcome::committed);
     total_operations = flash.operations();
     std::printf("[ figures  ] %zu-byte image, %u blocks: %llu flash operations (%llu erases, %llu programs)\n",
                 new_image.size(), sender.total_blocks(), static_cast<unsigned long long>(total_operations),
@@ -71,8 +72,8 @@ TEST(PowerFail, EveryFlashOperationOfAnUpdate) {
       std::memcpy(flash.raw(), snapshot.data(), snapshot.size());
       UpdateBoard board(flash, {});
       flash.power_loss_at(k, cut);
-      auto sender = std::make_unique<deploy::UpdateSender>(new_image);
-      board.run_sender(*sender, 20000);
+      auto sender = std::make_unique<SentImage>(new_image);
+      board.run_sender(sender->sender, 20000);
       ASSERT_TRUE(flash.power_lost());
 
       // Reboot on what the flash holds.
@@ -95,12 +96,12 @@ TEST(PowerFail, EveryFlashOperationOfAnUpdate) {
       // The update resumes: the host restarts too every other time.
       if (!committed) {
         if (k % 2 == 0) {
-          sender = std::make_unique<deploy::UpdateSender>(new_image);
-          board.run_sender(*sender, 20000);
+          sender = std::make_unique<SentImage>(new_image);
+          board.run_sender(sender->sender, 20000);
         } else {
-          board.run_sender(*sender, 20000, false);
+          board.run_sender(sender->sender, 20000, false);
         }
-        ASSERT_EQ(sender->outcome(), deploy::UpdateSender::Outcome::committed);
+        ASSERT_EQ(sender->sender.outcome(), UpdateSender::Outcome::committed);
       }
       ASSERT_EQ(board.active_image(), new_image);
       board.boot();

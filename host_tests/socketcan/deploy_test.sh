@@ -6,6 +6,13 @@
 #   2. A larger model, with the runtime killed (SIGKILL) at 10 random moments
 #      of the transfer and restarted each time on the same flash: every
 #      restart runs a valid image, and the deploy resumes and finishes.
+#   3. A model through a faulty link: `cdcr deploy` on vcan1, the runtime on
+#      vcan0 at 25 Hz (the pace of the busy machine where deploys were
+#      refused as malformed: 36 ms a cycle, so that the sender's 200 ms of
+#      silence before it STARTs again are a few cycles), and between them
+#      socketcan_relay (beside CDCR_CHECK), which loses 5 % of the frames
+#      each way and repeats and reorders 1 % (seeded): the transfer resends
+#      and commits.
 #   CDCR_RUNTIME, CDCR_CLI, CDCR_CHECK: host-built binaries; CDCR_WORK_DIR.
 set -u
 work=$CDCR_WORK_DIR
@@ -14,13 +21,14 @@ mkdir -p "$capture_dir"
 mount -t tmpfs tmpfs "$capture_dir" || exit 1
 log=$capture_dir/candump.log
 flash=$work/flash
-rm -rf "$flash" "$work"/runtime.err.* "$work"/deploy.*
+rm -rf "$flash" "$work"/runtime.err.* "$work"/deploy.* "$work"/relay.err
 
 . "$(dirname "$0")/bus_waits.sh"
 
 "$CDCR_CHECK" image "$work/old.img" 24 1 || fail "cannot write the old image"
 "$CDCR_CHECK" image "$work/new.img" 40 2 || fail "cannot write the new image"
 "$CDCR_CHECK" image "$work/big.img" 1000 3 || fail "cannot write the large image"
+"$CDCR_CHECK" image "$work/lossy.img" 100 4 || fail "cannot write the image for the faulty link"
 eval "$("$CDCR_CHECK" frames "$work/old.img")" || fail "cannot compute the frames"
 
 start_feeders
@@ -28,8 +36,9 @@ stdbuf -oL candump -L -r 4194304 vcan0,130:7F8,150:7FF,178:7FF,7F0:7FF > "$log" 
 candump_pid=$!
 
 restarts=0
+rate=100
 start_runtime() {
-  "$CDCR_RUNTIME" --image "$work/old.img" --can vcan0 --flash-dir "$flash" --rate 100 \
+  "$CDCR_RUNTIME" --image "$work/old.img" --can vcan0 --flash-dir "$flash" --rate "$rate" \
     > /dev/null 2> "$work/runtime.err.$restarts" &
   runtime_pid=$!
 }
@@ -87,6 +96,26 @@ wait "$deploy_pid" || fail "deploy after 10 kills: $(cat "$work/deploy.big.err")
 progress "$(cat "$work/deploy.big.out")"
 "$CDCR_CLI" deploy --can vcan0 --status > "$work/deploy.status" 2>&1 || fail "status: $(cat "$work/deploy.status")"
 grep -q "active slot B" "$work/deploy.status" || fail "status after the large model: $(cat "$work/deploy.status")"
+
+# 3. Through a faulty link, to the runtime at 25 Hz.
+kill "$runtime_pid"
+wait "$runtime_pid" 2>/dev/null
+restarts=$((restarts + 1))
+rate=25
+start_runtime
+wait_until "the runtime in RUN at 25 Hz" grep -q "state RUN" "$work/runtime.err.$restarts"
+ip link add dev vcan1 type vcan && ip link set up vcan1 || fail "cannot bring up vcan1"
+"$(dirname "$CDCR_CHECK")/socketcan_relay" vcan1 vcan0 0.05 0.01 0.01 24 2> "$work/relay.err" &
+relay_pid=$!
+"$CDCR_CLI" deploy --can vcan1 --image "$work/lossy.img" --quiet --timeout 60 \
+  > "$work/deploy.lossy.out" 2> "$work/deploy.lossy.err"
+deploy_status=$?
+kill "$relay_pid"
+wait "$relay_pid"
+[ "$deploy_status" -eq 0 ] || fail "deploy through the faulty link: $(cat "$work/deploy.lossy.err"); relay: $(cat "$work/relay.err")"
+progress "$(cat "$work/deploy.lossy.out"); relay: $(cat "$work/relay.err")"
+"$CDCR_CLI" deploy --can vcan0 --status > "$work/deploy.status" 2>&1 || fail "status: $(cat "$work/deploy.status")"
+grep -q "active slot A" "$work/deploy.status" || fail "status after the faulty link: $(cat "$work/deploy.status")"
 stop_all
 echo "SOCKETCAN_TEST_PASS"
 exit 0

@@ -10,8 +10,8 @@
 #include <fmt/format.h>
 
 #include <cdcr/firmware/capacity.hpp>
+#include <cdcr/firmware/update/update_sender.hpp>
 
-#include "deploy_sender.hpp"
 #include "cli_errors.hpp"
 #include "export/binary_file.hpp"
 #include "cdcr/linux/socketcan_bus.hpp"
@@ -49,7 +49,9 @@ std::int64_t now_ms() {
       .count();
 }
 
-class Link {
+// The SocketCAN bus behind a queue: a frame the socket has no room for
+// waits for the next flush() instead of being dropped.
+class Link final : public hal::CanBus {
  public:
   explicit Link(const std::string& interface_name) {
     std::string error;
@@ -61,7 +63,6 @@ class Link {
   void flush() {
     while (!pending_.empty() && bus_.send(pending_.front()) == hal::CanStatus::ok) pending_.pop_front();
   }
-  void queue(const std::vector<hal::CanFrame>& frames) { pending_.insert(pending_.end(), frames.begin(), frames.end()); }
   bool idle() const { return pending_.empty(); }
   bool receive(protocol::UpdateReport& report, hal::CanFrame& frame) {
     while (bus_.receive(frame) == hal::CanStatus::ok) {
@@ -69,6 +70,16 @@ class Link {
     }
     return false;
   }
+
+  hal::CanStatus send(const hal::CanFrame& frame) override {
+    pending_.push_back(frame);
+    return hal::CanStatus::ok;
+  }
+  hal::CanStatus receive(hal::CanFrame& frame) override { return bus_.receive(frame); }
+  bool set_filters(const hal::CanFilter* filters, std::size_t count) override {
+    return bus_.set_filters(filters, count);
+  }
+  hal::CanErrorCounters error_counters() const override { return bus_.error_counters(); }
 
  private:
   linux_host::SocketCanBus bus_;
@@ -88,7 +99,7 @@ void draw_progress(std::uint32_t done, std::uint32_t total) {
 protocol::UpdateReport command(Link& link, protocol::UpdateCommand which, double timeout_s) {
   hal::CanFrame frame;
   protocol::encode(protocol::UpdateCommandFrame{which, 0, 0}, frame);
-  link.queue({frame});
+  link.send(frame);
   const std::int64_t deadline = now_ms() + static_cast<std::int64_t>(timeout_s * 1000);
   protocol::UpdateReport report;
   while (now_ms() < deadline) {
@@ -133,20 +144,15 @@ CommandOutput run_deploy(const DeployCommandOptions& options) {
   std::vector<std::uint8_t> image = exporting::read_binary_file(options.image_path);
   if (image.empty()) throw InputError(options.image_path + ": empty file");
   if (image.size() > 0xFFFFFF) throw InputError(options.image_path + ": larger than a transfer can carry (16 MiB)");
-  deploy::UpdateSender sender(std::move(image));
-  std::vector<hal::CanFrame> out;
-  sender.start(out);
-  link.queue(out);
+  firmware::UpdateSender sender(image.data(), static_cast<std::uint32_t>(image.size()));
+  sender.start(link, now_ms());
   std::int64_t last_progress_ms = now_ms();
   std::uint32_t last_acknowledged = 0;
   const std::int64_t started_ms = now_ms();
-  hal::CanFrame frame;
-  protocol::UpdateReport report;
-  while (sender.outcome() == deploy::UpdateSender::Outcome::running) {
-    out.clear();
-    while (link.receive(report, frame)) sender.on_report(frame, now_ms(), out);
-    if (link.idle()) sender.pump(now_ms(), out, 9 * firmware::kUpdateWindowBlocks);
-    link.queue(out);
+  while (sender.outcome() == firmware::UpdateSender::Outcome::running) {
+    sender.receive_reports(link, now_ms());
+    // A window's worth of blocks, less one frame: room for a COMMIT.
+    if (link.idle()) sender.pump(now_ms(), link, firmware::UpdateSender::kFramesPerBlock * firmware::kUpdateWindowBlocks - 1);
     link.flush();
     if (sender.acknowledged_blocks() != last_acknowledged) {
       last_acknowledged = sender.acknowledged_blocks();
@@ -161,7 +167,7 @@ CommandOutput run_deploy(const DeployCommandOptions& options) {
     std::this_thread::sleep_for(std::chrono::microseconds(200));
   }
   if (!options.quiet) std::fprintf(stderr, "\n");
-  if (sender.outcome() == deploy::UpdateSender::Outcome::refused) {
+  if (sender.outcome() == firmware::UpdateSender::Outcome::refused) {
     throw InputError("the runtime refused " + options.image_path + ": " + reason_text(sender.refusal()));
   }
   const double seconds = double(now_ms() - started_ms) * 1e-3;

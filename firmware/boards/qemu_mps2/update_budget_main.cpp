@@ -21,6 +21,7 @@
 #include <cdcr/cortexm/semihosting.hpp>
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/firmware/sha256.hpp>
+#include <cdcr/firmware/update/update_sender.hpp>
 #include <cdcr/model/crc32.hpp>
 
 #include "board.hpp"
@@ -100,123 +101,24 @@ float uniform(float lo, float hi) {
 int segments = 0;
 float drive_lengths_mm[firmware::kMaxSegments][4];
 
-// The host's side of the transfer (as tools/cdcr/deploy_sender.hpp, without
-// its heap): go-back-N over the window the last report granted.
-class Sender {
+// The host's side of the mailbox: what the sender sends is delivered to
+// the runtime; the runtime's reports reach the sender through exchange().
+class HostSide final : public cdcr::hal::CanBus {
  public:
-  void begin(const std::uint8_t* image, std::uint32_t size) {
-    image_ = image;
-    size_ = size;
-    firmware::sha256(image, size, digest_);
-    transfer_id_ = static_cast<std::uint16_t>(digest_[0] | (digest_[1] << 8));
-    total_ = (size + protocol::kUpdateBlockBytes - 1) / protocol::kUpdateBlockBytes;
-    next_ = base_ = window_ = 0;
-    acknowledged_ = 0;
-    commit_sent_ = committed_ = refused_ = false;
-    silent_cycles_ = 0;
-    start();
-  }
-  bool committed() const { return committed_; }
-  bool refused() const { return refused_; }
-
-  void on_report(const cdcr::hal::CanFrame& frame) {
-    protocol::UpdateReport report;
-    if (protocol::decode(frame, report) != protocol::DecodeStatus::ok) return;
-    silent_cycles_ = 0;
-    switch (report.reason) {
-      case protocol::UpdateReason::none:
-      case protocol::UpdateReason::duplicate:
-        break;
-      case protocol::UpdateReason::corrupted:
-      case protocol::UpdateReason::out_of_order:
-      case protocol::UpdateReason::missing_block:
-        next_ = report.next_block;
-        break;
-      default:
-        refused_ = true;
-        return;
-    }
-    if (report.state == protocol::UpdateState::committed) {
-      committed_ = true;
-      return;
-    }
-    if (report.state != protocol::UpdateState::receiving) return;
-    acknowledged_ = std::max<std::uint32_t>(acknowledged_, report.next_block);
-    base_ = report.next_block;
-    window_ = report.window;
-    if (next_ < base_) next_ = base_;
-    if (acknowledged_ == total_ && !commit_sent_) {
-      protocol::UpdateCommandFrame command;
-      command.command = protocol::UpdateCommand::commit;
-      command.transfer_id = transfer_id_;
-      send(command);
-      commit_sent_ = true;
-    }
-  }
-
-  // The blocks the window allows, at most `frames` frames this cycle.
-  void pump(int frames) {
-    if (committed_ || refused_) return;
-    if (++silent_cycles_ > 200) {
-      // Silence: from the last acknowledged block again.
-      silent_cycles_ = 0;
-      commit_sent_ = false;
-      next_ = acknowledged_;
-      start();
-      return;
-    }
-    constexpr int kFramesPerBlock = 1 + protocol::kUpdateDataFramesPerBlock;
-    while (next_ < total_ && next_ < base_ + window_ && frames >= kFramesPerBlock) {
-      send_block(next_++);
-      frames -= kFramesPerBlock;
-    }
-  }
-
- private:
-  template <typename Message>
-  static void send(const Message& message) {
-    cdcr::hal::CanFrame frame;
-    protocol::encode(message, frame);
+  cdcr::hal::CanStatus send(const cdcr::hal::CanFrame& frame) override {
     board.can.deliver(frame);
+    return cdcr::hal::CanStatus::ok;
   }
-  void start() {
-    for (std::uint8_t part = 0; part < 8; ++part) {
-      protocol::UpdateDigest digest;
-      digest.part = part;
-      std::memcpy(digest.bytes, digest_ + 4 * part, 4);
-      send(digest);
-    }
-    protocol::UpdateCommandFrame command;
-    command.command = protocol::UpdateCommand::start;
-    command.transfer_id = transfer_id_;
-    command.image_size = size_;
-    send(command);
-  }
-  void send_block(std::uint32_t block) {
-    const std::uint32_t at = block * protocol::kUpdateBlockBytes;
-    const std::uint32_t length = std::min<std::uint32_t>(protocol::kUpdateBlockBytes, size_ - at);
-    protocol::UpdateBlock header;
-    header.block = static_cast<std::uint16_t>(block);
-    header.length = static_cast<std::uint8_t>(length);
-    header.crc = protocol::update_block_crc(header.block, image_ + at, length);
-    send(header);
-    for (std::uint32_t offset = 0; offset < length; offset += 8) {
-      protocol::UpdateData data;
-      std::memcpy(data.bytes, image_ + at + offset, std::min<std::uint32_t>(8, length - offset));
-      send(data);
-    }
-  }
-
-  const std::uint8_t* image_ = nullptr;
-  std::uint32_t size_ = 0;
-  std::uint8_t digest_[firmware::kSha256Bytes] = {};
-  std::uint16_t transfer_id_ = 0;
-  std::uint32_t total_ = 0, next_ = 0, base_ = 0, window_ = 0, acknowledged_ = 0;
-  bool commit_sent_ = false, committed_ = false, refused_ = false;
-  int silent_cycles_ = 0;
+  cdcr::hal::CanStatus receive(cdcr::hal::CanFrame&) override { return cdcr::hal::CanStatus::empty; }
+  bool set_filters(const cdcr::hal::CanFilter*, std::size_t) override { return true; }
+  cdcr::hal::CanErrorCounters error_counters() const override { return {}; }
 };
 
-Sender sender;
+HostSide host;
+std::uint32_t cycles_run = 0;
+// The transfer under way (firmware/update/update_sender.hpp, as `cdcr
+// deploy` sends), silent for 200 cycles before it asks again.
+firmware::UpdateSender* sender = nullptr;
 
 // The ideal drives: the last setpoint of each segment, reported every
 // cycle; the runtime's reports go to the sender.
@@ -224,7 +126,7 @@ void exchange() {
   cdcr::hal::CanFrame frame;
   while (board.can.take_transmitted(frame)) {
     if (protocol::update_report::kMessage.carries(frame.id)) {
-      sender.on_report(frame);
+      if (sender != nullptr) sender->on_report(frame, cycles_run, host);
       continue;
     }
     protocol::CableSetpoint setpoint;
@@ -266,7 +168,6 @@ const char* const kPhaseNames[kPhases] = {"transfer", "commit (hash, CRC, parse,
 std::uint32_t worst_of[kPhases] = {};
 std::uint32_t cycles_of[kPhases] = {};
 std::uint32_t worst = 0;
-std::uint32_t cycles_run = 0;
 std::uint32_t over_budget = 0;
 std::uint32_t poses_missing = 0;
 std::uint32_t switches = 0;
@@ -276,7 +177,7 @@ std::uint32_t switches = 0;
 void cycle() {
   exchange();
   if (cycles_run % 40 == 0) deliver_target();
-  sender.pump(32 - segments - 3);
+  if (sender != nullptr) sender->pump(cycles_run, host, 32 - segments - 3);
   const firmware::ModelUpdate& update = runtime.model_update();
   const protocol::UpdateState before = update.state();
   const int slot_before = update.active_slot();
@@ -316,10 +217,17 @@ void cycle() {
 
 // Cycles until the sender is done (committed and switched) or refused.
 bool transfer(const std::uint8_t* image, std::uint32_t size, int expected_slot) {
-  sender.begin(image, size);
-  for (int i = 0; i < 20'000 && !sender.committed() && !sender.refused(); ++i) cycle();
+  firmware::UpdateSender update(image, size);
+  // pump() restarts after resend_after cycles without a report, and it
+  // runs once a cycle: the 201st silent cycle.
+  update.resend_after = 199;
+  sender = &update;
+  update.start(host, cycles_run);
+  for (int i = 0; i < 20'000 && update.outcome() == firmware::UpdateSender::Outcome::running; ++i) cycle();
   for (int i = 0; i < 20; ++i) cycle();
-  const bool ok = sender.committed() && runtime.model_update().active_slot() == expected_slot &&
+  sender = nullptr;
+  const bool ok = update.outcome() == firmware::UpdateSender::Outcome::committed &&
+                  runtime.model_update().active_slot() == expected_slot &&
                   runtime.state() == firmware::RuntimeState::run;
   console::console_write(ok ? "update into slot " : "FAIL: update into slot ");
   console::console_write_int(expected_slot);

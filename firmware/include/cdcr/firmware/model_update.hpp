@@ -1,11 +1,19 @@
 #pragma once
 // A new model image over CAN into the inactive flash slot, while the runtime
 // keeps running the active one (the protocol: protocol/messages.hpp, "Model
-// updates"; the slots: model_slots.hpp).
+// updates"; the slots: model_slots.hpp). ModelUpdate is the coordinator the
+// runtime calls; the work is in three parts under update/:
+//   update_receiver.hpp  the digest, the blocks and their window, in RAM
+//   slot_writer.hpp      the flash operations, the commit and the revoke,
+//                        and which slot runs at boot
+//   image_verifier.hpp   the hash, the image scan, the parse, the geometry
 //
 //   START (after the 8 digest frames)  erase the slot's metadata sector,
 //                 write the transfer record, erase the image sectors;
 //                 or resume the transfer the record in flash describes.
+//                 A START without all of its digest goes on with the
+//                 transfer under way if it names it, and is otherwise
+//                 answered NO_TRANSFER: the sender sends both again.
 //   blocks        go-back-N with a window of kUpdateWindowBlocks: each block
 //                 is checked (number, length, CRC), held in RAM, programmed,
 //                 then its progress byte; UPDATE_REPORT acknowledges the
@@ -30,6 +38,9 @@
 #include "cdcr/firmware/capacity.hpp"
 #include "cdcr/firmware/model_slots.hpp"
 #include "cdcr/firmware/protocol.hpp"
+#include "cdcr/firmware/update/image_verifier.hpp"
+#include "cdcr/firmware/update/slot_writer.hpp"
+#include "cdcr/firmware/update/update_receiver.hpp"
 #include "cdcr/hal/can_bus.hpp"
 #include "cdcr/hal/flash.hpp"
 #include "cdcr/model/flash_image.hpp"
@@ -46,13 +57,13 @@ class ModelUpdate {
   ModelUpdate& operator=(const ModelUpdate&) = delete;
 
   // A flash large enough for two slots, programs of a whole block.
-  bool enabled() const { return enabled_; }
+  bool enabled() const { return writer_.usable(); }
 
   // Boot: the committed images, newest first (hashed once, here).
   void boot();
   bool booted() const { return booted_; }
-  int candidate_count() const { return candidate_count_; }
-  const SlotImage& candidate(int index) const { return candidates_[index]; }
+  int candidate_count() const { return writer_.candidate_count(); }
+  const SlotImage& candidate(int index) const { return writer_.candidate(index); }
   // The runtime tells which candidate it runs (-1: the model storage's image).
   void set_active(int candidate_index);
 
@@ -70,9 +81,9 @@ class ModelUpdate {
 
   protocol::UpdateState state() const;
   protocol::UpdateReason last_reason() const { return last_reason_; }
-  int active_slot() const { return active_slot_; }  // -1: model storage
-  std::uint32_t active_sequence() const { return active_sequence_; }
-  std::uint32_t blocks_in_flash() const { return durable_; }
+  int active_slot() const { return writer_.active_slot(); }  // -1: model storage
+  std::uint32_t active_sequence() const { return writer_.active_sequence(); }
+  std::uint32_t blocks_in_flash() const { return receiver_.durable(); }
 
  private:
   enum class Phase : std::uint8_t {
@@ -93,65 +104,29 @@ class ModelUpdate {
   bool transferring() const;
   void start_transfer(const protocol::UpdateCommandFrame& command);
   void handle_command(const protocol::UpdateCommandFrame& command);
-  void handle_block(const hal::CanFrame& frame);
-  void handle_data(const hal::CanFrame& frame);
+  void answer(const UpdateReceiver::Answer& answer);
   void operation_done();
   void start_work(const Geometry& geometry, std::uint32_t units);
-  void start_operation(hal::FlashStatus started);
-  void finish_verification(const Geometry& geometry);
+  void started(hal::FlashStatus status);
   void fail(protocol::UpdateReason reason);
   void report(protocol::UpdateReason reason);
-  std::uint32_t block_length(std::uint32_t block) const;
-  std::uint32_t image_sectors() const;
 
-  hal::Flash* flash_;
   hal::CanBus& can_;
-  bool enabled_ = false;
+  UpdateReceiver receiver_;
+  SlotWriter writer_;
+  ImageVerifier verifier_;
   bool booted_ = false;
-  SlotImage candidates_[kModelSlots];
-  int candidate_count_ = 0;
-  int active_slot_ = -1;
-  std::uint32_t active_sequence_ = 0;
 
   Phase phase_ = Phase::idle;
   protocol::UpdateReason last_reason_ = protocol::UpdateReason::none;
-  bool operation_running_ = false;
   std::uint32_t last_activity_cycle_ = 0;
   std::uint32_t frames_ = 0;  // update frames since the last step
   std::uint32_t cycle_ = 0;
-
-  // The transfer.
-  int target_slot_ = 0;
-  SlotGeometry target_;
-  TransferRecord record_;
-  bool record_in_flash_ = false;  // record_ describes the target slot's record
-  std::uint32_t total_blocks_ = 0;
-  std::uint32_t erase_sector_ = 0;  // within the slot
-  std::uint32_t received_ = 0;      // blocks received (in RAM or flash)
-  std::uint32_t durable_ = 0;       // blocks in flash, progress byte included
-  std::uint32_t acknowledged_ = 0;
-  std::uint8_t program_stage_ = 0;  // 0 none, 1 data, 2 progress byte
-  std::uint8_t blocks_[kUpdateWindowBlocks][protocol::kUpdateBlockBytes] = {};
-
-  // The block whose data frames are arriving.
-  bool incoming_ = false;
-  std::uint16_t incoming_block_ = 0;
-  std::uint8_t incoming_length_ = 0;
-  std::uint32_t incoming_crc_ = 0;
-  std::uint8_t incoming_frames_ = 0;
-
-  std::uint8_t announced_digest_[kSha256Bytes] = {};
-  std::uint8_t digest_parts_ = 0;  // bit k: part k received
-
-  // Verification, and what is written at the commit point.
-  Sha256 hash_;
-  std::uint32_t hashed_ = 0;
   std::uint32_t hash_units_spent_ = 0;
-  model::ImageScan scan_;  // parse_image()'s whole-image checks, beside the hash
-  std::uint32_t committed_sequence_ = 0;
+
+  // A rollback, and the switch the runtime makes after a commit or one.
   int rollback_slot_ = -1;
   SlotHeader rollback_header_;
-  std::uint8_t staged_[kSlotRecordBytes] = {};
   bool switch_pending_ = false;
   int switch_slot_ = -1;
   int revoke_slot_ = -1;
