@@ -16,7 +16,7 @@
 
 #include <cdcr/firmware/protocol.hpp>
 
-#include "linux/socketcan_bus.hpp"
+#include "cdcr/linux/socketcan_bus.hpp"
 
 namespace {
 
