@@ -20,8 +20,9 @@
 #include <cdcr/firmware/runtime.hpp>
 
 #include "board.hpp"
-#include "instruction_count.hpp"
 #include "golden_check.hpp"
+#include "instruction_count.hpp"
+#include "workload.hpp"
 
 namespace {
 
@@ -39,12 +40,7 @@ firmware::Correction correction;
 
 cdcr::boards::mps2::InstructionCounter counter{board.timer};
 
-__attribute__((noinline)) void run_cycle_opaque(const cdcr::hal::TimerTick& tick) { runtime.run_cycle(tick); }
-
-std::uint32_t counted_cycle() {
-  const cdcr::hal::TimerTick tick{board.timer.now_ns(), 0};
-  return counter.instructions([&] { run_cycle_opaque(tick); });
-}
+std::uint32_t counted_cycle() { return cdcr::qemu_programs::counted_cycle(counter, board, runtime); }
 
 // Instructions of one call of work(), as counted_cycle() counts a cycle.
 template <typename Work>
@@ -52,66 +48,25 @@ std::uint32_t counted(Work&& work) {
   return counter.instructions(work);
 }
 
-// xorshift32: the same workload on every run and both boards.
-std::uint32_t rng_state = 0x2545F491u;
-float uniform(float lo, float hi) {
-  rng_state ^= rng_state << 13;
-  rng_state ^= rng_state >> 17;
-  rng_state ^= rng_state << 5;
-  return lo + (hi - lo) * float(rng_state >> 8) * (1.0f / 16777216.0f);
-}
+// The same workload on every run and both boards (workload.hpp).
+cdcr::qemu_programs::Random random_numbers{0x2545F491u};
+cdcr::qemu_programs::IdealDrives drives;
+int& segments = drives.segments;
+int& silent_segment = drives.silent_segment;
 
-// The ideal drives: the last setpoint of each segment, reported every cycle.
-float drive_lengths_mm[firmware::kMaxSegments][4];
-int segments = 0;
-int silent_segment = -1;
-
-void exchange_with_drives() {
-  cdcr::hal::CanFrame frame;
-  while (board.can.take_transmitted(frame)) {
-    protocol::CableSetpoint setpoint;
-    if (protocol::decode(frame, setpoint) != protocol::DecodeStatus::ok) continue;
-    for (int k = 0; k < 4; ++k) drive_lengths_mm[setpoint.segment][k] = float(setpoint.lengths_mm[k]);
-  }
-  for (int s = 0; s < segments; ++s) {
-    if (s == silent_segment) continue;
-    protocol::CableFeedback feedback{s, {drive_lengths_mm[s][0], drive_lengths_mm[s][1], drive_lengths_mm[s][2],
-                                         drive_lengths_mm[s][3]}};
-    if (protocol::encode(feedback, frame)) board.can.deliver(frame);
-  }
-}
+void exchange_with_drives() { drives.exchange(board); }
 
 void deliver_target(const model::Pose<float>& target, protocol::TargetMode mode, bool tracking,
                     std::uint8_t sequence, bool refuse_extrapolating = false) {
-  cdcr::hal::CanFrame frame;
-  if (mode == protocol::TargetMode::pose) {
-    Eigen::Quaternion<float> q(target.rotation);
-    q.normalize();
-    protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, frame);
-    board.can.deliver(frame);
-  }
-  protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
-  board.can.deliver(frame);
-  protocol::TargetPositionZ commit{target.position_mm.z(), mode, tracking, sequence};
-  commit.refuse_extrapolating = refuse_extrapolating;
-  protocol::encode(commit, frame);
-  board.can.deliver(frame);
+  cdcr::qemu_programs::deliver_target(board, target, mode, tracking, sequence, refuse_extrapolating);
 }
 
-// Where the compensated model puts the tip for the given joints.
 model::Pose<float> compensated_tip(const model::JointVector<float>& joints) {
-  const model::JointVector<float> bend = model::bend_from_joints(joints);
-  return model::exp(correction.predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
+  return cdcr::qemu_programs::compensated_tip(correction, runtime.geometry(), joints);
 }
 
-// ... and for random joints.
 model::Pose<float> reachable_target(float theta_max_rad) {
-  model::JointVector<float> joints(2 * segments);
-  for (int s = 0; s < segments; ++s) {
-    joints[2 * s] = uniform(-3.14159f, 3.14159f);
-    joints[2 * s + 1] = uniform(0.0f, std::min(theta_max_rad, runtime.geometry().segments[s].theta_max_rad));
-  }
-  return compensated_tip(joints);
+  return cdcr::qemu_programs::reachable_target(random_numbers, correction, runtime.geometry(), theta_max_rad);
 }
 
 // Latencies in cycles, per kind of request.
@@ -326,7 +281,7 @@ int main() {
 
   // The drives start where golden case 0 has them.
   for (int s = 0; s < segments; ++s) {
-    for (int k = 0; k < 4; ++k) drive_lengths_mm[s][k] = float(cdcr::qemu_golden::kCablesMm[0][4 * s + k]);
+    for (int k = 0; k < 4; ++k) drives.lengths_mm[s][k] = float(cdcr::qemu_golden::kCablesMm[0][4 * s + k]);
   }
   // Forward-only cycles.
   for (int i = 0; i < 100; ++i) cycle();
@@ -434,13 +389,7 @@ int main() {
   console::console_write("cycle overhead (beyond the units spent): at most ");
   console::console_write_int(worst_unaccounted);
   console::console_write(" instructions\n");
-  console::console_write("worst cycle: ");
-  console::console_write_int(static_cast<std::int32_t>(worst));
-  console::console_write(" instructions over ");
-  console::console_write_int(static_cast<std::int32_t>(cycles_run));
-  console::console_write(" cycles (budget ");
-  console::console_write_int(static_cast<std::int32_t>(kBudgetInstructions));
-  console::console_write(")\n");
+  cdcr::qemu_programs::report_worst_cycle(worst, cycles_run);
   bool ok = true;
   if (over_budget > 0) {
     console::console_write("FAIL: cycles over budget: ");

@@ -25,8 +25,9 @@
 #include <cdcr/model/crc32.hpp>
 
 #include "board.hpp"
-#include "instruction_count.hpp"
 #include "golden_check.hpp"
+#include "instruction_count.hpp"
+#include "workload.hpp"
 
 namespace {
 
@@ -56,12 +57,7 @@ firmware::Correction correction;
 
 cdcr::boards::mps2::InstructionCounter counter{board.timer};
 
-__attribute__((noinline)) void run_cycle_opaque(const cdcr::hal::TimerTick& tick) { runtime.run_cycle(tick); }
-
-std::uint32_t counted_cycle() {
-  const cdcr::hal::TimerTick tick{board.timer.now_ns(), 0};
-  return counter.instructions([&] { run_cycle_opaque(tick); });
-}
+std::uint32_t counted_cycle() { return cdcr::qemu_programs::counted_cycle(counter, board, runtime); }
 
 // Instructions of one call of work(), as counted_cycle() counts a cycle.
 template <typename Work>
@@ -89,17 +85,10 @@ void report_update_costs(const std::uint8_t* image, std::uint32_t size) {
   console::console_write(" units)\n");
 }
 
-// xorshift32: the same workload on every run and both boards.
-std::uint32_t rng_state = 0x9E3779B9u;
-float uniform(float lo, float hi) {
-  rng_state ^= rng_state << 13;
-  rng_state ^= rng_state >> 17;
-  rng_state ^= rng_state << 5;
-  return lo + (hi - lo) * float(rng_state >> 8) * (1.0f / 16777216.0f);
-}
-
-int segments = 0;
-float drive_lengths_mm[firmware::kMaxSegments][4];
+// The same workload on every run and both boards (workload.hpp).
+cdcr::qemu_programs::Random random_numbers{0x9E3779B9u};
+cdcr::qemu_programs::IdealDrives drives;
+int& segments = drives.segments;
 
 // The host's side of the mailbox: what the sender sends is delivered to
 // the runtime; the runtime's reports reach the sender through exchange().
@@ -120,47 +109,21 @@ std::uint32_t cycles_run = 0;
 // deploy` sends), silent for 200 cycles before it asks again.
 firmware::UpdateSender* sender = nullptr;
 
-// The ideal drives: the last setpoint of each segment, reported every
-// cycle; the runtime's reports go to the sender.
+// The ideal drives, and the runtime's reports to the sender.
 void exchange() {
-  cdcr::hal::CanFrame frame;
-  while (board.can.take_transmitted(frame)) {
-    if (protocol::update_report::kMessage.carries(frame.id)) {
-      if (sender != nullptr) sender->on_report(frame, cycles_run, host);
-      continue;
+  drives.exchange(board, [](const cdcr::hal::CanFrame& frame) {
+    if (sender != nullptr && protocol::update_report::kMessage.carries(frame.id)) {
+      sender->on_report(frame, cycles_run, host);
     }
-    protocol::CableSetpoint setpoint;
-    if (protocol::decode(frame, setpoint) != protocol::DecodeStatus::ok) continue;
-    for (int k = 0; k < 4; ++k) drive_lengths_mm[setpoint.segment][k] = float(setpoint.lengths_mm[k]);
-  }
-  for (int s = 0; s < segments; ++s) {
-    protocol::CableFeedback feedback{s, {drive_lengths_mm[s][0], drive_lengths_mm[s][1], drive_lengths_mm[s][2],
-                                         drive_lengths_mm[s][3]}};
-    if (protocol::encode(feedback, frame)) board.can.deliver(frame);
-  }
+  });
 }
 
 // A pose target at random joints, through the runtime's compensated model.
 std::uint8_t next_sequence = 0;
 void deliver_target() {
-  model::JointVector<float> joints(2 * segments);
-  for (int s = 0; s < segments; ++s) {
-    joints[2 * s] = uniform(-3.14159f, 3.14159f);
-    joints[2 * s + 1] = uniform(0.0f, std::min(0.2f, runtime.geometry().segments[s].theta_max_rad));
-  }
-  const model::JointVector<float> bend = model::bend_from_joints(joints);
   const model::Pose<float> target =
-      model::exp(correction.predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
-  Eigen::Quaternion<float> q(target.rotation);
-  q.normalize();
-  cdcr::hal::CanFrame frame;
-  protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, frame);
-  board.can.deliver(frame);
-  protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
-  board.can.deliver(frame);
-  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), protocol::TargetMode::pose, false, next_sequence++},
-                   frame);
-  board.can.deliver(frame);
+      cdcr::qemu_programs::reachable_target(random_numbers, correction, runtime.geometry(), 0.2f);
+  cdcr::qemu_programs::deliver_target(board, target, protocol::TargetMode::pose, false, next_sequence++);
 }
 
 enum Phase { kTransfer, kCommit, kSwitch, kOther, kPhases };
@@ -258,7 +221,7 @@ int main() {
   segments = runtime.geometry().segment_count;
   counter.calibrate();
   for (int s = 0; s < segments; ++s) {
-    for (int k = 0; k < 4; ++k) drive_lengths_mm[s][k] = float(cdcr::qemu_golden::kCablesMm[0][4 * s + k]);
+    for (int k = 0; k < 4; ++k) drives.lengths_mm[s][k] = float(cdcr::qemu_golden::kCablesMm[0][4 * s + k]);
   }
   const std::uint32_t size = static_cast<std::uint32_t>(region.size_bytes);
   console::console_write("image: ");
@@ -301,13 +264,7 @@ int main() {
     console::console_write_int(static_cast<std::int32_t>(cycles_of[p]));
     console::console_write(" cycles\n");
   }
-  console::console_write("worst cycle: ");
-  console::console_write_int(static_cast<std::int32_t>(worst));
-  console::console_write(" instructions over ");
-  console::console_write_int(static_cast<std::int32_t>(cycles_run));
-  console::console_write(" cycles (budget ");
-  console::console_write_int(static_cast<std::int32_t>(kBudgetInstructions));
-  console::console_write(")\n");
+  cdcr::qemu_programs::report_worst_cycle(worst, cycles_run);
   if (over_budget > 0) {
     console::console_write("FAIL: cycles over budget: ");
     console::console_write_int(static_cast<std::int32_t>(over_budget));
