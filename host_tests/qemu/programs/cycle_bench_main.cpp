@@ -24,8 +24,9 @@
 #include <cdcr/model/work_costs.hpp>
 
 #include "board.hpp"
-#include "instruction_count.hpp"
 #include "golden_check.hpp"
+#include "instruction_count.hpp"
+#include "workload.hpp"
 
 namespace {
 
@@ -95,17 +96,7 @@ model::Pose<float> golden_pose(int c) {
 
 // The three target frames of a pose target, as a planner sends them.
 void deliver_pose_target(const model::Pose<float>& target, std::uint8_t sequence) {
-  namespace protocol = cdcr::firmware::protocol;
-  Eigen::Quaternion<float> q(target.rotation);
-  q.normalize();
-  cdcr::hal::CanFrame frame;
-  protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, frame);
-  board.can.deliver(frame);
-  protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
-  board.can.deliver(frame);
-  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), protocol::TargetMode::pose, false, sequence},
-                   frame);
-  board.can.deliver(frame);
+  cdcr::qemu_programs::deliver_target(board, target, cdcr::firmware::protocol::TargetMode::pose, false, sequence);
 }
 
 void drain_transmitted() {
@@ -124,10 +115,8 @@ int main() {
     console::console_write("FAIL: the runtime did not boot into RUN\n");
     return 1;
   }
-  const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
   model::ImageView image{};
-  if (model::parse_image(region.data, region.size_bytes, image, model::ImageCapacity{}) != model::ImageStatus::ok ||
-      correction.bind(image) != model::Status::ok) {
+  if (!cdcr::qemu_programs::bind_board_image(board, correction, image)) {
     console::console_write("FAIL: cannot bind the image\n");
     return 1;
   }

@@ -263,10 +263,8 @@ int main() {
     console::console_write("FAIL: the runtime did not boot into RUN\n");
     return 1;
   }
-  const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
   model::ImageView image{};
-  if (model::parse_image(region.data, region.size_bytes, image, model::ImageCapacity{}) != model::ImageStatus::ok ||
-      correction.bind(image) != model::Status::ok) {
+  if (!cdcr::qemu_programs::bind_board_image(board, correction, image)) {
     console::console_write("FAIL: cannot bind the image\n");
     return 1;
   }

@@ -213,8 +213,7 @@ int main() {
   }
   const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
   model::ImageView image{};
-  if (model::parse_image(region.data, region.size_bytes, image, model::ImageCapacity{}) != model::ImageStatus::ok ||
-      correction.bind(image) != model::Status::ok || region.size_bytes > sizeof(second_image)) {
+  if (!cdcr::qemu_programs::bind_board_image(board, correction, image) || region.size_bytes > sizeof(second_image)) {
     console::console_write("FAIL: cannot bind the image\n");
     return 1;
   }

@@ -115,6 +115,14 @@ inline std::uint32_t counted_cycle(const boards::mps2::InstructionCounter& count
   return counter.instructions([&] { run_cycle_opaque(runtime, tick); });
 }
 
+// The board's model image parsed and bound to `correction` (what the runtime
+// itself bound at init), for the workload to make its targets with.
+inline bool bind_board_image(boards::mps2::Board& board, firmware::Correction& correction, model::ImageView& image) {
+  const hal::MemoryRegion region = board.model_storage.model_region();
+  return model::parse_image(region.data, region.size_bytes, image, model::ImageCapacity{}) == model::ImageStatus::ok &&
+         correction.bind(image) == model::Status::ok;
+}
+
 // `worst cycle: N instructions over C cycles (budget B)`, the line the
 // budget tests and tools/bench read.
 inline void report_worst_cycle(std::uint32_t worst, std::uint32_t cycles) {
