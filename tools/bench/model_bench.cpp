@@ -208,26 +208,6 @@ void run_ik(benchmark::State& state) {
   report_failures(state, failures);
 }
 
-template <typename S>
-void ik_pose_warm(benchmark::State& state) {
-  run_ik<S, Target::pose, Start::warm>(state);
-}
-
-template <typename S>
-void ik_pose_cold(benchmark::State& state) {
-  run_ik<S, Target::pose, Start::cold>(state);
-}
-
-template <typename S>
-void ik_position_warm(benchmark::State& state) {
-  run_ik<S, Target::position, Start::warm>(state);
-}
-
-template <typename S>
-void ik_position_cold(benchmark::State& state) {
-  run_ik<S, Target::position, Start::cold>(state);
-}
-
 BENCHMARK(baseline_mat4_chain);
 BENCHMARK_TEMPLATE(fk_from_cables, float);
 BENCHMARK_TEMPLATE(fk_from_cables, double);
@@ -239,14 +219,15 @@ BENCHMARK_TEMPLATE(se3_log, float);
 BENCHMARK_TEMPLATE(se3_log, double);
 BENCHMARK_TEMPLATE(jacobian_bend, float);
 BENCHMARK_TEMPLATE(jacobian_bend, double);
-BENCHMARK_TEMPLATE(ik_pose_warm, float);
-BENCHMARK_TEMPLATE(ik_pose_warm, double);
-BENCHMARK_TEMPLATE(ik_pose_cold, float);
-BENCHMARK_TEMPLATE(ik_pose_cold, double);
-BENCHMARK_TEMPLATE(ik_position_warm, float);
-BENCHMARK_TEMPLATE(ik_position_warm, double);
-BENCHMARK_TEMPLATE(ik_position_cold, float);
-BENCHMARK_TEMPLATE(ik_position_cold, double);
+// Named ik_<target>_<start><scalar>.
+BENCHMARK_TEMPLATE(run_ik, float, Target::pose, Start::warm)->Name("ik_pose_warm<float>");
+BENCHMARK_TEMPLATE(run_ik, double, Target::pose, Start::warm)->Name("ik_pose_warm<double>");
+BENCHMARK_TEMPLATE(run_ik, float, Target::pose, Start::cold)->Name("ik_pose_cold<float>");
+BENCHMARK_TEMPLATE(run_ik, double, Target::pose, Start::cold)->Name("ik_pose_cold<double>");
+BENCHMARK_TEMPLATE(run_ik, float, Target::position, Start::warm)->Name("ik_position_warm<float>");
+BENCHMARK_TEMPLATE(run_ik, double, Target::position, Start::warm)->Name("ik_position_warm<double>");
+BENCHMARK_TEMPLATE(run_ik, float, Target::position, Start::cold)->Name("ik_position_cold<float>");
+BENCHMARK_TEMPLATE(run_ik, double, Target::position, Start::cold)->Name("ik_position_cold<double>");
 
 }  // namespace
 
