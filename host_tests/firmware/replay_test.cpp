@@ -19,17 +19,65 @@
 #include "train/evaluation.hpp"
 #include "train/predictive_variance.hpp"
 
+#include "../support/random_joints.hpp"
+
 namespace cdcr::firmware {
 namespace {
 
-TEST(RuntimeReplay, MatchesTheEvaluationsFirmwarePoses) {
-  training::TrainedModel trained = test_support::synthetic_trained_model();
-  // The variance factor holds one kernel for every output, as the trainer's.
+// The variance factor holds one kernel for every output, as the trainer's;
+// fitted on `points` of the model's inputs.
+void fit_variance(training::TrainedModel& trained, int points) {
   trained.signal_variance.setConstant(trained.signal_variance[0]);
   trained.noise_variance.setConstant(trained.noise_variance[0]);
-  trained.variance = training::fit_variance_factor(
-      trained, trained.inputs, training::variance_points(trained, trained.inputs, std::min(16, trained.training_points()), 1));
+  trained.variance = training::fit_variance_factor(trained, trained.inputs,
+                                                   training::variance_points(trained, trained.inputs, points, 1));
   trained.variance.extrapolation_variance = 0.5;
+}
+
+// `samples` rows of cables from joints drawn in alpha [-pi, pi] and theta
+// [0, 1.2] rad through `geometry`; with_payload: a payload in [0, 1] kg
+// after each row's cables.
+void random_cables(const model::RobotGeometry<double>& geometry, int samples, unsigned seed, bool with_payload,
+                   dataset::Dataset& data) {
+  data.segment_count = geometry.segment_count;
+  data.cables_mm.resize(samples, 4 * geometry.segment_count);
+  data.has_payload = with_payload;
+  if (with_payload) data.payload_kg.resize(samples);
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> alpha(-M_PI, M_PI), theta(0.0, 1.2), payload(0.0, 1.0);
+  for (int i = 0; i < samples; ++i) {
+    const model::JointVector<double> joints = test_support::random_joints(geometry.segment_count, rng, alpha, theta);
+    model::CableVector<double> cables;
+    ASSERT_EQ(model::cables_from_joints(joints, geometry, cables), model::Status::ok);
+    data.cables_mm.row(i) = cables.transpose();
+    if (with_payload) data.payload_kg[i] = payload(rng);
+  }
+}
+
+// The image and the cables, as the replay reads them, in `dir`: model.img
+// and cables.csv.
+void write_replay_inputs(const std::filesystem::path& dir, const std::vector<std::uint8_t>& image,
+                         const dataset::Dataset& data) {
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream out(dir / "model.img", std::ios::binary);
+    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
+  }
+  dataset::write_dataset_csv((dir / "cables.csv").string(), data);
+}
+
+int run_replay(const std::filesystem::path& dir, const std::string& image, const std::string& cables,
+               const std::string& extra = "") {
+  const std::string command = std::string("\"") + CDCR_RUNTIME_EXE + "\" --image \"" + (dir / image).string() +
+                              "\" --replay \"" + (dir / cables).string() + "\" --out \"" +
+                              (dir / "poses.csv").string() + "\"" + extra;
+  const int status = std::system(command.c_str());
+  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+TEST(RuntimeReplay, MatchesTheEvaluationsFirmwarePoses) {
+  training::TrainedModel trained = test_support::synthetic_trained_model();
+  fit_variance(trained, std::min(16, trained.training_points()));
   const std::vector<std::uint8_t> image = exporting::write_image(trained);
   model::ImageView view;
   ASSERT_EQ(model::parse_image(image.data(), image.size(), view), model::ImageStatus::ok);
@@ -37,33 +85,11 @@ TEST(RuntimeReplay, MatchesTheEvaluationsFirmwarePoses) {
   ASSERT_EQ(model::geometry_from_image(view, geometry), model::Status::ok);
 
   dataset::Dataset data;
-  data.segment_count = geometry.segment_count;
-  const int samples = 200;
-  data.cables_mm.resize(samples, 4 * geometry.segment_count);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> alpha(-M_PI, M_PI), theta(0.0, 1.2);
-  for (int i = 0; i < samples; ++i) {
-    model::JointVector<double> joints(2 * geometry.segment_count);
-    for (int s = 0; s < geometry.segment_count; ++s) {
-      joints[2 * s] = alpha(rng);
-      joints[2 * s + 1] = theta(rng);
-    }
-    model::CableVector<double> cables;
-    ASSERT_EQ(model::cables_from_joints(joints, geometry, cables), model::Status::ok);
-    data.cables_mm.row(i) = cables.transpose();
-  }
+  ASSERT_NO_FATAL_FAILURE(random_cables(geometry, 200, 3, false, data));
 
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay";
-  std::filesystem::create_directories(dir);
-  {
-    std::ofstream out(dir / "model.img", std::ios::binary);
-    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
-  }
-  dataset::write_dataset_csv((dir / "cables.csv").string(), data);
-  const std::string command = std::string("\"") + CDCR_RUNTIME_EXE + "\" --image \"" + (dir / "model.img").string() +
-                              "\" --replay \"" + (dir / "cables.csv").string() + "\" --out \"" +
-                              (dir / "poses.csv").string() + "\"";
-  ASSERT_EQ(std::system(command.c_str()), 0) << command;
+  write_replay_inputs(dir, image, data);
+  ASSERT_EQ(run_replay(dir, "model.img", "cables.csv"), 0);
 
   // The replay reads the cables back from the CSV, as cdcr eval does.
   const dataset::Dataset written = dataset::read_dataset_csv((dir / "cables.csv").string());
@@ -119,15 +145,6 @@ std::string replay_line(const training::FirmwareEstimate& e) {
   return line;
 }
 
-int run_replay(const std::filesystem::path& dir, const std::string& image, const std::string& cables,
-               const std::string& extra = "") {
-  const std::string command = std::string("\"") + CDCR_RUNTIME_EXE + "\" --image \"" + (dir / image).string() +
-                              "\" --replay \"" + (dir / cables).string() + "\" --out \"" +
-                              (dir / "poses.csv").string() + "\"" + extra;
-  const int status = std::system(command.c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
 // With a payload model and the payload beside the cables in each row, the
 // replay's output is eval's float32 path (training::firmware_estimates with
 // the rows' payloads), line for line and digit for digit; the payload moves
@@ -137,11 +154,7 @@ TEST(RuntimeReplay, WithThePayloadInEachRowEqualsTheEvaluationBitForBit) {
   options.training_points = 40;
   options.payload_input = true;
   training::TrainedModel trained = test_support::synthetic_trained_model(options);
-  trained.signal_variance.setConstant(trained.signal_variance[0]);
-  trained.noise_variance.setConstant(trained.noise_variance[0]);
-  trained.variance = training::fit_variance_factor(trained, trained.inputs,
-                                                   training::variance_points(trained, trained.inputs, 12, 1));
-  trained.variance.extrapolation_variance = 0.5;
+  fit_variance(trained, 12);
   const std::vector<std::uint8_t> image = exporting::write_image(trained);
   model::ImageView view;
   ASSERT_EQ(model::parse_image(image.data(), image.size(), view), model::ImageStatus::ok);
@@ -149,32 +162,11 @@ TEST(RuntimeReplay, WithThePayloadInEachRowEqualsTheEvaluationBitForBit) {
   model::RobotGeometry<double> geometry;
   ASSERT_EQ(model::geometry_from_image(view, geometry), model::Status::ok);
 
-  dataset::Dataset data;
-  data.segment_count = geometry.segment_count;
   const int samples = 120;
-  data.cables_mm.resize(samples, 4 * geometry.segment_count);
-  data.has_payload = true;
-  data.payload_kg.resize(samples);
-  std::mt19937 rng(4);
-  std::uniform_real_distribution<double> alpha(-M_PI, M_PI), theta(0.0, 1.2), payload(0.0, 1.0);
-  for (int i = 0; i < samples; ++i) {
-    model::JointVector<double> joints(2 * geometry.segment_count);
-    for (int s = 0; s < geometry.segment_count; ++s) {
-      joints[2 * s] = alpha(rng);
-      joints[2 * s + 1] = theta(rng);
-    }
-    model::CableVector<double> cables;
-    ASSERT_EQ(model::cables_from_joints(joints, geometry, cables), model::Status::ok);
-    data.cables_mm.row(i) = cables.transpose();
-    data.payload_kg[i] = payload(rng);
-  }
+  dataset::Dataset data;
+  ASSERT_NO_FATAL_FAILURE(random_cables(geometry, samples, 4, true, data));
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_payload";
-  std::filesystem::create_directories(dir);
-  {
-    std::ofstream out(dir / "model.img", std::ios::binary);
-    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
-  }
-  dataset::write_dataset_csv((dir / "cables.csv").string(), data);
+  write_replay_inputs(dir, image, data);
   ASSERT_EQ(run_replay(dir, "model.img", "cables.csv"), 0);
 
   const dataset::Dataset written = dataset::read_dataset_csv((dir / "cables.csv").string());

@@ -24,12 +24,9 @@ training::TrainedModel payload_model() {
   test_support::SyntheticModelOptions options;
   options.training_points = 8;
   options.payload_input = true;
-  training::TrainedModel m = test_support::synthetic_trained_model(options);
-  for (int k = 0; k < 6; ++k) {
-    m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
-    m.output_scale[k] *= k < 3 ? 0.1 : 0.001;
-  }
-  return m;
+  options.position_output_factor = 0.1;
+  options.rotation_output_factor = 0.001;
+  return test_support::synthetic_trained_model(options);
 }
 
 class RuntimePayloadTest : public RuntimeTest {

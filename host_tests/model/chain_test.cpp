@@ -24,21 +24,13 @@ namespace {
 using test_support::kPi;
 using test_support::Real;
 
-// Relative error bounds. Forward kinematics and the Jacobians are a few
-// dozen operations per segment, so the observed error is a few tens of
-// roundings of the tested type; the references (long double) are exact to
-// that scale.
-template <typename S> struct Tolerance;
-template <> struct Tolerance<float> { static constexpr Real relative = 1e-5L; };
-template <> struct Tolerance<double> { static constexpr Real relative = 1e-12L; };
-
+// Forward kinematics and the Jacobians are a few dozen operations per
+// segment, so the observed error is a few tens of roundings of the tested
+// type: test_support::RelativeTolerance.
 template <typename S>
-class Chain : public ::testing::Test {
+class Chain : public test_support::RandomScalarTest<S, 13u> {
  protected:
-  static constexpr Real kTol = Tolerance<S>::relative;
-  std::mt19937 rng{13u};
-
-  Real uniform(Real lo, Real hi) { return std::uniform_real_distribution<double>(double(lo), double(hi))(rng); }
+  using test_support::RandomScalarTest<S, 13u>::uniform;
 
   // Each segment different: slender to stubby, small to full bending range.
   RobotGeometry<S> random_geometry(int segment_count) {
@@ -64,17 +56,6 @@ class Chain : public ::testing::Test {
 };
 
 TYPED_TEST_SUITE(Chain, test_support::Scalars, test_support::ScalarNames);
-
-template <typename S>
-RobotGeometry<Real> to_real(const RobotGeometry<S>& geometry) {
-  RobotGeometry<Real> result;
-  result.segment_count = geometry.segment_count;
-  for (int i = 0; i < geometry.segment_count; ++i) {
-    const SegmentGeometry<S>& g = geometry.segments[i];
-    result.segments[i] = SegmentGeometry<Real>{g.backbone_length_mm, g.anchor_radius_mm, g.theta_max_rad};
-  }
-  return result;
-}
 
 template <typename S>
 Real total_length(const RobotGeometry<S>& geometry) {
@@ -132,6 +113,16 @@ Real relative_jacobian_error(const Jacobian<S>& actual, const Jacobian<Real>& ex
                   error.template bottomRows<3>().cwiseAbs().maxCoeff());
 }
 
+// The tip pose and spatial tip Jacobian computed at `at` against pose_of (in
+// long double) there and its central differences.
+template <typename S, typename PoseOf>
+void expect_tip_and_jacobian_of(const PoseOf& pose_of, const JointVector<S>& at, const Pose<S>& tip,
+                                const Jacobian<S>& jacobian, Real length_mm, Real tolerance) {
+  const JointVector<Real> reference_at = at.template cast<Real>();
+  EXPECT_LE(relative_jacobian_error(jacobian, spatial_finite_difference(pose_of, reference_at), length_mm), tolerance);
+  EXPECT_LE(relative_distance(tip, pose_of(reference_at), length_mm), tolerance);
+}
+
 TYPED_TEST(Chain, ForwardKinematicsIsProductOfSegmentPoses) {
   using S = TypeParam;
   for (int n = 1; n <= kMaxSegments; ++n) {
@@ -140,7 +131,8 @@ TYPED_TEST(Chain, ForwardKinematicsIsProductOfSegmentPoses) {
       const JointVector<S> joints = this->random_joints(geometry, S(0), 0.2L);
       Pose<S> tip;
       ASSERT_EQ(forward_kinematics(joints, geometry, tip), Status::ok);
-      const Pose<Real> reference = product_of_segment_poses_from_joints(joints.template cast<Real>(), to_real(geometry));
+      const Pose<Real> reference =
+          product_of_segment_poses_from_joints(joints.template cast<Real>(), geometry.template cast<Real>());
       EXPECT_LE(relative_distance(tip, reference, total_length(geometry)), TestFixture::kTol) << n << " segments";
 
       // The unchecked bend-vector path is the same computation.
@@ -178,14 +170,12 @@ TYPED_TEST(Chain, JointJacobianMatchesFiniteDifferences) {
       ASSERT_EQ(tip_jacobian(joints, geometry, tip, jacobian), Status::ok);
       ASSERT_EQ(jacobian.cols(), 2 * n);
 
-      const RobotGeometry<Real> reference_geometry = to_real(geometry);
+      const RobotGeometry<Real> reference_geometry = geometry.template cast<Real>();
       const auto pose_of = [&](const JointVector<Real>& q) {
         return product_of_segment_poses_from_joints(q, reference_geometry);
       };
-      const Real length = total_length(geometry);
-      const Jacobian<Real> reference = spatial_finite_difference(pose_of, joints.template cast<Real>());
-      EXPECT_LE(relative_jacobian_error(jacobian, reference, length), TestFixture::kTol) << n << " segments";
-      EXPECT_LE(relative_distance(tip, pose_of(joints.template cast<Real>()), length), TestFixture::kTol);
+      SCOPED_TRACE(testing::Message() << n << " segments");
+      expect_tip_and_jacobian_of(pose_of, joints, tip, jacobian, total_length(geometry), TestFixture::kTol);
     }
   }
 }
@@ -205,12 +195,10 @@ TYPED_TEST(Chain, BendJacobianMatchesFiniteDifferencesIncludingStraightSegments)
       tip_jacobian_bend(bend, geometry, tip, jacobian);
       ASSERT_EQ(jacobian.cols(), 2 * n);
 
-      const RobotGeometry<Real> reference_geometry = to_real(geometry);
+      const RobotGeometry<Real> reference_geometry = geometry.template cast<Real>();
       const auto pose_of = [&](const JointVector<Real>& b) { return product_of_segment_poses(b, reference_geometry); };
-      const Real length = total_length(geometry);
-      const Jacobian<Real> reference = spatial_finite_difference(pose_of, bend.template cast<Real>());
-      EXPECT_LE(relative_jacobian_error(jacobian, reference, length), TestFixture::kTol) << n << " segments";
-      EXPECT_LE(relative_distance(tip, pose_of(bend.template cast<Real>()), length), TestFixture::kTol);
+      SCOPED_TRACE(testing::Message() << n << " segments");
+      expect_tip_and_jacobian_of(pose_of, bend, tip, jacobian, total_length(geometry), TestFixture::kTol);
     }
   }
 }
@@ -224,7 +212,7 @@ TYPED_TEST(Chain, AllStraightBendJacobian) {
     Pose<S> tip;
     Jacobian<S> jacobian;
     tip_jacobian_bend(bend, geometry, tip, jacobian);
-    const RobotGeometry<Real> reference_geometry = to_real(geometry);
+    const RobotGeometry<Real> reference_geometry = geometry.template cast<Real>();
     const auto pose_of = [&](const JointVector<Real>& b) { return product_of_segment_poses(b, reference_geometry); };
     const Jacobian<Real> reference = spatial_finite_difference(pose_of, JointVector<Real>::Zero(2 * n));
     EXPECT_LE(relative_jacobian_error(jacobian, reference, total_length(geometry)), TestFixture::kTol);

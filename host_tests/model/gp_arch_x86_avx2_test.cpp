@@ -18,7 +18,7 @@
 #include "cdcr/model/gp_correction.hpp"
 #include "export/image_writer.hpp"
 
-#include "../support/synthetic_trained_model.hpp"
+#include "../support/synthetic_image.hpp"
 
 namespace cdcr::model {
 namespace {
@@ -26,11 +26,7 @@ namespace {
 using Vector = GpCorrection<float, double, kMaxSegments, arch::X86Avx2>;
 using Reference = GpCorrection<float, double, kMaxSegments, arch::FusedScalar>;
 
-struct Model {
-  training::TrainedModel trained;
-  std::vector<std::uint8_t> image;
-  ImageView view{};
-};
+using Model = test_support::SyntheticImage;
 
 Model make_model(int segments, int points, bool payload) {
   test_support::SyntheticModelOptions options;
@@ -38,11 +34,7 @@ Model make_model(int segments, int points, bool payload) {
   options.training_points = points;
   options.payload_input = payload;
   options.seed = 7000u + std::uint32_t(segments * 10 + points);
-  Model m;
-  m.trained = test_support::synthetic_trained_model(options);
-  m.image = exporting::write_image(m.trained);
-  EXPECT_EQ(parse_image(m.image.data(), m.image.size(), m.view), ImageStatus::ok);
-  return m;
+  return test_support::synthetic_image(options);
 }
 
 // Bends over the synthetic models' range, and some far outside it: there the

@@ -14,29 +14,26 @@
 #include "export/image_writer.hpp"
 #include "train/trainer.hpp"
 
-#include "../support/synthetic_trained_model.hpp"
+#include "../support/synthetic_image.hpp"
 
 namespace cdcr::model {
 namespace {
 
-using Bytes = std::vector<std::uint8_t>;
-
-struct BoundModel {
-  training::TrainedModel model;
-  Bytes image;
-  ImageView view{};
-};
+using BoundModel = test_support::SyntheticImage;
 
 BoundModel make_model(int segments, InputEncoding encoding, int training_points) {
   test_support::SyntheticModelOptions options;
   options.segments = segments;
   options.encoding = encoding;
   options.training_points = training_points;
-  BoundModel b;
-  b.model = test_support::synthetic_trained_model(options);
-  b.image = exporting::write_image(b.model);
-  EXPECT_EQ(parse_image(b.image.data(), b.image.size(), b.view), ImageStatus::ok);
-  return b;
+  return test_support::synthetic_image(options);
+}
+
+// 2 to 4 segments take the fixed-size loops, 5 the general one; each in both
+// input encodings.
+auto segments_and_encodings() {
+  return ::testing::Combine(::testing::Values(2, 3, 4, 5),
+                            ::testing::Values(InputEncoding::bend_vector, InputEncoding::joint_angles));
 }
 
 JointVector<double> random_bend(int segments, std::mt19937& rng, double theta_min_rad = 0.05) {
@@ -52,14 +49,29 @@ JointVector<double> random_bend(int segments, std::mt19937& rng, double theta_mi
   return bend;
 }
 
+// `gradient`, the double correction's at `bend`, against central differences
+// of its mean (steps of 1e-6) to 1e-6 relative.
+template <typename Correction>
+void expect_gradient_of_mean(Correction& correction, const JointVector<double>& bend,
+                             const Jacobian<double>& gradient) {
+  constexpr double h = 1e-6;
+  for (int d = 0; d < bend.size(); ++d) {
+    JointVector<double> plus = bend;
+    JointVector<double> minus = bend;
+    plus[d] += h;
+    minus[d] -= h;
+    const Twist<double> difference = (correction.predict(plus) - correction.predict(minus)) / (2 * h);
+    for (int k = 0; k < 6; ++k) {
+      EXPECT_NEAR(gradient(k, d), difference[k], 1e-6 * (1.0 + std::abs(difference[k])))
+          << "output " << k << ", input " << d;
+    }
+  }
+}
+
 class GpCorrectionSizes : public ::testing::TestWithParam<std::tuple<int, InputEncoding>> {};
 
-// 2 to 4 segments take the fixed-size loops, 5 the general one; 37 points
-// leave a partial block and a partial chunk.
-INSTANTIATE_TEST_SUITE_P(Segments, GpCorrectionSizes,
-                         ::testing::Combine(::testing::Values(2, 3, 4, 5),
-                                            ::testing::Values(InputEncoding::bend_vector,
-                                                              InputEncoding::joint_angles)));
+// 37 points leave a partial block and a partial chunk.
+INSTANTIATE_TEST_SUITE_P(Segments, GpCorrectionSizes, segments_and_encodings());
 
 TEST_P(GpCorrectionSizes, GradientMatchesCentralDifferences) {
   const auto [segments, encoding] = GetParam();
@@ -75,18 +87,8 @@ TEST_P(GpCorrectionSizes, GradientMatchesCentralDifferences) {
     ASSERT_EQ(gradient.cols(), 2 * segments);
     const Twist<double> mean = correction.predict(bend);
     for (int k = 0; k < 6; ++k) EXPECT_EQ(eps[k], mean[k]);
-    constexpr double h = 1e-6;
-    for (int d = 0; d < 2 * segments; ++d) {
-      JointVector<double> plus = bend;
-      JointVector<double> minus = bend;
-      plus[d] += h;
-      minus[d] -= h;
-      const Twist<double> difference = (correction.predict(plus) - correction.predict(minus)) / (2 * h);
-      for (int k = 0; k < 6; ++k) {
-        EXPECT_NEAR(gradient(k, d), difference[k], 1e-6 * (1.0 + std::abs(difference[k])))
-            << "output " << k << ", input " << d << ", trial " << trial;
-      }
-    }
+    SCOPED_TRACE(testing::Message() << "trial " << trial);
+    expect_gradient_of_mean(correction, bend, gradient);
   }
 }
 
@@ -101,7 +103,7 @@ TEST_P(GpCorrectionSizes, FloatMeanAndGradientFollowDouble) {
     std::mt19937 rng(5);
     Eigen::MatrixXd bends(30, 2 * segments);
     for (int q = 0; q < 30; ++q) bends.row(q) = random_bend(segments, rng).transpose();
-    return training::predict_error_twists(b.model, bends);
+    return training::predict_error_twists(b.trained, bends);
   }();
   std::mt19937 rng(5);
   for (int q = 0; q < 30; ++q) {
@@ -115,7 +117,7 @@ TEST_P(GpCorrectionSizes, FloatMeanAndGradientFollowDouble) {
     for (int k = 0; k < 6; ++k) {
       // The trainer's own prediction, independent of the image code; the
       // image holds float32 values, hence float32-sized differences.
-      const double scale = b.model.output_scale[k] * b.model.signal_variance[k] + std::abs(b.model.output_mean[k]);
+      const double scale = b.trained.output_scale[k] * b.trained.signal_variance[k] + std::abs(b.trained.output_mean[k]);
       EXPECT_NEAR(eps[k], expected_mean(q, k), 2e-6 * scale);
       EXPECT_NEAR(eps_float[k], eps[k], 2e-6 * scale);
       const double gradient_scale = gradient.row(k).cwiseAbs().maxCoeff() + scale;
@@ -178,10 +180,7 @@ std::array<double, 6> output_magnitudes(const ImageView& image) {
 // 4, 6 and 8 inputs take the fixed-size loops, 10 (5 segments) the general one.
 class GpCorrectionChunks : public ::testing::TestWithParam<std::tuple<int, InputEncoding>> {};
 
-INSTANTIATE_TEST_SUITE_P(Segments, GpCorrectionChunks,
-                         ::testing::Combine(::testing::Values(2, 3, 4, 5),
-                                            ::testing::Values(InputEncoding::bend_vector,
-                                                              InputEncoding::joint_angles)));
+INSTANTIATE_TEST_SUITE_P(Segments, GpCorrectionChunks, segments_and_encodings());
 
 // predict and predict_with_gradient against the dense sum, in double and
 // in float with either accumulator the firmware uses.
@@ -293,10 +292,7 @@ TEST_P(GpCorrectionPayload, TheMeanFollowsThePayloadAsTheTrainerPredictsIt) {
   options.segments = segments;
   options.training_points = 37;
   options.payload_input = true;
-  BoundModel b;
-  b.model = test_support::synthetic_trained_model(options);
-  b.image = exporting::write_image(b.model);
-  ASSERT_EQ(parse_image(b.image.data(), b.image.size(), b.view), ImageStatus::ok);
+  const BoundModel b = test_support::synthetic_image(options);
   ASSERT_EQ(b.view.extra_inputs, 1);
   ASSERT_EQ(b.view.input_dims, 2 * segments + 1);
   ASSERT_EQ(*b.view.extra_input_default, 0.375f);
@@ -318,7 +314,7 @@ TEST_P(GpCorrectionPayload, TheMeanFollowsThePayloadAsTheTrainerPredictsIt) {
     Eigen::MatrixXd bends(12, 2 * segments);
     for (int q = 0; q < bends.rows(); ++q) bends.row(q) = random_bend(segments, rng).transpose();
     const Eigen::MatrixXd expected =
-        training::predict_error_twists(b.model, bends, Eigen::VectorXd::Constant(bends.rows(), used_kg));
+        training::predict_error_twists(b.trained, bends, Eigen::VectorXd::Constant(bends.rows(), used_kg));
     for (int q = 0; q < bends.rows(); ++q) {
       const JointVector<double> bend = bends.row(q).transpose();
       Twist<double> eps;
@@ -327,19 +323,11 @@ TEST_P(GpCorrectionPayload, TheMeanFollowsThePayloadAsTheTrainerPredictsIt) {
       ASSERT_EQ(gradient.cols(), 2 * segments);
       const Twist<float> eps_float = correction.predict(bend.cast<float>());
       for (int k = 0; k < 6; ++k) {
-        const double scale = b.model.output_scale[k] * b.model.signal_variance[k] + std::abs(b.model.output_mean[k]);
+        const double scale = b.trained.output_scale[k] * b.trained.signal_variance[k] + std::abs(b.trained.output_mean[k]);
         EXPECT_NEAR(eps[k], expected(q, k), 2e-6 * scale) << "payload " << used_kg << ", query " << q;
         EXPECT_NEAR(eps_float[k], eps[k], 2e-6 * scale) << "payload " << used_kg << ", query " << q;
       }
-      constexpr double h = 1e-6;
-      for (int d = 0; d < 2 * segments; ++d) {
-        JointVector<double> plus = bend;
-        JointVector<double> minus = bend;
-        plus[d] += h;
-        minus[d] -= h;
-        const Twist<double> difference = (reference.predict(plus) - reference.predict(minus)) / (2 * h);
-        for (int k = 0; k < 6; ++k) EXPECT_NEAR(gradient(k, d), difference[k], 1e-6 * (1.0 + std::abs(difference[k])));
-      }
+      expect_gradient_of_mean(reference, bend, gradient);
     }
   }
   // The payload is an input, not a constant: two payloads, two corrections.

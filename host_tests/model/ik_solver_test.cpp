@@ -3,6 +3,7 @@
 // does not depend on how the work is sliced over calls (cycles).
 
 #include <cstdint>
+#include <initializer_list>
 #include <random>
 #include <vector>
 
@@ -19,6 +20,7 @@ namespace cdcr::model {
 namespace {
 
 using Correction = GpCorrection<float, double, kMaxSegments>;
+using Solver = IkSolver<float, kMaxSegments, Correction>;
 
 struct Fixture {
   std::vector<std::uint8_t> image;
@@ -28,22 +30,21 @@ struct Fixture {
 };
 
 // A model of several blocks and gradient chunks with a ragged end, its
-// correction scaled to the size a trained model has (millimetres).
-void make(Fixture& f, int training_points) {
+// correction scaled to the size a trained model has (millimetres); the
+// solvers are configured on it.
+void make(Fixture& f, int training_points, std::initializer_list<Solver*> solvers = {}) {
   test_support::SyntheticModelOptions options;
   options.segments = 4;
   options.training_points = training_points;
-  training::TrainedModel m = test_support::synthetic_trained_model(options);
-  for (int k = 0; k < 6; ++k) {
-    m.output_mean[k] *= k < 3 ? 0.5 : 0.002;
-    m.output_scale[k] *= k < 3 ? 0.5 : 0.002;
-  }
-  f.image = exporting::write_image(m);
+  options.position_output_factor = 0.5;
+  options.rotation_output_factor = 0.002;
+  f.image = exporting::write_image(test_support::synthetic_trained_model(options));
   ImageCapacity capacity;
   capacity.max_training_points = 4096;
   ASSERT_EQ(parse_image(f.image.data(), f.image.size(), f.view, capacity), ImageStatus::ok);
   ASSERT_EQ(geometry_from_image(f.view, f.geometry), Status::ok);
   ASSERT_EQ(f.correction.bind(f.view), Status::ok);
+  for (Solver* solver : solvers) solver->configure(f.geometry, f.correction);
 }
 
 JointVector<float> random_joints(std::mt19937& rng, int segments, double theta_max) {
@@ -96,11 +97,9 @@ TEST(IkSolver, SlicedEvaluationHasTheBitsOfAWholeOne) {
 // its budget.
 TEST(IkSolver, ResultDoesNotDependOnTheBudgetAndNoCallExceedsIt) {
   Fixture f;
-  make(f, 203);
+  static Solver whole, sliced;
+  make(f, 203, {&whole, &sliced});
   std::mt19937 rng(11);
-  static IkSolver<float, kMaxSegments, Correction> whole, sliced;
-  whole.configure(f.geometry, f.correction);
-  sliced.configure(f.geometry, f.correction);
   const JointVector<float> start = random_joints(rng, 4, 0.1);
   int converged = 0;
   for (int trial = 0; trial < 30; ++trial) {
@@ -139,9 +138,8 @@ TEST(IkSolver, ResultDoesNotDependOnTheBudgetAndNoCallExceedsIt) {
 // and a solve still ends once the budget allows.
 TEST(IkSolver, TooSmallABudgetDoesNothing) {
   Fixture f;
-  make(f, 64);
-  static IkSolver<float, kMaxSegments, Correction> solver;
-  solver.configure(f.geometry, f.correction);
+  static Solver solver;
+  make(f, 64, {&solver});
   std::mt19937 rng(3);
   const JointVector<float> q = random_joints(rng, 4, 0.2);
   const Pose<float> target = forward_kinematics_bend(JointVector<float>(bend_from_joints(q)), f.geometry);
@@ -155,9 +153,8 @@ TEST(IkSolver, TooSmallABudgetDoesNothing) {
 // small step needs few evaluations.
 TEST(IkSolver, WarmStartsAlongAPathNeedFewEvaluations) {
   Fixture f;
-  make(f, 203);
-  static IkSolver<float, kMaxSegments, Correction> solver;
-  solver.configure(f.geometry, f.correction);
+  static Solver solver;
+  make(f, 203, {&solver});
   JointVector<float> q(8);
   for (int s = 0; s < 4; ++s) {
     q[2 * s] = 0.5f * float(s);
@@ -187,9 +184,8 @@ TEST(IkSolver, WarmStartsAlongAPathNeedFewEvaluations) {
 // tracking threshold, and it is offered only while that solve runs.
 TEST(IkSolver, LinearisedPointIsWhereItsResidualSays) {
   Fixture f;
-  make(f, 203);
-  static IkSolver<float, kMaxSegments, Correction> solver;
-  solver.configure(f.geometry, f.correction);
+  static Solver solver;
+  make(f, 203, {&solver});
   std::mt19937 rng(7);
   int checked = 0;
   for (int t = 0; t < 10; ++t) {

@@ -46,17 +46,6 @@ namespace {
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kPaperWorkspaceThetaRad = 0.2;
 
-template <typename S>
-RobotGeometry<double> to_double(const RobotGeometry<S>& geometry) {
-  RobotGeometry<double> result;
-  result.segment_count = geometry.segment_count;
-  for (int i = 0; i < geometry.segment_count; ++i) {
-    const SegmentGeometry<S>& g = geometry.segments[i];
-    result.segments[i] = SegmentGeometry<double>{g.backbone_length_mm, g.anchor_radius_mm, g.theta_max_rad};
-  }
-  return result;
-}
-
 double rotation_angle(const Mat3<double>& rotation) { return Eigen::AngleAxis<double>(rotation).angle(); }
 
 struct Measured {
@@ -70,7 +59,7 @@ template <typename S>
 Measured measure(const JointVector<S>& joints, const RobotGeometry<S>& geometry, const Pose<S>& target) {
   const JointVector<double> q = joints.template cast<double>();
   Pose<double> tip;
-  EXPECT_EQ(forward_kinematics(q, to_double(geometry), tip), Status::ok);
+  EXPECT_EQ(forward_kinematics(q, geometry.template cast<double>(), tip), Status::ok);
   const Pose<double> t = target.template cast<double>();
   return Measured{(tip.position_mm - t.position_mm).norm(), rotation_angle(t.rotation * tip.rotation.transpose())};
 }

@@ -18,6 +18,7 @@
 
 #include "cdcr/model/se3.hpp"
 
+#include "../support/pose_distance.hpp"
 #include "../support/scalar_types.hpp"
 
 namespace cdcr::model {
@@ -26,32 +27,24 @@ namespace {
 using test_support::kPi;
 using test_support::Real;
 
-// Error bounds relative to the size of the compared quantity (a rotation
-// entry, or a translation divided by max(1 mm, its norm)). The worst observed
-// errors are about ten roundings of the tested type (6e-7 in float, 1.3e-15
-// in double); the bounds leave a wide margin without letting an O(h) series
-// or branch mistake through.
-template <typename S> struct Tolerance;
-template <> struct Tolerance<float> {
-  static constexpr Real relative = 1e-5L;
-  // The left Jacobian is compared against finite differences taken in long
-  // double, so only the float rounding of its ten-term series counts.
-  static constexpr Real jacobian = 2e-5L;
-};
-template <> struct Tolerance<double> {
-  static constexpr Real relative = 1e-12L;
-  // The left Jacobian truncates its series after ten terms; for rotations up
-  // to 0.3 rad the omitted term is about 0.3^10 / 11! = 1.5e-13 relative.
-  static constexpr Real jacobian = 2e-12L;
-};
+// Error bounds (test_support::RelativeTolerance) are relative to the size of
+// the compared quantity (a rotation entry, or a translation divided by
+// max(1 mm, its norm)). The worst observed errors are about ten roundings of
+// the tested type (6e-7 in float, 1.3e-15 in double); the bounds leave a wide
+// margin without letting an O(h) series or branch mistake through.
+template <typename S> struct JacobianTolerance;
+// The left Jacobian is compared against finite differences taken in long
+// double, so only the float rounding of its ten-term series counts.
+template <> struct JacobianTolerance<float> { static constexpr Real value = 2e-5L; };
+// The left Jacobian truncates its series after ten terms; for rotations up
+// to 0.3 rad the omitted term is about 0.3^10 / 11! = 1.5e-13 relative.
+template <> struct JacobianTolerance<double> { static constexpr Real value = 2e-12L; };
 
 template <typename S>
-class Se3 : public ::testing::Test {
+class Se3 : public test_support::RandomScalarTest<S, 20200417u> {
  protected:
-  static constexpr Real kTol = Tolerance<S>::relative;
-  std::mt19937 rng{20200417u};
-
-  Real uniform(Real lo, Real hi) { return std::uniform_real_distribution<double>(double(lo), double(hi))(rng); }
+  using test_support::RandomScalarTest<S, 20200417u>::rng;
+  using test_support::RandomScalarTest<S, 20200417u>::uniform;
 
   Vec3<Real> random_unit_vector() {
     std::normal_distribution<double> normal;
@@ -83,15 +76,7 @@ class Se3 : public ::testing::Test {
 
 TYPED_TEST_SUITE(Se3, test_support::Scalars, test_support::ScalarNames);
 
-// Distance between two poses: largest rotation-entry difference, or
-// position difference relative to max(1 mm, |p|), whichever is larger.
-template <typename S>
-Real relative_distance(const Pose<S>& actual, const Pose<Real>& expected) {
-  const Real rotation = (actual.rotation.template cast<Real>() - expected.rotation).cwiseAbs().maxCoeff();
-  const Real position = (actual.position_mm.template cast<Real>() - expected.position_mm).norm() /
-                        std::max(Real(1), expected.position_mm.norm());
-  return std::max(rotation, position);
-}
+using test_support::relative_distance;  // pose against its long-double reference
 
 template <typename S>
 Real relative_distance(const Pose<S>& actual, const Pose<S>& expected) {
@@ -311,7 +296,7 @@ TYPED_TEST(Se3, LeftJacobianMatchesFiniteDifferences) {
     for (int k = 0; k < 6; ++k) finite_difference.col(k) = (4 * central(k, h / 2) - central(k, h)) / 3;
     const Mat6<Real> jacobian = left_jacobian<S>(xi).template cast<Real>();
     const Real scale = std::max(Real(1), finite_difference.cwiseAbs().maxCoeff());
-    EXPECT_LE((jacobian - finite_difference).cwiseAbs().maxCoeff(), Tolerance<S>::jacobian * scale)
+    EXPECT_LE((jacobian - finite_difference).cwiseAbs().maxCoeff(), JacobianTolerance<S>::value * scale)
         << "xi = " << xi.transpose();
   }
 }

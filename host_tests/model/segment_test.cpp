@@ -21,6 +21,7 @@
 
 #include "cdcr/model/segment.hpp"
 
+#include "../support/pose_distance.hpp"
 #include "../support/scalar_types.hpp"
 
 namespace cdcr::model {
@@ -28,11 +29,6 @@ namespace {
 
 using test_support::kPi;
 using test_support::Real;
-
-// Relative error bounds, a few tens of roundings of the tested type.
-template <typename S> struct Tolerance;
-template <> struct Tolerance<float> { static constexpr Real relative = 1e-5L; };
-template <> struct Tolerance<double> { static constexpr Real relative = 1e-12L; };
 
 // Segment shapes from slender (small r / L, where the cable differences are
 // small and joints_from_cables amplifies rounding most) to the prototype.
@@ -46,12 +42,9 @@ const std::array<SegmentGeometry<double>, 4> kGeometries = {{
 Real wrap_angle(Real angle) { return std::remainder(angle, 2 * kPi); }
 
 template <typename S>
-class Segment : public ::testing::Test {
+class Segment : public test_support::RandomScalarTest<S, 7u> {
  protected:
-  static constexpr Real kTol = Tolerance<S>::relative;
-  std::mt19937 rng{7u};
-
-  Real uniform(Real lo, Real hi) { return std::uniform_real_distribution<double>(double(lo), double(hi))(rng); }
+  using test_support::RandomScalarTest<S, 7u>::uniform;
 
   // Random joints with theta uniform in [0, theta_max], plus the values where
   // the parametrisation is singular or wraps.
@@ -82,14 +75,7 @@ SegmentGeometry<S> cast_geometry(const SegmentGeometry<double>& g) {
   return SegmentGeometry<S>{S(g.backbone_length_mm), S(g.anchor_radius_mm), S(g.theta_max_rad)};
 }
 
-// Rotation entries absolutely, position relative to max(1 mm, |p|).
-template <typename S>
-Real relative_distance(const Pose<S>& actual, const Pose<Real>& expected) {
-  const Real rotation = (actual.rotation.template cast<Real>() - expected.rotation).cwiseAbs().maxCoeff();
-  const Real position = (actual.position_mm.template cast<Real>() - expected.position_mm).norm() /
-                        std::max(Real(1), expected.position_mm.norm());
-  return std::max(rotation, position);
-}
+using test_support::relative_distance;  // pose against its long-double reference
 
 // The note's closed form of the arc, evaluated directly. 1 - cos(theta) is
 // written 2 sin^2(theta/2): at theta = 1e-9 the literal form keeps only one

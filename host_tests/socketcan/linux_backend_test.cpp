@@ -59,16 +59,25 @@ std::int64_t thread_cpu_ns() {
   return std::int64_t(t.tv_sec) * 1'000'000'000 + t.tv_nsec;
 }
 
-class PosixPeriodicTimerWaits : public ::testing::TestWithParam<ReleaseWait> {};
+// A timer of a 2 ms period on the monotonic clock, waiting as the parameter says.
+class PosixPeriodicTimerWaits : public ::testing::TestWithParam<ReleaseWait> {
+ protected:
+  static constexpr std::int64_t kPeriodNs = 2'000'000;
+
+  // Starts the timer; its first release.
+  hal::TimerTick start() {
+    timer.start(kPeriodNs);
+    return timer.wait_next();
+  }
+
+  PosixMonotonicClock clock;
+  PosixPeriodicTimer timer{clock, GetParam()};
+};
 INSTANTIATE_TEST_SUITE_P(Waits, PosixPeriodicTimerWaits, ::testing::Values(ReleaseWait::sleep, ReleaseWait::spin),
                          [](const auto& info) { return info.param == ReleaseWait::sleep ? "sleep" : "spin"; });
 
 TEST_P(PosixPeriodicTimerWaits, ReleasesOnAbsoluteDeadlines) {
-  PosixMonotonicClock clock;
-  PosixPeriodicTimer timer(clock, GetParam());
-  constexpr std::int64_t kPeriodNs = 2'000'000;
-  timer.start(kPeriodNs);
-  const hal::TimerTick first = timer.wait_next();
+  const hal::TimerTick first = start();
   EXPECT_GE(clock.now_ns(), first.release_ns);
   std::int64_t releases = 0;
   const std::int64_t cpu_begin_ns = thread_cpu_ns();
@@ -91,11 +100,7 @@ TEST_P(PosixPeriodicTimerWaits, ReleasesOnAbsoluteDeadlines) {
 }
 
 TEST_P(PosixPeriodicTimerWaits, CountsEveryMissedRelease) {
-  PosixMonotonicClock clock;
-  PosixPeriodicTimer timer(clock, GetParam());
-  constexpr std::int64_t kPeriodNs = 2'000'000;
-  timer.start(kPeriodNs);
-  const hal::TimerTick first = timer.wait_next();
+  const hal::TimerTick first = start();
   // Come back three and a half periods late: releases 2, 3 and 4 have passed.
   while (clock.now_ns() < first.release_ns + 3 * kPeriodNs + kPeriodNs / 2) {
   }

@@ -21,6 +21,11 @@ struct SyntheticModelOptions {
   std::uint32_t seed = 20200921;
   // One more input after the bend pairs: the payload, 0 to 1 kg.
   bool payload_input = false;
+  // The correction's size: the output means and scales of the position
+  // outputs times the first, of the rotation outputs times the second (a
+  // trained model's correction is millimetres and milliradians).
+  double position_output_factor = 1.0;
+  double rotation_output_factor = 1.0;
 };
 
 inline training::TrainedModel synthetic_trained_model(const SyntheticModelOptions& options = {}) {
@@ -62,6 +67,11 @@ inline training::TrainedModel synthetic_trained_model(const SyntheticModelOption
     m.output_scale[k] = uniform(0.1, 3.0);
     m.signal_variance[k] = uniform(0.5, 2.0);
     m.noise_variance[k] = uniform(1e-4, 1e-2);
+  }
+  for (int k = 0; k < 6; ++k) {
+    const double factor = k < 3 ? options.position_output_factor : options.rotation_output_factor;
+    m.output_mean[k] *= factor;
+    m.output_scale[k] *= factor;
   }
   m.alpha.resize(n, 6);
   for (int i = 0; i < n; ++i) {

@@ -27,6 +27,7 @@
 #include "export/c_source.hpp"
 #include "export/image_writer.hpp"
 #include "image_report.hpp"
+#include "test_work_dir.hpp"
 
 #include "../support/run_cdcr.hpp"
 #include "../support/synthetic_trained_model.hpp"
@@ -68,12 +69,7 @@ using CliResult = cdcr::test_support::CliRun;
 
 class ImageCli : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir = fs::path(CDCR_TEST_WORK_DIR) / (std::string(info->test_suite_name()) + "." + info->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
+  void SetUp() override { dir = test_support::fresh_test_work_dir(); }
 
   fs::path save(const std::string& name, const Bytes& bytes) const {
     const fs::path path = dir / name;

@@ -26,6 +26,7 @@
 #include "export/intel_hex.hpp"
 
 #include "../support/synthetic_trained_model.hpp"
+#include "test_work_dir.hpp"
 
 namespace cdcr::exporting {
 namespace {
@@ -65,12 +66,7 @@ CommandResult run(const std::string& command, const fs::path& log) {
 
 class ExportTest : public ::testing::Test {
  protected:
-  void SetUp() override {
-    const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-    dir = fs::path(CDCR_TEST_WORK_DIR) / (std::string(info->test_suite_name()) + "." + info->name());
-    fs::remove_all(dir);
-    fs::create_directories(dir);
-  }
+  void SetUp() override { dir = test_support::fresh_test_work_dir(); }
   fs::path dir;
 };
 
@@ -258,6 +254,20 @@ std::string replace_all(std::string text, const std::string& from, const std::st
 constexpr const char* kStrictC = " -std=c99 -Wall -Wextra -Wpedantic -Werror ";
 constexpr const char* kStrictCxx = " -x c++ -std=c++17 -Wall -Wextra -Wpedantic -Werror ";
 
+// Links dump.c against model<suffix>.o into dump<suffix> and runs it, which
+// writes dumped<suffix>.bin; `printed` is what it printed.
+void link_and_run_dump(const fs::path& dir, const std::string& suffix, std::string& printed) {
+  const auto quoted = [](const fs::path& p) { return "'" + p.string() + "'"; };
+  const fs::path program = dir / ("dump" + suffix);
+  CommandResult r = run(std::string(CDCR_C_COMPILER) + kStrictC + quoted(dir / "dump.c") + " " +
+                            quoted(dir / ("model" + suffix + ".o")) + " -o " + quoted(program),
+                        dir / ("link" + suffix + ".log"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  r = run(quoted(program) + " " + quoted(dir / ("dumped" + suffix + ".bin")), dir / ("dump" + suffix + ".log"));
+  ASSERT_EQ(r.exit_code, 0) << r.output;
+  printed = r.output;
+}
+
 void expect_c_array_round_trip(const fs::path& dir, const Bytes& image, const CSourceOptions& options) {
   const std::string source = format_c_source(image.data(), image.size(), options);
   write_text(dir / "model.c", source);
@@ -276,25 +286,16 @@ void expect_c_array_round_trip(const fs::path& dir, const Bytes& image, const CS
   ASSERT_EQ(r.exit_code, 0) << r.output;
   EXPECT_EQ(r.output, "");
 
-  r = run(c_compiler + kStrictC + quoted(dir / "dump.c") + " " + quoted(dir / "model.o") + " -o " +
-              quoted(dir / "dump"),
-          dir / "link.log");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = run(quoted(dir / "dump") + " " + quoted(dir / "dumped.bin"), dir / "dump.log");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  std::string printed;
+  ASSERT_NO_FATAL_FAILURE(link_and_run_dump(dir, "", printed));
   char expected[64];
   std::snprintf(expected, sizeof expected, "%zu %08x\n", image.size(),
                 model::crc32(image.data(), image.size() - model::kImageTrailerSize));
-  EXPECT_EQ(r.output, expected);
+  EXPECT_EQ(printed, expected);
   EXPECT_EQ(read_binary_file((dir / "dumped.bin").string()), image);
 
   // The object compiled as C++ defines the same C symbols.
-  r = run(c_compiler + kStrictC + quoted(dir / "dump.c") + " " + quoted(dir / "model_cxx.o") + " -o " +
-              quoted(dir / "dump_cxx"),
-          dir / "link_cxx.log");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
-  r = run(quoted(dir / "dump_cxx") + " " + quoted(dir / "dumped_cxx.bin"), dir / "dump_cxx.log");
-  ASSERT_EQ(r.exit_code, 0) << r.output;
+  ASSERT_NO_FATAL_FAILURE(link_and_run_dump(dir, "_cxx", printed));
   EXPECT_EQ(read_binary_file((dir / "dumped_cxx.bin").string()), image);
 
 #ifdef CDCR_OBJDUMP

@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <random>
+#include <type_traits>
 #include <vector>
 
 #include "cdcr/model/kinematics.hpp"
@@ -31,7 +32,21 @@ constexpr double kSampledThetaMaxRad = 0.2;
 constexpr double kWarmStartOffsetRad = 0.02;
 constexpr double kColdStartThetaRad = 0.05;
 
-std::size_t next_index(std::size_t k) { return (k + 1) % kRingSize; }
+// Runs step(k) once per benchmark iteration, k walking the ring of inputs;
+// what step returns is kept from the optimiser.
+template <typename Step>
+void over_ring(benchmark::State& state, Step step) {
+  std::size_t k = 0;
+  for (auto _ : state) {
+    if constexpr (std::is_void_v<std::invoke_result_t<Step&, std::size_t>>) {
+      step(k);
+    } else {
+      auto result = step(k);
+      benchmark::DoNotOptimize(result);
+    }
+    k = (k + 1) % kRingSize;
+  }
+}
 
 [[noreturn]] void fail_setup(const char* what, Status status) {
   std::fprintf(stderr, "benchmark input generation failed: %s: %s\n", what, to_string(status));
@@ -113,13 +128,10 @@ void baseline_mat4_chain(benchmark::State& state) {
       matrices.push_back(segment_pose<double>(b, geometry.segments[i].backbone_length_mm).matrix());
     }
   }
-  std::size_t k = 0;
-  for (auto _ : state) {
+  over_ring(state, [&](std::size_t k) {
     const Mat4<double>* m = &matrices[4 * k];
-    Mat4<double> product = m[0] * m[1] * m[2] * m[3];
-    benchmark::DoNotOptimize(product);
-    k = next_index(k);
-  }
+    return Mat4<double>(m[0] * m[1] * m[2] * m[3]);
+  });
 }
 
 // The checked path a caller takes from measured cable lengths.
@@ -127,63 +139,44 @@ template <typename S>
 void fk_from_cables(benchmark::State& state) {
   const Workload<S>& w = workload<S>();
   std::size_t failures = 0;
-  std::size_t k = 0;
-  for (auto _ : state) {
+  over_ring(state, [&](std::size_t k) {
     JointVector<S> joints;
     Pose<S> tip;
     failures += joints_from_cables(w.cables_mm[k], w.geometry, joints) != Status::ok;
     failures += forward_kinematics(joints, w.geometry, tip) != Status::ok;
     benchmark::DoNotOptimize(tip);
-    k = next_index(k);
-  }
+  });
   report_failures(state, failures);
 }
 
 template <typename S>
 void fk_from_bend(benchmark::State& state) {
   const Workload<S>& w = workload<S>();
-  std::size_t k = 0;
-  for (auto _ : state) {
-    Pose<S> tip = forward_kinematics_bend(w.bends[k], w.geometry);
-    benchmark::DoNotOptimize(tip);
-    k = next_index(k);
-  }
+  over_ring(state, [&](std::size_t k) { return forward_kinematics_bend(w.bends[k], w.geometry); });
 }
 
 template <typename S>
 void se3_exp(benchmark::State& state) {
   const Workload<S>& w = workload<S>();
-  std::size_t k = 0;
-  for (auto _ : state) {
-    Pose<S> pose = cdcr::model::exp(w.tip_twists[k]);
-    benchmark::DoNotOptimize(pose);
-    k = next_index(k);
-  }
+  over_ring(state, [&](std::size_t k) { return cdcr::model::exp(w.tip_twists[k]); });
 }
 
 template <typename S>
 void se3_log(benchmark::State& state) {
   const Workload<S>& w = workload<S>();
-  std::size_t k = 0;
-  for (auto _ : state) {
-    Twist<S> twist = cdcr::model::log(w.tips[k]);
-    benchmark::DoNotOptimize(twist);
-    k = next_index(k);
-  }
+  over_ring(state, [&](std::size_t k) { return cdcr::model::log(w.tips[k]); });
 }
 
 template <typename S>
 void jacobian_bend(benchmark::State& state) {
   const Workload<S>& w = workload<S>();
-  std::size_t k = 0;
-  for (auto _ : state) {
+  over_ring(state, [&](std::size_t k) {
     Pose<S> tip;
     Jacobian<S> jacobian;
     tip_jacobian_bend(w.bends[k], w.geometry, tip, jacobian);
     benchmark::DoNotOptimize(tip);
     benchmark::DoNotOptimize(jacobian);
-    k = next_index(k);
-  }
+  });
 }
 
 enum class Target { pose, position };
@@ -197,8 +190,7 @@ void run_ik(benchmark::State& state) {
   std::size_t failures = 0;
   double iterations = 0;
   double converged = 0;
-  std::size_t k = 0;
-  for (auto _ : state) {
+  over_ring(state, [&](std::size_t k) {
     const JointVector<S>& initial = start == Start::warm ? w.warm_starts[k] : w.cold_start;
     IkResult<S> result;
     if constexpr (target == Target::pose) {
@@ -210,31 +202,10 @@ void run_ik(benchmark::State& state) {
     iterations += result.iterations;
     converged += result.converged();
     failures += !result.converged() && result.status != Status::ik_not_converged;
-    k = next_index(k);
-  }
+  });
   state.counters["ik_iterations"] = benchmark::Counter(iterations, benchmark::Counter::kAvgIterations);
   state.counters["converged"] = benchmark::Counter(converged, benchmark::Counter::kAvgIterations);
   report_failures(state, failures);
-}
-
-template <typename S>
-void ik_pose_warm(benchmark::State& state) {
-  run_ik<S, Target::pose, Start::warm>(state);
-}
-
-template <typename S>
-void ik_pose_cold(benchmark::State& state) {
-  run_ik<S, Target::pose, Start::cold>(state);
-}
-
-template <typename S>
-void ik_position_warm(benchmark::State& state) {
-  run_ik<S, Target::position, Start::warm>(state);
-}
-
-template <typename S>
-void ik_position_cold(benchmark::State& state) {
-  run_ik<S, Target::position, Start::cold>(state);
 }
 
 BENCHMARK(baseline_mat4_chain);
@@ -248,14 +219,15 @@ BENCHMARK_TEMPLATE(se3_log, float);
 BENCHMARK_TEMPLATE(se3_log, double);
 BENCHMARK_TEMPLATE(jacobian_bend, float);
 BENCHMARK_TEMPLATE(jacobian_bend, double);
-BENCHMARK_TEMPLATE(ik_pose_warm, float);
-BENCHMARK_TEMPLATE(ik_pose_warm, double);
-BENCHMARK_TEMPLATE(ik_pose_cold, float);
-BENCHMARK_TEMPLATE(ik_pose_cold, double);
-BENCHMARK_TEMPLATE(ik_position_warm, float);
-BENCHMARK_TEMPLATE(ik_position_warm, double);
-BENCHMARK_TEMPLATE(ik_position_cold, float);
-BENCHMARK_TEMPLATE(ik_position_cold, double);
+// Named ik_<target>_<start><scalar>.
+BENCHMARK_TEMPLATE(run_ik, float, Target::pose, Start::warm)->Name("ik_pose_warm<float>");
+BENCHMARK_TEMPLATE(run_ik, double, Target::pose, Start::warm)->Name("ik_pose_warm<double>");
+BENCHMARK_TEMPLATE(run_ik, float, Target::pose, Start::cold)->Name("ik_pose_cold<float>");
+BENCHMARK_TEMPLATE(run_ik, double, Target::pose, Start::cold)->Name("ik_pose_cold<double>");
+BENCHMARK_TEMPLATE(run_ik, float, Target::position, Start::warm)->Name("ik_position_warm<float>");
+BENCHMARK_TEMPLATE(run_ik, double, Target::position, Start::warm)->Name("ik_position_warm<double>");
+BENCHMARK_TEMPLATE(run_ik, float, Target::position, Start::cold)->Name("ik_position_cold<float>");
+BENCHMARK_TEMPLATE(run_ik, double, Target::position, Start::cold)->Name("ik_position_cold<double>");
 
 }  // namespace
 

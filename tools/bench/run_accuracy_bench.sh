@@ -7,27 +7,18 @@
 #   bash tools/bench/run_accuracy_bench.sh [--seed S]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+source tools/bench/bench_build.sh
 
 seed=1
 if [[ ${1:-} == --seed ]]; then seed=$2; fi
 
-build_dir=${BUILD_DIR:-build}
 work_dir=$build_dir/accuracy_bench
-bash tools/install-deps.sh base
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release --log-level=WARNING >/dev/null
-cmake --build "$build_dir" -j"$(nproc)" --target cdcr >/dev/null
+bench_build base "" cdcr
 mkdir -p "$work_dir"
 cdcr=$build_dir/bin/cdcr
 
 "$cdcr" simulate --samples 750 --seed "$seed" --out "$work_dir/data.csv" --json >"$work_dir/simulate.json"
-floor=$(/usr/bin/python3 - "$work_dir/simulate.json" <<'PYTHON'
-import json
-import sys
-
-floor = json.load(open(sys.argv[1]))["noise_floor"]
-print("{},{}".format(floor["position_mm"], floor["orientation_deg"]))
-PYTHON
-)
+floor=$(noise_floor "$work_dir/simulate.json")
 echo "simulated robot (seed $seed): $(cat "$work_dir/simulate.json")"
 
 echo

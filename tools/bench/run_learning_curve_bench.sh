@@ -11,26 +11,17 @@
 #   bash tools/bench/run_learning_curve_bench.sh
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+source tools/bench/bench_build.sh
 
-build_dir=${BUILD_DIR:-build}
 work_dir=$build_dir/learning_curve_bench
-bash tools/install-deps.sh base
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release --log-level=WARNING >/dev/null
-cmake --build "$build_dir" -j"$(nproc)" --target cdcr >/dev/null
+bench_build base "" cdcr
 mkdir -p "$work_dir"
 cdcr=$build_dir/bin/cdcr
 
 "$cdcr" simulate --samples 4000 --seed 1 --workspace-theta-max 0.7 --out "$work_dir/train.csv" >/dev/null
 "$cdcr" simulate --samples 200 --seed 1 --session 1 --workspace-theta-max 0.7 --out "$work_dir/test.csv" --json \
   >"$work_dir/test-simulate.json"
-floor=$(/usr/bin/python3 - "$work_dir/test-simulate.json" <<'PYTHON'
-import json
-import sys
-
-floor = json.load(open(sys.argv[1]))["noise_floor"]
-print("{},{}".format(floor["position_mm"], floor["orientation_deg"]))
-PYTHON
-)
+floor=$(noise_floor "$work_dir/test-simulate.json")
 echo "noise floor of the test set: $floor (mm, deg)"
 "$cdcr" learning-curve --data "$work_dir/train.csv" --test-data "$work_dir/test.csv" \
   --sizes 250,500,1000,2000,4000 --encodings bend-vector --models exact,sparse --inducing 1024 \

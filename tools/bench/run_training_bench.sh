@@ -14,6 +14,7 @@
 #   bash tools/bench/run_training_bench.sh [--restarts R] [--repetitions K]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+source tools/bench/bench_build.sh
 
 restarts=0
 repetitions=3
@@ -25,12 +26,8 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 
-build_dir=${BUILD_DIR:-build}
 work_dir=$build_dir/training_bench
-bash tools/install-deps.sh base sklearn
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCDCR_BUILD_TOOLS=ON -DCDCR_BUILD_BENCHMARKS=ON \
-  --log-level=WARNING >/dev/null
-cmake --build "$build_dir" -j"$(nproc)" --target cdcr cdcr-bench-training
+bench_build --show-build "base sklearn" "-DCDCR_BUILD_TOOLS=ON -DCDCR_BUILD_BENCHMARKS=ON" cdcr cdcr-bench-training
 mkdir -p "$work_dir"
 
 # Both sides' BLAS on one thread per call: the trainer's default (its

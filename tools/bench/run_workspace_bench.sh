@@ -22,6 +22,7 @@
 #   bash tools/bench/run_workspace_bench.sh [--skip-sklearn]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
+source tools/bench/bench_build.sh
 
 skip_sklearn=0
 while [[ $# -gt 0 ]]; do
@@ -31,12 +32,8 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 
-build_dir=${BUILD_DIR:-build}
 work_dir=$build_dir/workspace_bench
-bash tools/install-deps.sh base sklearn
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCDCR_BUILD_TOOLS=ON -DCDCR_BUILD_BENCHMARKS=ON \
-  --log-level=WARNING >/dev/null
-cmake --build "$build_dir" -j"$(nproc)" --target cdcr cdcr-bench-training >/dev/null
+bench_build "base sklearn" "-DCDCR_BUILD_TOOLS=ON -DCDCR_BUILD_BENCHMARKS=ON" cdcr cdcr-bench-training
 mkdir -p "$work_dir"
 cdcr=$build_dir/bin/cdcr
 

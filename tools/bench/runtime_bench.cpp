@@ -52,6 +52,7 @@
 #include "cdcr/linux/posix_time.hpp"
 #include "sim/simulated_platform.hpp"
 #include "sim/simulated_robot.hpp"
+#include "sim/target_frames.hpp"
 #include "sim/workspace_sampler.hpp"
 
 namespace {
@@ -92,23 +93,7 @@ CableFrames cable_frames(const model::CableVector<double>& cables_mm, int segmen
   return frames;
 }
 
-// tracking: the target is one of a stream along a path (TRACKING = 1).
-std::vector<cdcr::hal::CanFrame> target_frames(const model::Pose<double>& target, protocol::TargetMode mode,
-                                               bool tracking, std::uint8_t sequence) {
-  std::vector<cdcr::hal::CanFrame> frames;
-  cdcr::hal::CanFrame frame;
-  if (mode == protocol::TargetMode::pose) {
-    Eigen::Quaterniond q(target.rotation);
-    q.normalize();
-    protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, frame);
-    frames.push_back(frame);
-  }
-  protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
-  frames.push_back(frame);
-  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), mode, tracking, sequence}, frame);
-  frames.push_back(frame);
-  return frames;
-}
+using cdcr::sim::target_frames;
 
 // Everything the cycles read, generated before any timing.
 struct Workload {

@@ -21,6 +21,7 @@
 #include "sim/simulated_drives.hpp"
 #include "sim/simulated_platform.hpp"
 #include "sim/simulated_robot.hpp"
+#include "sim/target_frames.hpp"
 
 namespace cdcr::runtime_host {
 
@@ -32,25 +33,17 @@ namespace sim = cdcr::sim;
 namespace {
 
 void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, std::uint8_t sequence) {
-  cdcr::hal::CanFrame frame;
-  protocol::encode(protocol::TargetPositionXy{target_mm.x(), target_mm.y()}, frame);
-  host.send(frame);
-  protocol::encode(protocol::TargetPositionZ{target_mm.z(), protocol::TargetMode::position, false, sequence}, frame);
-  host.send(frame);
+  for (const cdcr::hal::CanFrame& frame :
+       sim::target_frames(target_mm, protocol::TargetMode::position, false, sequence)) {
+    host.send(frame);
+  }
 }
 
 void send_pose_target(cdcr::hal::CanBus& host, const model::Pose<double>& target, std::uint8_t sequence,
                       bool tracking) {
-  cdcr::hal::CanFrame frame;
-  Eigen::Quaterniond q(target.rotation);
-  q.normalize();
-  protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, frame);
-  host.send(frame);
-  protocol::encode(protocol::TargetPositionXy{target.position_mm.x(), target.position_mm.y()}, frame);
-  host.send(frame);
-  protocol::encode(protocol::TargetPositionZ{target.position_mm.z(), protocol::TargetMode::pose, tracking, sequence},
-                   frame);
-  host.send(frame);
+  for (const cdcr::hal::CanFrame& frame : sim::target_frames(target, protocol::TargetMode::pose, tracking, sequence)) {
+    host.send(frame);
+  }
 }
 
 // The closed loop following a streamed circle: the robot first goes to the

@@ -18,8 +18,7 @@ MeanErrors mean_errors(const std::vector<model::Pose<double>>& reference, const 
 
 Fidelity compare_poses(const std::vector<model::Pose<double>>& reference, const std::vector<model::Pose<double>>& poses) {
   if (reference.size() != poses.size() || reference.empty()) throw std::invalid_argument("pose lists differ in size");
-  const model::PoseErrorSummary s = model::summarize_pose_errors(reference.data(), poses.data(), poses.size());
-  return Fidelity{s.max_position_mm, s.mean_position_mm, s.max_orientation_deg, s.mean_orientation_deg};
+  return model::summarize_pose_errors(reference.data(), poses.data(), poses.size());
 }
 
 std::vector<model::Pose<double>> compensated_poses(const TrainingSet& set, const Eigen::MatrixXd& error_twists) {

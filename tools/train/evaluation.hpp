@@ -9,6 +9,7 @@
 
 #include "cdcr/model/flash_image.hpp"
 #include "cdcr/model/gp_uncertainty.hpp"
+#include "cdcr/model/pose_error_summary.hpp"
 #include "cdcr/model/se3.hpp"
 #include "training_set.hpp"
 
@@ -50,12 +51,9 @@ std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, c
                                                 FirmwareAccumulator accumulator = FirmwareAccumulator::float64,
                                                 const Eigen::VectorXd& payload_kg = {});
 
-struct Fidelity {
-  double max_position_mm = 0.0;
-  double mean_position_mm = 0.0;
-  double max_orientation_deg = 0.0;
-  double mean_orientation_deg = 0.0;
-};
+// How far one path's poses lie from another's: the mean and largest position
+// and orientation differences.
+using Fidelity = model::PoseErrorSummary;
 
 // The firmware's uncertainty path (model::GpUncertainty on the parsed
 // image, float32) for each sample, beside its compensated pose.

@@ -14,29 +14,17 @@
 #include <gtest/gtest.h>
 
 #include "dataset/csv_dataset.hpp"
+#include "rejection_case.hpp"
 
 namespace {
 
-using cdcr::dataset::Dataset;
-using cdcr::dataset::DatasetError;
-using cdcr::dataset::fnv1a64;
-using cdcr::dataset::format_dataset_csv;
-using cdcr::dataset::parse_dataset_csv;
-using cdcr::dataset::PoseColumns;
-using cdcr::dataset::read_dataset_csv;
-using cdcr::dataset::write_dataset_csv;
+using namespace cdcr::dataset;  // the reader and writer under test
 
 constexpr const char* kPoseHeader = "l1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy,qz\n";
 
 // Runs the parser and returns the rejection; fails the test if there is none.
 DatasetError rejection(const std::string& text, PoseColumns poses = PoseColumns::optional) {
-  try {
-    parse_dataset_csv(text, poses);
-  } catch (const DatasetError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "accepted:\n" << text;
-  return DatasetError(-1, "accepted");
+  return cdcr::test_support::refusal([&] { parse_dataset_csv(text, poses); }, text);
 }
 
 std::string temp_path(const std::string& name) { return testing::TempDir() + "cdcr_dataset_" + name; }
@@ -140,22 +128,13 @@ TEST(DatasetCsv, AcceptsUtf8ByteOrderMark) {
   EXPECT_EQ(data.sample_count(), 1);
 }
 
-struct BadCsv {
-  const char* name;
-  std::string text;
-  int line;
-  std::string message;  // exact what()
-};
-
-void PrintTo(const BadCsv& c, std::ostream* os) { *os << c.name; }
+using BadCsv = cdcr::test_support::RejectionCase;
 
 class DatasetCsvRejects : public testing::TestWithParam<BadCsv> {};
 
 TEST_P(DatasetCsvRejects, WithOneLineNamingTheLine) {
-  const BadCsv& c = GetParam();
-  const DatasetError e = rejection(c.text);
-  EXPECT_EQ(e.line(), c.line);
-  EXPECT_EQ(std::string(e.what()), c.message);
+  const DatasetError e = rejection(GetParam().text);
+  cdcr::test_support::expect_refusal_matches(e, GetParam());
   EXPECT_EQ(std::string(e.what()).find_first_of("\r\n"), std::string::npos);
 }
 
@@ -181,7 +160,7 @@ INSTANTIATE_TEST_SUITE_P(
                "line 2: column l1_1: '1e999' is out of the range of a double"},
         BadCsv{"long_field", kCables + "1,2,3," + std::string(100, 'z') + "\n", 2,
                "line 2: column l1_4: '" + std::string(40, 'z') + "...' is not a number"}),
-    [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
+    cdcr::test_support::rejection_case_name);
 
 INSTANTIATE_TEST_SUITE_P(
     NotFinite, DatasetCsvRejects,
@@ -194,7 +173,7 @@ INSTANTIATE_TEST_SUITE_P(
                            "line 2: column x: 'nan' is NaN or Inf"},
                     BadCsv{"inf_quaternion", kPoses + "1,2,3,4,0,0,0,1,0,0,inf\n", 2,
                            "line 2: column qz: 'inf' is NaN or Inf"}),
-    [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
+    cdcr::test_support::rejection_case_name);
 
 INSTANTIATE_TEST_SUITE_P(
     Quaternion, DatasetCsvRejects,
@@ -206,7 +185,7 @@ INSTANTIATE_TEST_SUITE_P(
                            "line 2: quaternion norm 0 is not 1 (tolerance 0.001)"},
                     BadCsv{"overflowing_norm", kPoses + "1,2,3,4,0,0,0,1e300,1e300,0,0\n", 2,
                            "line 2: quaternion norm inf is not 1 (tolerance 0.001)"}),
-    [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
+    cdcr::test_support::rejection_case_name);
 
 INSTANTIATE_TEST_SUITE_P(
     Header, DatasetCsvRejects,
@@ -240,7 +219,7 @@ INSTANTIATE_TEST_SUITE_P(
         BadCsv{"empty", "", 0, "no header line (expected l1_1,l1_2,...): the file is empty or only comments"},
         BadCsv{"only_comments", "# a\n\n# b\n", 0,
                "no header line (expected l1_1,l1_2,...): the file is empty or only comments"}),
-    [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
+    cdcr::test_support::rejection_case_name);
 
 const std::string kPayload = "l1_1,l1_2,l1_3,l1_4,payload_kg\n";
 const std::string kPayloadPoses = "l1_1,l1_2,l1_3,l1_4,payload_kg,x,y,z,qw,qx,qy,qz\n";
@@ -275,7 +254,7 @@ INSTANTIATE_TEST_SUITE_P(
                "x,y,z,..."},
         BadCsv{"misnamed", "l1_1,l1_2,l1_3,l1_4,payload,x,y,z,qw,qx,qy,qz\n", 1,
                "line 1: header column 5 is 'payload', expected 'x'"}),
-    [](const testing::TestParamInfo<BadCsv>& info) { return std::string(info.param.name); });
+    cdcr::test_support::rejection_case_name);
 
 TEST(DatasetCsv, RequiredPoseColumns) {
   const DatasetError e = rejection(kCables + "1,2,3,4\n", PoseColumns::required);

@@ -20,6 +20,7 @@
 #include "dataset/csv_dataset.hpp"
 #include "dataset/mocap_import.hpp"
 #include "import_mocap_command.hpp"
+#include "rejection_case.hpp"
 
 #include "../../support/run_cdcr.hpp"
 
@@ -140,24 +141,13 @@ MocapImportOptions bodies(const std::string& base, const std::string& end, LostF
 }
 
 DatasetError tsv_rejection(const std::string& text) {
-  try {
-    cdcr::dataset::parse_qtm_6d_tsv(text);
-  } catch (const DatasetError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "accepted:\n" << text;
-  return DatasetError(-1, "accepted");
+  return cdcr::test_support::refusal([&] { cdcr::dataset::parse_qtm_6d_tsv(text); }, text);
 }
 
 DatasetError import_rejection(const Dataset& commanded, const std::string& text, const MocapImportOptions& options) {
   const MocapCapture capture = cdcr::dataset::parse_qtm_6d_tsv(text);
-  try {
-    cdcr::dataset::import_mocap(commanded, capture, options);
-  } catch (const DatasetError& e) {
-    return e;
-  }
-  ADD_FAILURE() << "imported:\n" << text;
-  return DatasetError(-1, "imported");
+  return cdcr::test_support::refusal([&] { cdcr::dataset::import_mocap(commanded, capture, options); }, text,
+                                     "imported");
 }
 
 // A file with base and end bodies whose end-in-base poses are known.
@@ -403,22 +393,12 @@ TEST(MocapImport, RejectsPosesThatOverflow) {
   }
 }
 
-struct BadTsv {
-  const char* name;
-  std::string text;
-  int line;
-  std::string message;
-};
-
-void PrintTo(const BadTsv& c, std::ostream* os) { *os << c.name; }
+using BadTsv = cdcr::test_support::RejectionCase;
 
 class MocapTsvRejects : public testing::TestWithParam<BadTsv> {};
 
 TEST_P(MocapTsvRejects, WithOneLineNamingTheLine) {
-  const BadTsv& c = GetParam();
-  const DatasetError e = tsv_rejection(c.text);
-  EXPECT_EQ(e.line(), c.line);
-  EXPECT_EQ(std::string(e.what()), c.message);
+  cdcr::test_support::expect_refusal_matches(tsv_rejection(GetParam().text), GetParam());
 }
 
 // A valid one-body, two-frame file, and ways to damage it.
@@ -467,7 +447,7 @@ INSTANTIATE_TEST_SUITE_P(
                "Rot[8]"},
         BadTsv{"bad_frame_count", "NO_OF_FRAMES\tmany\n" + kHeader.substr(kHeader.find("Frame")) + kRow1, 1,
                "line 1: NO_OF_FRAMES: 'many' is not a non-negative integer"}),
-    [](const testing::TestParamInfo<BadTsv>& info) { return std::string(info.param.name); });
+    cdcr::test_support::rejection_case_name);
 
 TEST(MocapImport, ReadErrorsNameThePath) {
   const std::string path = testing::TempDir() + "cdcr_mocap_missing.tsv";

@@ -16,17 +16,13 @@
 
 #include "sim/simulated_robot.hpp"
 #include "sim/workspace_sampler.hpp"
+#include "sim_test_types.hpp"
 
 namespace cdcr::sim {
 namespace {
 
-using Geometry = model::RobotGeometry<double>;
-using Pose = model::Pose<double>;
-using Cables = model::CableVector<double>;
-using Joints = model::JointVector<double>;
-
+using namespace test_types;
 using model::kPi;
-const Geometry kPrototype = Geometry::prototype();
 
 Pose nominal_pose(const Cables& cables, const Geometry& geometry = kPrototype) {
   Joints joints;

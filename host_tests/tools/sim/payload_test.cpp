@@ -16,17 +16,12 @@
 #include "sim/data_collection.hpp"
 #include "sim/simulated_robot.hpp"
 #include "sim/workspace_sampler.hpp"
+#include "sim_test_types.hpp"
 
 namespace cdcr::sim {
 namespace {
 
-using Geometry = model::RobotGeometry<double>;
-using Pose = model::Pose<double>;
-using Cables = model::CableVector<double>;
-using Joints = model::JointVector<double>;
-using Vec3 = model::Vec3<double>;
-
-const Geometry kPrototype = Geometry::prototype();
+using namespace test_types;
 
 Cables straight_cables(int segments = 4) { return Cables::Constant(4 * segments, 120.0); }
 

@@ -10,6 +10,8 @@
 #include "cdcr/model/chain.hpp"
 #include "train/calibration.hpp"
 
+#include "../../support/random_joints.hpp"
+
 namespace cdcr::training {
 namespace {
 
@@ -25,11 +27,7 @@ dataset::Dataset robot_with(const model::RobotGeometry<double>& design, const mo
   std::uniform_real_distribution<double> alpha(-3.1, 3.1);
   std::uniform_real_distribution<double> theta(0.02, 0.4);
   for (int k = 0; k < samples; ++k) {
-    model::JointVector<double> joints(2 * design.segment_count);
-    for (int i = 0; i < design.segment_count; ++i) {
-      joints[2 * i] = alpha(rng);
-      joints[2 * i + 1] = theta(rng);
-    }
+    const model::JointVector<double> joints = test_support::random_joints(design.segment_count, rng, alpha, theta);
     model::CableVector<double> cables;
     EXPECT_EQ(model::cables_from_joints(joints, design, cables), model::Status::ok);
     data.cables_mm.row(k) = cables.transpose();

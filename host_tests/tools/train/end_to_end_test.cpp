@@ -24,6 +24,13 @@ namespace {
 using cdcr::test_support::CliRun;
 using cdcr::test_support::run_cdcr;
 
+// The JSON report of a cdcr command that must succeed (null if it fails).
+nlohmann::json cdcr_json(const std::string& arguments) {
+  const CliRun run = run_cdcr(arguments);
+  EXPECT_EQ(run.exit_code, 0) << run.err;
+  return run.exit_code == 0 ? nlohmann::json::parse(run.out) : nlohmann::json();
+}
+
 TEST(TrainEndToEnd, SimulateTrainEvalRemovesMostOfTheError) {
   const std::string dir = testing::TempDir();
   const std::string train = "'" + dir + "end_to_end_train.csv'";
@@ -129,9 +136,7 @@ void strip_payload_column(const std::string& from, const std::string& to) {
 }
 
 nlohmann::json eval_json(const std::string& image, const std::string& data) {
-  const CliRun run = run_cdcr("eval --model " + image + " --data " + data + " --json");
-  EXPECT_EQ(run.exit_code, 0) << run.err;
-  return run.exit_code == 0 ? nlohmann::json::parse(run.out) : nlohmann::json();
+  return cdcr_json("eval --model " + image + " --data " + data + " --json");
 }
 
 // The payload acceptance: a robot whose tip load varies from 0 to
@@ -157,9 +162,7 @@ TEST(TrainEndToEnd, ThePayloadAsAnInputReachesTheNoiseFloor) {
   strip_payload_column(train, train_stripped);
   strip_payload_column(test, test_stripped);
 
-  run = run_cdcr("train --data '" + train + "' --out " + with_image + " --json");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const nlohmann::json trained = nlohmann::json::parse(run.out);
+  const nlohmann::json trained = cdcr_json("train --data '" + train + "' --out " + with_image + " --json");
   EXPECT_TRUE(trained.at("payload_input").get<bool>());
   // Its own length scale: one per bend input and one for the payload.
   EXPECT_EQ(trained.at("length_scales").size(), 9u);
@@ -210,35 +213,25 @@ TEST(TrainEndToEnd, TheExportedModelIsFittedOnEveryRow) {
   const std::string image = "'" + dir + "every_row.img'";
   ASSERT_EQ(run_cdcr("simulate --samples 60 --seed 9 --out " + data).exit_code, 0);
 
-  CliRun run = run_cdcr("train --data " + data + " --out " + image + " --holdout 10 --restarts 0 --json");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  nlohmann::json trained = nlohmann::json::parse(run.out);
+  nlohmann::json trained = cdcr_json("train --data " + data + " --out " + image + " --holdout 10 --restarts 0 --json");
   EXPECT_EQ(trained.at("training_samples").get<int>(), 50);
   EXPECT_EQ(trained.at("validation_samples").get<int>(), 10);
   EXPECT_EQ(trained.at("fitted_rows").get<int>(), 60);
   EXPECT_FALSE(trained.at("validation").is_null());
-  run = run_cdcr("inspect " + image + " --json");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  nlohmann::json inspected = nlohmann::json::parse(run.out);
+  nlohmann::json inspected = cdcr_json("inspect " + image + " --json");
   EXPECT_EQ(inspected.at("fitted_rows").get<int>(), 60);
   EXPECT_EQ(inspected.at("metadata").at("validation_samples").get<int>(), 10);
 
-  run = run_cdcr("train --data " + data + " --out " + image + " --holdout 0 --restarts 0 --json");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  trained = nlohmann::json::parse(run.out);
+  trained = cdcr_json("train --data " + data + " --out " + image + " --holdout 0 --restarts 0 --json");
   EXPECT_EQ(trained.at("training_samples").get<int>(), 60);
   EXPECT_EQ(trained.at("validation_samples").get<int>(), 0);
   EXPECT_EQ(trained.at("fitted_rows").get<int>(), 60);
   EXPECT_TRUE(trained.at("validation").is_null());
-  run = run_cdcr("inspect " + image + " --json");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  inspected = nlohmann::json::parse(run.out);
+  inspected = cdcr_json("inspect " + image + " --json");
   EXPECT_EQ(inspected.at("fitted_rows").get<int>(), 60);
   EXPECT_EQ(inspected.at("metadata").at("validation_samples").get<int>(), 0);
   // The image the board runs reproduces the training rows it was fitted on.
-  run = run_cdcr("eval --model " + image + " --data " + data + " --json");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const nlohmann::json evaluated = nlohmann::json::parse(run.out);
+  const nlohmann::json evaluated = cdcr_json("eval --model " + image + " --data " + data + " --json");
   EXPECT_LT(evaluated.at("compensated").at("position_mm").get<double>(),
             0.25 * evaluated.at("initial").at("position_mm").get<double>());
 }
@@ -278,9 +271,7 @@ void write_lines(const std::string& path, const std::vector<std::string>& lines)
 // An image `cdcr train` wrote: every check of cdcr inspect passes and every
 // hyperparameter is finite.
 void expect_sound_image(const std::string& image) {
-  const CliRun run = run_cdcr("inspect " + image + " --json");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const nlohmann::json j = nlohmann::json::parse(run.out);
+  const nlohmann::json j = cdcr_json("inspect " + image + " --json");
   for (const auto& [name, check] : j.at("checks").items()) {
     EXPECT_TRUE(check.at("passed").is_null() || check.at("passed").get<bool>()) << name << ": " << check;
   }
@@ -442,11 +433,9 @@ TEST(TrainEndToEnd, LearningCurvesAgainstRowsAndInducingPoints) {
   const std::string prefix = dir + "curve";
   ASSERT_EQ(run_cdcr("simulate --samples 120 --seed 6 --out " + data).exit_code, 0);
   ASSERT_EQ(run_cdcr("simulate --samples 100 --seed 6 --session 3 --out " + test).exit_code, 0);
-  const CliRun run = run_cdcr("learning-curve --data " + data + " --test-data " + test +
+  const nlohmann::json j = cdcr_json("learning-curve --data " + data + " --test-data " + test +
                               " --sizes 40,120 --encodings bend-vector --models exact,sparse --inducing 40"
                               " --inducing-sizes 5,40 --restarts 0 --json --plot-prefix '" + prefix + "'");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const nlohmann::json j = nlohmann::json::parse(run.out);
   EXPECT_EQ(j.at("test_samples").get<int>(), 100);
   const nlohmann::json& exact = j.at("curves").at("exact");
   const nlohmann::json& sparse = j.at("curves").at("sparse, M = 40");
@@ -477,16 +466,13 @@ TEST(TrainEndToEnd, TheCalibratedGeometryGoesIntoTheImage) {
   const std::string data = "'" + dir + "calibrate.csv'";
   const std::string image = "'" + dir + "calibrate.img'";
   ASSERT_EQ(run_cdcr("simulate --samples 150 --seed 8 --out " + data).exit_code, 0);
-  CliRun run = run_cdcr("train --data " + data + " --out " + image + " --calibrate --restarts 0 --json");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const nlohmann::json trained = nlohmann::json::parse(run.out);
+  const nlohmann::json trained =
+      cdcr_json("train --data " + data + " --out " + image + " --calibrate --restarts 0 --json");
   const nlohmann::json& calibration = trained.at("calibration");
   ASSERT_FALSE(calibration.is_null());
   EXPECT_LT(calibration.at("nominal_after").at("position_mm").get<double>(),
             calibration.at("nominal_before").at("position_mm").get<double>());
-  run = run_cdcr("inspect " + image + " --json");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const nlohmann::json geometry = nlohmann::json::parse(run.out).at("geometry");
+  const nlohmann::json geometry = cdcr_json("inspect " + image + " --json").at("geometry");
   const nlohmann::json& segments = calibration.at("segments");
   ASSERT_EQ(geometry.size(), segments.size());
   for (std::size_t s = 0; s < segments.size(); ++s) {
@@ -570,9 +556,7 @@ TEST(TrainEndToEnd, TrainAndEvalReadAPayloadColumn) {
   CliRun run = run_cdcr("train --data " + train + " --out " + image + " --restarts 0 --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_EQ(nlohmann::json::parse(run.out).at("fitted_rows").get<int>(), 150) << run.out;
-  run = run_cdcr("eval --model " + image + " --data " + test + " --json");
-  ASSERT_EQ(run.exit_code, 0) << run.err;
-  const nlohmann::json result = nlohmann::json::parse(run.out);
+  const nlohmann::json result = cdcr_json("eval --model " + image + " --data " + test + " --json");
   EXPECT_EQ(result.at("n").get<int>(), 60);
   // The payload's sag is an error the model cannot see yet; the rest it
   // still removes.
