@@ -38,8 +38,8 @@ class InputQueue final : public CycleInputs {
   void push_target(const cdcr_target& target) {
     const bool pose = target.mode == CDCR_TARGET_POSE;
     Input& input = push(Kind::target, pose ? 3 : 2);
-    input.pose = pose;
-    input.flags = (target.tracking != 0 ? kTracking : 0) | (target.refuse_extrapolating != 0 ? kRefuse : 0);
+    input.flags = static_cast<std::uint8_t>((pose ? kPose : 0) | (target.tracking != 0 ? kTracking : 0) |
+                                            (target.refuse_extrapolating != 0 ? kRefuse : 0));
     input.sequence = target.sequence;
     for (int i = 0; i < 3; ++i) input.values[i] = target.position_mm[i];
     for (int i = 0; i < 4; ++i) input.values[3 + i] = target.quaternion[i];
@@ -66,16 +66,12 @@ class InputQueue final : public CycleInputs {
 
  private:
   enum class Kind : std::uint8_t { cables, target, payload };
-  static constexpr std::uint8_t kTracking = 1;
-  static constexpr std::uint8_t kRefuse = 2;
+  enum Flags : std::uint8_t { kPose = 1, kTracking = 2, kRefuse = 4 };
   // Small: the queue lives in cdcr_runtime's storage. A target's values are
   // its position and quaternion, a cable input's the segment's four lengths.
   struct Input {
     Kind kind = Kind::cables;
-    std::uint8_t segment = 0;
-    bool pose = false;
-    std::uint8_t flags = 0;
-    std::uint8_t sequence = 0;
+    std::uint8_t segment = 0, flags = 0, sequence = 0;
     float values[7] = {};
   };
 
@@ -91,8 +87,8 @@ class InputQueue final : public CycleInputs {
     out.position_mm[0] = transmitted(protocol::position_xy::kX, in.values[0]);
     out.position_mm[1] = transmitted(protocol::position_xy::kY, in.values[1]);
     out.position_mm[2] = transmitted(protocol::target_position_z::kZ, in.values[2]);
-    out.mode = in.pose ? protocol::TargetMode::pose : protocol::TargetMode::position;
-    if (in.pose) {
+    out.mode = (in.flags & kPose) != 0 ? protocol::TargetMode::pose : protocol::TargetMode::position;
+    if (out.mode == protocol::TargetMode::pose) {
       out.quaternion[0] = transmitted(protocol::quaternion::kQw, in.values[3]);
       out.quaternion[1] = transmitted(protocol::quaternion::kQx, in.values[4]);
       out.quaternion[2] = transmitted(protocol::quaternion::kQy, in.values[5]);

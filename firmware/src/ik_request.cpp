@@ -74,9 +74,10 @@ void IkRequest::straight_start(Joints& joints) const {
   }
 }
 
-// A cycle's IK slice: solver steps within `units`, and the request's end (setpoints and report, kWorkCosts.ik_finish) when what is
-// left of the slice pays for it; otherwise the end goes out first thing in
-// the next cycle's slice.
+// A cycle's IK slice: solver steps within `units`, and the request's end
+// (setpoints and report, kWorkCosts.ik_finish) when what is left of the
+// slice pays for it; otherwise the end goes out first thing in the next
+// cycle's slice.
 std::uint32_t IkRequest::continue_slice(std::uint32_t units) {
   ++cycles_;
   if (checking_solution_) return continue_solution_check(units);
