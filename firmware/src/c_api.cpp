@@ -1,8 +1,9 @@
-// The C API (cdcr/cdcr.h): the runtime behind a HAL made of the caller's
-// callbacks, placed in the caller's storage. Cable lengths and targets are
-// encoded into the protocol's frames and queued on the in-memory bus the
-// runtime reads, so they pass the same checks as frames from a real bus;
-// the runtime's own frames go to can_send, or nowhere.
+// The C API (cdcr/cdcr.h): the runtime behind the HAL made of the caller's
+// callbacks (hal/callbacks), placed in the caller's storage. Cable lengths,
+// targets and the payload are queued as given and handed to the runtime's
+// direct inputs at the next step, ahead of the bus's frames, in the values
+// the protocol's frames would carry, so they pass the same checks as frames
+// from a real bus; the runtime's own frames go to can_send, or nowhere.
 
 #include "cdcr/cdcr.h"
 
@@ -10,166 +11,109 @@
 #include <cstdint>
 #include <new>
 
+#include "cdcr/callbacks/callback_hal.hpp"
 #include "cdcr/firmware/runtime.hpp"
 
 namespace cdcr::firmware {
 namespace {
 
-// Frames queued between two steps: one cable frame per segment twice over,
-// two targets (three frames each) and a payload.
+// Inputs queued between two steps, counted in the frames that would carry
+// them: one cable frame per segment twice over, two targets (three frames
+// each) and a payload.
 constexpr int kInputQueueDepth = 2 * kMaxSegments + 6 + 1;
 constexpr std::uint32_t kInitializedMagic = 0x43444352u;  // "CDCR"
 
-class CallbackClock final : public hal::MonotonicClock {
+double transmitted(const protocol::SignalSpec& signal, float value) { return protocol::as_transmitted(signal, value); }
+
+// The inputs given since the last step, oldest first, as the caller gave
+// them (checked); each reaches the runtime as its frames would have.
+class InputQueue final : public CycleInputs {
  public:
-  explicit CallbackClock(const cdcr_callbacks& callbacks) : callbacks_(callbacks) {}
-  std::int64_t now_ns() const override {
-    return callbacks_.now_ns != nullptr ? callbacks_.now_ns(callbacks_.user) : 0;
+  bool has_room(int frames) const { return frames_ + frames <= kInputQueueDepth; }
+  void push_cables(int segment, const float* lengths_mm) {
+    Input& input = push(Kind::cables, 1);
+    input.segment = static_cast<std::uint8_t>(segment);
+    for (int k = 0; k < 4; ++k) input.values[k] = lengths_mm[k];
+  }
+  void push_target(const cdcr_target& target) {
+    const bool pose = target.mode == CDCR_TARGET_POSE;
+    Input& input = push(Kind::target, pose ? 3 : 2);
+    input.flags = static_cast<std::uint8_t>((pose ? kPose : 0) | (target.tracking != 0 ? kTracking : 0) |
+                                            (target.refuse_extrapolating != 0 ? kRefuse : 0));
+    input.sequence = target.sequence;
+    for (int i = 0; i < 3; ++i) input.values[i] = target.position_mm[i];
+    for (int i = 0; i < 4; ++i) input.values[3 + i] = target.quaternion[i];
+  }
+  void push_payload(float payload_kg) { push(Kind::payload, 1).values[0] = payload_kg; }
+
+  int deliver(Runtime& runtime) override {
+    for (int i = 0; i < count_; ++i) {
+      const Input& input = inputs_[i];
+      if (input.kind == Kind::cables) {
+        Scalar lengths_mm[4];
+        for (int k = 0; k < 4; ++k) lengths_mm[k] = Scalar(protocol::cable_length_as_transmitted(input.values[k]));
+        runtime.set_cable_lengths(input.segment, lengths_mm);
+      } else if (input.kind == Kind::target) {
+        runtime.set_target(target_request(input));
+      } else {
+        runtime.set_payload_kg(Scalar(transmitted(protocol::payload::kPayload, input.values[0])));
+      }
+    }
+    const int frames = frames_;
+    count_ = frames_ = 0;
+    return frames;
   }
 
  private:
-  const cdcr_callbacks& callbacks_;
-};
+  enum class Kind : std::uint8_t { cables, target, payload };
+  enum Flags : std::uint8_t { kPose = 1, kTracking = 2, kRefuse = 4 };
+  // Small: the queue lives in cdcr_runtime's storage. A target's values are
+  // its position and quaternion, a cable input's the segment's four lengths.
+  struct Input {
+    Kind kind = Kind::cables;
+    std::uint8_t segment = 0, flags = 0, sequence = 0;
+    float values[7] = {};
+  };
 
-// The caller calls cdcr_step() once per period; this only keeps the schedule
-// so that lateness shows as jitter and missed releases.
-class SteppedTimer final : public hal::PeriodicTimer {
- public:
-  explicit SteppedTimer(const hal::MonotonicClock& clock) : clock_(clock) {}
-  void start(std::int64_t period_ns) override {
-    period_ns_ = period_ns > 0 ? period_ns : 0;
-    started_ = false;
-    overruns_ = 0;
+  Input& push(Kind kind, int frames) {
+    frames_ += frames;
+    Input& input = inputs_[count_++];
+    input.kind = kind;
+    return input;
   }
-  hal::TimerTick wait_next() override {
-    hal::TimerTick tick;
-    const std::int64_t now = clock_.now_ns();
-    if (period_ns_ == 0) {
-      tick.release_ns = now;
-      return tick;
+
+  static TargetRequest target_request(const Input& in) {
+    TargetRequest out;
+    out.position_mm[0] = transmitted(protocol::position_xy::kX, in.values[0]);
+    out.position_mm[1] = transmitted(protocol::position_xy::kY, in.values[1]);
+    out.position_mm[2] = transmitted(protocol::target_position_z::kZ, in.values[2]);
+    out.mode = (in.flags & kPose) != 0 ? protocol::TargetMode::pose : protocol::TargetMode::position;
+    if (out.mode == protocol::TargetMode::pose) {
+      out.quaternion[0] = transmitted(protocol::quaternion::kQw, in.values[3]);
+      out.quaternion[1] = transmitted(protocol::quaternion::kQx, in.values[4]);
+      out.quaternion[2] = transmitted(protocol::quaternion::kQy, in.values[5]);
+      out.quaternion[3] = transmitted(protocol::quaternion::kQz, in.values[6]);
     }
-    if (!started_) {
-      started_ = true;
-      next_release_ns_ = now;
-    }
-    if (now >= next_release_ns_ + period_ns_) {
-      const std::int64_t missed = (now - next_release_ns_) / period_ns_;
-      tick.missed_releases = static_cast<std::uint32_t>(missed);
-      overruns_ += tick.missed_releases;
-      next_release_ns_ += missed * period_ns_;
-    }
-    tick.release_ns = next_release_ns_;
-    next_release_ns_ += period_ns_;
-    return tick;
-  }
-  std::int64_t period_ns() const override { return period_ns_; }
-  std::uint32_t overruns() const override { return overruns_; }
-
- private:
-  const hal::MonotonicClock& clock_;
-  std::int64_t period_ns_ = 0;
-  std::int64_t next_release_ns_ = 0;
-  bool started_ = false;
-  std::uint32_t overruns_ = 0;
-};
-
-// Frames queued by the cdcr_set_* functions come first, then the caller's bus.
-class CallbackBus final : public hal::CanBus {
- public:
-  explicit CallbackBus(const cdcr_callbacks& callbacks) : callbacks_(callbacks) {}
-
-  bool has_room(int frames) const { return count_ + frames <= kInputQueueDepth; }
-  void queue(const hal::CanFrame& frame) {
-    queue_[(head_ + count_) % kInputQueueDepth] = frame;
-    ++count_;
+    out.tracking = (in.flags & kTracking) != 0;
+    out.refuse_extrapolating = (in.flags & kRefuse) != 0;
+    out.sequence = in.sequence;
+    return out;
   }
 
-  hal::CanStatus send(const hal::CanFrame& frame) override {
-    if (callbacks_.can_send == nullptr) return hal::CanStatus::ok;
-    cdcr_can_frame out{};
-    out.id = frame.id;
-    out.dlc = frame.dlc;
-    for (int i = 0; i < 8; ++i) out.data[i] = frame.data[i];
-    if (callbacks_.can_send(callbacks_.user, &out) == 0) return hal::CanStatus::ok;
-    ++counters_.tx_dropped;
-    return hal::CanStatus::queue_full;
-  }
-
-  hal::CanStatus receive(hal::CanFrame& frame) override {
-    if (count_ > 0) {
-      frame = queue_[head_];
-      head_ = (head_ + 1) % kInputQueueDepth;
-      --count_;
-      return hal::CanStatus::ok;
-    }
-    cdcr_can_frame in{};
-    if (callbacks_.can_receive == nullptr || callbacks_.can_receive(callbacks_.user, &in) != 1) {
-      return hal::CanStatus::empty;
-    }
-    frame.id = in.id;
-    frame.dlc = in.dlc <= 8 ? in.dlc : 8;
-    for (int i = 0; i < 8; ++i) frame.data[i] = in.data[i];
-    return hal::CanStatus::ok;
-  }
-
-  // Without a bus of the caller's there is nothing foreign to filter.
-  bool set_filters(const hal::CanFilter* filters, std::size_t count) override {
-    if (callbacks_.can_receive == nullptr) return true;
-    if (callbacks_.can_set_filters == nullptr || count > std::size_t(kMaxCanFilters)) return false;
-    cdcr_can_filter out[kMaxCanFilters] = {};
-    for (std::size_t i = 0; i < count; ++i) out[i] = cdcr_can_filter{filters[i].id, filters[i].mask};
-    return callbacks_.can_set_filters(callbacks_.user, out, count) == 1;
-  }
-
-  hal::CanErrorCounters error_counters() const override { return counters_; }
-
- private:
-  const cdcr_callbacks& callbacks_;
-  hal::CanFrame queue_[kInputQueueDepth] = {};
-  int head_ = 0;
+  Input inputs_[kInputQueueDepth] = {};
   int count_ = 0;
-  hal::CanErrorCounters counters_;
+  int frames_ = 0;
 };
 
-class ImageStorage final : public hal::ModelStorage {
- public:
-  ImageStorage(const std::uint8_t* data, std::uint32_t size) : region_{data, data != nullptr ? size : 0} {}
-  hal::MemoryRegion model_region() const override { return region_; }
-
- private:
-  hal::MemoryRegion region_;
-};
-
-class CallbackConsole final : public hal::Console {
- public:
-  explicit CallbackConsole(const cdcr_callbacks& callbacks) : callbacks_(callbacks) {}
-  void write_line(const char* line) override {
-    if (callbacks_.console_write_line != nullptr) callbacks_.console_write_line(callbacks_.user, line);
-  }
-
- private:
-  const cdcr_callbacks& callbacks_;
-};
-
-// Everything cdcr_runtime holds. The HAL objects come before the runtime,
-// which keeps references to them.
+// Everything cdcr_runtime holds. The HAL comes before the runtime, which
+// keeps references to its parts.
 struct CRuntime {
   CRuntime(const cdcr_config& config, const Geometry& fallback)
-      : callbacks(config.callbacks),
-        clock(callbacks),
-        timer(clock),
-        bus(callbacks),
-        storage(config.model_image, config.model_image_size),
-        console(callbacks),
-        runtime(hal::Hal{clock, timer, bus, storage, console}, fallback) {}
+      : hal(config.callbacks, config.model_image, config.model_image_size), runtime(hal.hal(), fallback) {}
 
   std::uint32_t magic = 0;
-  cdcr_callbacks callbacks;
-  CallbackClock clock;
-  SteppedTimer timer;
-  CallbackBus bus;
-  ImageStorage storage;
-  CallbackConsole console;
+  callbacks::CallbackHal hal;
+  InputQueue inputs;
   Runtime runtime;
 };
 
@@ -235,7 +179,7 @@ cdcr_result cdcr_init(cdcr_runtime* runtime, const cdcr_config* config) {
   firmware::Geometry fallback;
   if (!firmware::geometry_from_config(config->fallback_geometry, fallback)) return CDCR_ERROR_INVALID_ARGUMENT;
   auto* c = new (firmware::aligned_storage(runtime)) CRuntime(*config, fallback);
-  c->timer.start(config->period_ns);
+  c->hal.timer().start(config->period_ns);
   c->runtime.init();
   c->magic = firmware::kInitializedMagic;
   return CDCR_OK;
@@ -244,7 +188,7 @@ cdcr_result cdcr_init(cdcr_runtime* runtime, const cdcr_config* config) {
 cdcr_result cdcr_step(cdcr_runtime* runtime) {
   CRuntime* c = nullptr;
   if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
-  c->runtime.run_cycle(c->timer.wait_next());
+  c->runtime.run_cycle(c->hal.timer().wait_next(), &c->inputs);
   return CDCR_OK;
 }
 
@@ -253,16 +197,11 @@ cdcr_result cdcr_set_segment_cable_lengths(cdcr_runtime* runtime, int segment, c
   if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
   if (lengths_mm == nullptr) return CDCR_ERROR_NULL_ARGUMENT;
   if (segment < 0 || segment >= c->runtime.geometry().segment_count) return CDCR_ERROR_INVALID_ARGUMENT;
-  protocol::CableFeedback feedback;
-  feedback.segment = segment;
   for (int k = 0; k < 4; ++k) {
     if (!protocol::cable_length_encodable(lengths_mm[k])) return CDCR_ERROR_OUT_OF_RANGE;
-    feedback.lengths_mm[k] = lengths_mm[k];
   }
-  if (!c->bus.has_room(1)) return CDCR_ERROR_QUEUE_FULL;
-  cdcr::hal::CanFrame frame;
-  protocol::encode(feedback, frame);
-  c->bus.queue(frame);
+  if (!c->inputs.has_room(1)) return CDCR_ERROR_QUEUE_FULL;
+  c->inputs.push_cables(segment, lengths_mm);
   return CDCR_OK;
 }
 
@@ -276,7 +215,7 @@ cdcr_result cdcr_set_cable_lengths(cdcr_runtime* runtime, const float* lengths_m
   for (size_t i = 0; i < count; ++i) {
     if (!protocol::cable_length_encodable(lengths_mm[i])) return CDCR_ERROR_OUT_OF_RANGE;
   }
-  if (!c->bus.has_room(segments)) return CDCR_ERROR_QUEUE_FULL;
+  if (!c->inputs.has_room(segments)) return CDCR_ERROR_QUEUE_FULL;
   for (int s = 0; s < segments; ++s) cdcr_set_segment_cable_lengths(runtime, s, lengths_mm + 4 * s);
   return CDCR_OK;
 }
@@ -284,10 +223,10 @@ cdcr_result cdcr_set_cable_lengths(cdcr_runtime* runtime, const float* lengths_m
 cdcr_result cdcr_set_payload(cdcr_runtime* runtime, float payload_kg) {
   CRuntime* c = nullptr;
   if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
-  cdcr::hal::CanFrame frame;
-  if (!protocol::encode(protocol::Payload{payload_kg}, frame)) return CDCR_ERROR_OUT_OF_RANGE;
-  if (!c->bus.has_room(1)) return CDCR_ERROR_QUEUE_FULL;
-  c->bus.queue(frame);
+  std::int64_t raw = 0;
+  if (!protocol::to_raw_checked(protocol::payload::kPayload, payload_kg, raw)) return CDCR_ERROR_OUT_OF_RANGE;
+  if (!c->inputs.has_room(1)) return CDCR_ERROR_QUEUE_FULL;
+  c->inputs.push_payload(payload_kg);
   return CDCR_OK;
 }
 
@@ -309,24 +248,8 @@ cdcr_result cdcr_set_target(cdcr_runtime* runtime, const cdcr_target* target) {
     }
     if (std::fabs(std::sqrt(norm2) - 1.0) > protocol::kQuaternionNormTolerance) return CDCR_ERROR_INVALID_ARGUMENT;
   }
-  if (!c->bus.has_room(pose ? 3 : 2)) return CDCR_ERROR_QUEUE_FULL;
-  cdcr::hal::CanFrame frame;
-  if (pose) {
-    protocol::encode(protocol::TargetOrientation{target->quaternion[0], target->quaternion[1],
-                                                 target->quaternion[2], target->quaternion[3]},
-                     frame);
-    c->bus.queue(frame);
-  }
-  protocol::encode(protocol::TargetPositionXy{target->position_mm[0], target->position_mm[1]}, frame);
-  c->bus.queue(frame);
-  protocol::TargetPositionZ commit;
-  commit.z_mm = target->position_mm[2];
-  commit.mode = pose ? protocol::TargetMode::pose : protocol::TargetMode::position;
-  commit.tracking = target->tracking != 0;
-  commit.refuse_extrapolating = target->refuse_extrapolating != 0;
-  commit.sequence = target->sequence;
-  protocol::encode(commit, frame);
-  c->bus.queue(frame);
+  if (!c->inputs.has_room(pose ? 3 : 2)) return CDCR_ERROR_QUEUE_FULL;
+  c->inputs.push_target(*target);
   return CDCR_OK;
 }
 

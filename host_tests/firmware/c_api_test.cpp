@@ -25,9 +25,11 @@ namespace {
 // Corrections of a few tenths of a millimetre, as a trained model makes.
 // With fitted_range_offset, the image's fitted input range is moved that
 // far (in every input) from where its points are, so every query is outside.
-std::vector<std::uint8_t> small_image(int segments = 2, double fitted_range_offset = 0.0) {
+// With payload_input, the model has the payload as an input.
+std::vector<std::uint8_t> small_image(int segments = 2, double fitted_range_offset = 0.0, bool payload_input = false) {
   test_support::SyntheticModelOptions options;
   options.segments = segments;
+  options.payload_input = payload_input;
   training::TrainedModel m = test_support::synthetic_trained_model(options);
   for (int k = 0; k < 6; ++k) {
     m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
@@ -409,6 +411,151 @@ TEST_F(CApiRuntime, CanCallbacksCarryTheProtocol) {
   config.callbacks.can_set_filters = nullptr;
   ASSERT_EQ(cdcr_init(&runtime, &config), CDCR_OK);
   EXPECT_EQ(status().fault, CDCR_FAULT_CAN_FILTERS_REFUSED);
+}
+
+// Inputs given by call reach the runtime as their frames would: a runtime
+// fed through cdcr_set_* and one fed the same inputs as frames on its bus
+// send the same frames, byte for byte, with lengths, positions, quaternions
+// and payload off the protocol's steps.
+class CallsAndFrames {
+ public:
+  explicit CallsAndFrames(const std::vector<std::uint8_t>& image) {
+    cdcr_config config{};
+    config.model_image = image.data();
+    config.model_image_size = std::uint32_t(image.size());
+    config.fallback_geometry = cdcr_geometry{2, 120.0f, 67.0f, 1.5707963f};
+    for (int i = 0; i < 2; ++i) {
+      config.callbacks.user = &buses_[i];
+      config.callbacks.can_send = [](void* user, const cdcr_can_frame* frame) {
+        static_cast<Bus*>(user)->sent.push_back(*frame);
+        return 0;
+      };
+      config.callbacks.can_receive = [](void* user, cdcr_can_frame* frame) {
+        Bus& b = *static_cast<Bus*>(user);
+        if (b.inbox.empty()) return 0;
+        *frame = b.inbox.front();
+        b.inbox.erase(b.inbox.begin());
+        return 1;
+      };
+      config.callbacks.can_set_filters = [](void*, const cdcr_can_filter*, size_t) { return 1; };
+      EXPECT_EQ(cdcr_init(&runtimes_[i], &config), CDCR_OK);
+    }
+  }
+
+  void cables(const std::vector<float>& lengths) {
+    ASSERT_EQ(cdcr_set_cable_lengths(&runtimes_[0], lengths.data(), lengths.size()), CDCR_OK);
+    for (int s = 0; s < int(lengths.size()) / 4; ++s) {
+      protocol::CableFeedback feedback;
+      feedback.segment = s;
+      for (int k = 0; k < 4; ++k) feedback.lengths_mm[k] = lengths[4 * s + k];
+      hal::CanFrame frame;
+      ASSERT_TRUE(protocol::encode(feedback, frame));
+      put(frame);
+    }
+  }
+  void target(const cdcr_target& target) {
+    ASSERT_EQ(cdcr_set_target(&runtimes_[0], &target), CDCR_OK);
+    hal::CanFrame frame;
+    const bool pose = target.mode == CDCR_TARGET_POSE;
+    if (pose) {
+      protocol::encode(protocol::TargetOrientation{target.quaternion[0], target.quaternion[1], target.quaternion[2],
+                                                   target.quaternion[3]},
+                       frame);
+      put(frame);
+    }
+    protocol::encode(protocol::TargetPositionXy{target.position_mm[0], target.position_mm[1]}, frame);
+    put(frame);
+    protocol::TargetPositionZ commit;
+    commit.z_mm = target.position_mm[2];
+    commit.mode = pose ? protocol::TargetMode::pose : protocol::TargetMode::position;
+    commit.tracking = target.tracking != 0;
+    commit.refuse_extrapolating = target.refuse_extrapolating != 0;
+    commit.sequence = target.sequence;
+    protocol::encode(commit, frame);
+    put(frame);
+  }
+  void payload(float payload_kg) {
+    ASSERT_EQ(cdcr_set_payload(&runtimes_[0], payload_kg), CDCR_OK);
+    hal::CanFrame frame;
+    ASSERT_TRUE(protocol::encode(protocol::Payload{payload_kg}, frame));
+    put(frame);
+  }
+  // A step of both; what they computed is the same, to the bit.
+  void step() {
+    for (cdcr_runtime& runtime : runtimes_) ASSERT_EQ(cdcr_step(&runtime), CDCR_OK);
+    cdcr_pose poses[2] = {};
+    cdcr_setpoints setpoints[2] = {};
+    cdcr_status statuses[2] = {};
+    for (int i = 0; i < 2; ++i) {
+      ASSERT_EQ(cdcr_get_pose(&runtimes_[i], &poses[i]), CDCR_OK);
+      cdcr_get_setpoints(&runtimes_[i], &setpoints[i]);
+      ASSERT_EQ(cdcr_get_status(&runtimes_[i], &statuses[i]), CDCR_OK);
+    }
+    EXPECT_EQ(std::memcmp(&poses[0], &poses[1], sizeof poses[0]), 0);
+    EXPECT_EQ(std::memcmp(&setpoints[0], &setpoints[1], sizeof setpoints[0]), 0);
+    EXPECT_EQ(std::memcmp(&statuses[0], &statuses[1], sizeof statuses[0]), 0);
+  }
+  const cdcr_runtime& by_calls() const { return runtimes_[0]; }
+  const std::vector<cdcr_can_frame>& sent(int i) const { return buses_[i].sent; }
+
+ private:
+  void put(const hal::CanFrame& frame) {
+    cdcr_can_frame out{};
+    out.id = frame.id;
+    out.dlc = frame.dlc;
+    std::memcpy(out.data, frame.data, 8);
+    buses_[1].inbox.push_back(out);
+  }
+
+  Bus buses_[2];
+  cdcr_runtime runtimes_[2] = {};
+};
+
+TEST(CApiInputs, ByCallAndByFrameTheRuntimeSendsTheSameFrames) {
+  CallsAndFrames runtimes(small_image(2, 0.0, /*payload_input=*/true));
+  std::vector<float> lengths = bent_cables(Geometry::uniform(2, 120.0f, 67.0f), 0.1);
+  // Between two of the protocol's steps, by a different fraction each.
+  for (std::size_t i = 0; i < lengths.size(); ++i) lengths[i] += 0.0011f * float(i % 4 + 1);
+  runtimes.cables(lengths);
+  runtimes.step();
+  cdcr_pose start{};
+  ASSERT_EQ(cdcr_get_pose(&runtimes.by_calls(), &start), CDCR_OK);
+
+  cdcr_target target{};
+  target.position_mm[0] = start.position_mm[0] + 2.0037f;
+  target.position_mm[1] = start.position_mm[1] - 1.0063f;
+  target.position_mm[2] = start.position_mm[2] - 0.5041f;
+  for (int i = 0; i < 4; ++i) target.quaternion[i] = start.quaternion[i];
+  target.quaternion[1] += 0.00123f;  // off the Q15 steps, within the norm's tolerance
+  target.mode = CDCR_TARGET_POSE;
+  target.sequence = 7;
+  runtimes.payload(0.2503f);
+  runtimes.target(target);
+  for (int k = 0; k < 40; ++k) {
+    if (k == 20) {  // a streamed position target, and another one superseding it in the same step
+      target.mode = CDCR_TARGET_POSITION;
+      target.tracking = 1;
+      target.position_mm[0] += 0.0313f;
+      ++target.sequence;
+      runtimes.target(target);
+      target.position_mm[1] -= 0.0271f;
+      ++target.sequence;
+      runtimes.target(target);
+    }
+    runtimes.cables(lengths);
+    runtimes.step();
+  }
+  const std::vector<cdcr_can_frame>& by_calls = runtimes.sent(0);
+  const std::vector<cdcr_can_frame>& by_frames = runtimes.sent(1);
+  int setpoints = 0;
+  for (const cdcr_can_frame& frame : by_calls) setpoints += frame.id == protocol::cable_setpoint::kMessage.id;
+  EXPECT_GT(setpoints, 0);
+  ASSERT_EQ(by_calls.size(), by_frames.size());
+  for (std::size_t i = 0; i < by_calls.size(); ++i) {
+    EXPECT_EQ(by_calls[i].id, by_frames[i].id) << "frame " << i;
+    EXPECT_EQ(by_calls[i].dlc, by_frames[i].dlc) << "frame " << i;
+    EXPECT_EQ(std::memcmp(by_calls[i].data, by_frames[i].data, 8), 0) << "frame " << i << ", id " << by_calls[i].id;
+  }
 }
 
 TEST_F(CApiRuntime, EveryUnusableArgumentHasItsErrorCode) {

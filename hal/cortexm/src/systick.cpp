@@ -31,8 +31,7 @@ void SysTickTimer::start(std::int64_t period_ns) {
   SysTickRegisters& registers = systick();
   registers.control = 0;
   periods_ = 0;
-  next_release_period_ = 1;
-  overruns_ = 0;
+  schedule_.start(1, 1);  // in periods: release k is the k-th reload
   registers.reload = reload_ticks_ - 1;
   registers.current = 0;  // any write clears the counter, so the first period is whole
   registers.control = kEnable | kInterrupt | kCoreClock;
@@ -60,13 +59,11 @@ std::int64_t SysTickTimer::now_ns() const {
 
 hal::TimerTick SysTickTimer::wait_next() {
   hal::TimerTick tick;
-  // Release k is the k-th reload; sleeping until an interrupt is the wait.
-  while (periods_ < next_release_period_) asm volatile("wfi" ::: "memory");
-  const std::uint64_t now = periods_;
-  tick.missed_releases = static_cast<std::uint32_t>(now - next_release_period_);
-  overruns_ += tick.missed_releases;
-  tick.release_ns = static_cast<std::int64_t>(now) * period_ns_;
-  next_release_period_ = now + 1;
+  // Sleeping until an interrupt is the wait; one that woke the core late
+  // serves the latest reload, and the ones before it are missed.
+  while (periods_ < std::uint64_t(schedule_.next_release())) asm volatile("wfi" ::: "memory");
+  tick.missed_releases = schedule_.skip_to_latest(static_cast<std::int64_t>(periods_));
+  tick.release_ns = schedule_.take() * period_ns_;
   return tick;
 }
 

@@ -12,6 +12,7 @@
 #include <cstdint>
 
 #include <cdcr/hal/clock.hpp>
+#include <cdcr/hal/release_schedule.hpp>
 
 namespace cdcr::cortexm {
 
@@ -27,7 +28,7 @@ class SysTickTimer final : public hal::MonotonicClock, public hal::PeriodicTimer
   void start(std::int64_t period_ns) override;
   hal::TimerTick wait_next() override;
   std::int64_t period_ns() const override { return period_ns_; }
-  std::uint32_t overruns() const override { return overruns_; }
+  std::uint32_t overruns() const override { return schedule_.missed_total(); }
 
   std::int64_t now_ns() const override;
   // Core clock ticks since start().
@@ -45,8 +46,7 @@ class SysTickTimer final : public hal::MonotonicClock, public hal::PeriodicTimer
   std::uint32_t reload_ticks_ = 0;  // ticks per period
   std::int64_t period_ns_ = 0;
   volatile std::uint64_t periods_ = 0;
-  std::uint64_t next_release_period_ = 1;
-  std::uint32_t overruns_ = 0;
+  hal::ReleaseSchedule schedule_;  // in periods
 };
 
 // The timer the SysTick exception reports to; one per core.

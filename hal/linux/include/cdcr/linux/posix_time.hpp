@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include <cdcr/hal/clock.hpp>
+#include <cdcr/hal/release_schedule.hpp>
 
 namespace cdcr::linux_host {
 
@@ -32,15 +33,13 @@ class PosixPeriodicTimer final : public hal::PeriodicTimer {
   // Release 1 is one period after start().
   void start(std::int64_t period_ns) override;
   hal::TimerTick wait_next() override;
-  std::int64_t period_ns() const override { return period_ns_; }
-  std::uint32_t overruns() const override { return overruns_; }
+  std::int64_t period_ns() const override { return schedule_.period(); }
+  std::uint32_t overruns() const override { return schedule_.missed_total(); }
 
  private:
   const hal::MonotonicClock& clock_;
   ReleaseWait wait_;
-  std::int64_t period_ns_ = 0;
-  std::int64_t next_release_ns_ = 0;
-  std::uint32_t overruns_ = 0;
+  hal::ReleaseSchedule schedule_;
 };
 
 }  // namespace cdcr::linux_host

@@ -7,6 +7,7 @@
 #include <cstdint>
 
 #include <cdcr/hal/clock.hpp>
+#include <cdcr/hal/release_schedule.hpp>
 
 namespace cdcr::sim {
 
@@ -28,33 +29,24 @@ class LockstepTimer final : public hal::PeriodicTimer {
  public:
   explicit LockstepTimer(LockstepClock& clock) : clock_(clock) {}
 
-  void start(std::int64_t period_ns) override {
-    period_ns_ = period_ns;
-    next_release_ns_ = clock_.now_ns() + period_ns;
-    overruns_ = 0;
-  }
+  // Release 1 is one period after start().
+  void start(std::int64_t period_ns) override { schedule_.start(clock_.now_ns() + period_ns, period_ns); }
 
+  // The releases already past are missed; the clock jumps to the next.
   hal::TimerTick wait_next() override {
     hal::TimerTick tick;
-    while (next_release_ns_ < clock_.now_ns()) {
-      next_release_ns_ += period_ns_;
-      tick.missed_releases += 1;
-    }
-    overruns_ += tick.missed_releases;
-    clock_.advance_to(next_release_ns_);
-    tick.release_ns = next_release_ns_;
-    next_release_ns_ += period_ns_;
+    tick.missed_releases = schedule_.skip_past(clock_.now_ns());
+    clock_.advance_to(schedule_.next_release());
+    tick.release_ns = schedule_.take();
     return tick;
   }
 
-  std::int64_t period_ns() const override { return period_ns_; }
-  std::uint32_t overruns() const override { return overruns_; }
+  std::int64_t period_ns() const override { return schedule_.period(); }
+  std::uint32_t overruns() const override { return schedule_.missed_total(); }
 
  private:
   LockstepClock& clock_;
-  std::int64_t period_ns_ = 0;
-  std::int64_t next_release_ns_ = 0;
-  std::uint32_t overruns_ = 0;
+  hal::ReleaseSchedule schedule_;
 };
 
 }  // namespace cdcr::sim
