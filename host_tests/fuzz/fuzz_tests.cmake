@@ -32,7 +32,8 @@ add_test(NAME fuzz.build
          COMMAND ${CMAKE_COMMAND} -DSOURCE_DIR=${CMAKE_CURRENT_LIST_DIR} -DBINARY_DIR=${fuzz_dir}
                  -DCXX=${CDCR_CLANGXX} -DCDCR_SOURCE_DIR=${PROJECT_SOURCE_DIR} "-DGENERATOR=${CMAKE_GENERATOR}"
                  -P ${CMAKE_CURRENT_LIST_DIR}/build_fuzzers.cmake)
-set_tests_properties(fuzz.build PROPERTIES LABELS fuzz FIXTURES_SETUP cdcr_fuzzers TIMEOUT 1200)
+# COST: started early (see host_tests/qemu/CMakeLists.txt).
+set_tests_properties(fuzz.build PROPERTIES LABELS fuzz FIXTURES_SETUP cdcr_fuzzers TIMEOUT 1200 COST 500)
 cdcr_require_dependency_check(fuzz fuzz.build)
 
 # cdcr_fuzz_test(<name> SEEDS <seed dir> [FLAGS <libFuzzer flags...>])
