@@ -39,7 +39,6 @@ constexpr model::ForwardCycleInstructions kForwardCycle = model::kCortexM4fForwa
 #else
 constexpr model::ForwardCycleInstructions kForwardCycle = model::kCortexM7ForwardCycle;
 #endif
-using cdcr::boards::mps2::kCountingPeriodNs;
 
 cdcr::boards::mps2::Board board;
 cdcr::firmware::Runtime runtime(board.hal(), cdcr::boards::mps2::golden_geometry());
@@ -109,17 +108,8 @@ void drain_transmitted() {
 
 int main() {
   cdcr::cortexm::paint_stack();
-  cdcr::cortexm::attach_systick(board.timer);
-  board.timer.start(kCountingPeriodNs);
-  if (runtime.init() != cdcr::firmware::RuntimeState::run) {
-    console::console_write("FAIL: the runtime did not boot into RUN\n");
-    return 1;
-  }
   model::ImageView image{};
-  if (!cdcr::qemu_programs::bind_board_image(board, correction, image)) {
-    console::console_write("FAIL: cannot bind the image\n");
-    return 1;
-  }
+  if (!cdcr::qemu_programs::start_counting(board, runtime, correction, image)) return 1;
   console::console_write("model: ");
   console::console_write_int(static_cast<std::int32_t>(image.training_points));
   console::console_write(" training points, ");

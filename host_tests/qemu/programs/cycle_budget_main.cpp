@@ -31,7 +31,6 @@ namespace model = cdcr::model;
 namespace firmware = cdcr::firmware;
 namespace protocol = cdcr::firmware::protocol;
 
-using cdcr::boards::mps2::kCountingPeriodNs;
 constexpr std::uint32_t kBudgetInstructions = cdcr::boards::mps2::kCycleBudgetInstructions;
 
 cdcr::boards::mps2::Board board;
@@ -41,12 +40,6 @@ firmware::Correction correction;
 cdcr::boards::mps2::InstructionCounter counter{board.timer};
 
 std::uint32_t counted_cycle() { return cdcr::qemu_programs::counted_cycle(counter, board, runtime); }
-
-// Instructions of one call of work(), as counted_cycle() counts a cycle.
-template <typename Work>
-std::uint32_t counted(Work&& work) {
-  return counter.instructions(work);
-}
 
 // The same workload on every run and both boards (workload.hpp).
 cdcr::qemu_programs::Random random_numbers{0x2545F491u};
@@ -180,10 +173,10 @@ void report_unit_costs() {
   for (int s = 0; s < segments; ++s) bend[2 * s] = 0.1f;
   firmware::Correction::Evaluation evaluation;
   probe_correction.begin_evaluation(bend, evaluation, false);
-  const std::uint32_t mean = counted([&] { probe_correction.continue_evaluation(evaluation, points); });
+  const std::uint32_t mean = counter.instructions([&] { probe_correction.continue_evaluation(evaluation, points); });
   probe_correction.begin_evaluation(bend, evaluation, true);
   const std::uint32_t gradient =
-      counted([&] { probe_correction.continue_evaluation(evaluation, points * firmware::Correction::kGradientPointUnits); });
+      counter.instructions([&] { probe_correction.continue_evaluation(evaluation, points * firmware::Correction::kGradientPointUnits); });
   // Each run(kProbeBudget) call of a solver charged these costs does one
   // step, told apart by the units it returns.
   constexpr std::uint32_t kProbeJacobian = 100'000, kProbeStep = 99'999, kProbeOuter = 99'998;
@@ -204,10 +197,10 @@ void report_unit_costs() {
       initial[2 * s + 1] = 0.1f;
     }
     const model::IkTargetKind kind = t % 4 < 2 ? model::IkTargetKind::pose : model::IkTargetKind::position;
-    start_max = std::max(start_max, counted([&] { probe_solver.start(target, kind, initial); }));
+    start_max = std::max(start_max, counter.instructions([&] { probe_solver.start(target, kind, initial); }));
     for (int call = 0; call < 4000 && probe_solver.state() == model::IkSolveState::running; ++call) {
       std::uint32_t units = 0;
-      const std::uint32_t instructions = counted([&] { units = probe_solver.run(kProbeBudget); });
+      const std::uint32_t instructions = counter.instructions([&] { units = probe_solver.run(kProbeBudget); });
       for (Step& step : steps) {
         if (units != step.units) continue;
         step.max = std::max(step.max, instructions);
@@ -238,7 +231,7 @@ void report_unit_costs() {
   }
   model::CableVector<float, firmware::kMaxSegments> cables;
   cdcr::hal::CanFrame frames[firmware::kMaxSegments];
-  const std::uint32_t setpoints = counted([&] {
+  const std::uint32_t setpoints = counter.instructions([&] {
     model::cables_from_joints(joints, runtime.geometry(), cables);
     for (int s = 0; s < segments; ++s) {
       protocol::encode(
@@ -246,7 +239,7 @@ void report_unit_costs() {
           frames[s]);
     }
   });
-  const std::uint32_t report = counted([&] {
+  const std::uint32_t report = counter.instructions([&] {
     protocol::encode(protocol::IkReport{1, protocol::IkOutcome::converged, 12, 30, 0.001, 0.0001}, frames[0]);
   });
   write("; setpoints ", setpoints);
@@ -257,17 +250,8 @@ void report_unit_costs() {
 }  // namespace
 
 int main() {
-  cdcr::cortexm::attach_systick(board.timer);
-  board.timer.start(kCountingPeriodNs);
-  if (runtime.init() != firmware::RuntimeState::run) {
-    console::console_write("FAIL: the runtime did not boot into RUN\n");
-    return 1;
-  }
   model::ImageView image{};
-  if (!cdcr::qemu_programs::bind_board_image(board, correction, image)) {
-    console::console_write("FAIL: cannot bind the image\n");
-    return 1;
-  }
+  if (!cdcr::qemu_programs::start_counting(board, runtime, correction, image)) return 1;
   segments = runtime.geometry().segment_count;
   counter.calibrate();
   console::console_write("model: ");

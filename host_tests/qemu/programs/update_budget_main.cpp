@@ -36,7 +36,6 @@ namespace model = cdcr::model;
 namespace firmware = cdcr::firmware;
 namespace protocol = cdcr::firmware::protocol;
 
-using cdcr::boards::mps2::kCountingPeriodNs;
 constexpr std::uint32_t kBudgetInstructions = cdcr::boards::mps2::kCycleBudgetInstructions;
 
 // Two slots, each a metadata sector and 16 image sectors of 4 KiB: room for
@@ -59,12 +58,6 @@ cdcr::boards::mps2::InstructionCounter counter{board.timer};
 
 std::uint32_t counted_cycle() { return cdcr::qemu_programs::counted_cycle(counter, board, runtime); }
 
-// Instructions of one call of work(), as counted_cycle() counts a cycle.
-template <typename Work>
-std::uint32_t counted(Work&& work) {
-  return counter.instructions(work);
-}
-
 // What the update's charges stand for on this core: 64 bytes of the
 // verification pass (SHA-256 and the parser's scan), the most of 16 such.
 void report_update_costs(const std::uint8_t* image, std::uint32_t size) {
@@ -73,7 +66,7 @@ void report_update_costs(const std::uint8_t* image, std::uint32_t size) {
   scan.begin(image, size);
   std::uint32_t most = 0;
   for (std::uint32_t at = 0; at + 64 <= 1024 && at + 64 <= size; at += 64) {
-    most = std::max(most, counted([&] {
+    most = std::max(most, counter.instructions([&] {
       hash.update(image + at, 64);
       scan.step(64);
     }));
@@ -205,16 +198,11 @@ alignas(8) std::uint8_t second_image[64 * 1024];
 }  // namespace
 
 int main() {
-  cdcr::cortexm::attach_systick(board.timer);
-  board.timer.start(kCountingPeriodNs);
-  if (runtime.init() != firmware::RuntimeState::run || !runtime.model_update().enabled()) {
-    console::console_write("FAIL: the runtime did not boot into RUN with model updates enabled\n");
-    return 1;
-  }
-  const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
   model::ImageView image{};
-  if (!cdcr::qemu_programs::bind_board_image(board, correction, image) || region.size_bytes > sizeof(second_image)) {
-    console::console_write("FAIL: cannot bind the image\n");
+  if (!cdcr::qemu_programs::start_counting(board, runtime, correction, image)) return 1;
+  const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
+  if (!runtime.model_update().enabled() || region.size_bytes > sizeof(second_image)) {
+    console::console_write("FAIL: model updates are not enabled, or the image is larger than the second one's room\n");
     return 1;
   }
   segments = runtime.geometry().segment_count;

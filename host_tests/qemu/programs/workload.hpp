@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <cstdint>
 
+#include <cdcr/cortexm/semihosting.hpp>
 #include <cdcr/firmware/runtime.hpp>
 
 #include "board.hpp"
@@ -121,6 +122,24 @@ inline bool bind_board_image(boards::mps2::Board& board, firmware::Correction& c
   const hal::MemoryRegion region = board.model_storage.model_region();
   return model::parse_image(region.data, region.size_bytes, image, model::ImageCapacity{}) == model::ImageStatus::ok &&
          correction.bind(image) == model::Status::ok;
+}
+
+// The start every measuring program makes: SysTick counting at
+// kCountingPeriodNs, the runtime booted into RUN, and the board's image bound
+// to `correction`. False, with the reason printed, when one of them fails.
+inline bool start_counting(boards::mps2::Board& board, firmware::Runtime& runtime,
+                           firmware::Correction& correction, model::ImageView& image) {
+  cortexm::attach_systick(board.timer);
+  board.timer.start(boards::mps2::kCountingPeriodNs);
+  if (runtime.init() != firmware::RuntimeState::run) {
+    cortexm::console_write("FAIL: the runtime did not boot into RUN\n");
+    return false;
+  }
+  if (!bind_board_image(board, correction, image)) {
+    cortexm::console_write("FAIL: cannot bind the image\n");
+    return false;
+  }
+  return true;
 }
 
 // `worst cycle: N instructions over C cycles (budget B)`, the line the
