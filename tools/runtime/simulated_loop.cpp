@@ -32,6 +32,16 @@ namespace sim = cdcr::sim;
 
 namespace {
 
+// The sum and the largest of a run of errors, in mm.
+struct ErrorTally {
+  double sum_mm = 0;
+  double max_mm = 0;
+  void add(double error_mm) {
+    sum_mm += error_mm;
+    max_mm = std::max(max_mm, error_mm);
+  }
+};
+
 void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, std::uint8_t sequence) {
   for (const cdcr::hal::CanFrame& frame :
        sim::target_frames(target_mm, protocol::TargetMode::position, false, sequence)) {
@@ -154,7 +164,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   const double step_rad = speed_mm_s / radius_mm / rate_hz;
   const long stream_cycles = std::lround(2.0 * M_PI / step_rad);
   const std::uint32_t setpoints_before = runtime.setpoints_published();
-  double error_sum_mm = 0, error_max_mm = 0, following_sum_mm = 0, following_max_mm = 0;
+  ErrorTally error, following;
   model::Vec3<double> center_mm = model::Vec3<double>::Zero();
   for (long k = 1; k <= stream_cycles; ++k) {
     const model::Pose<double> target = target_at(step_rad * double(k));
@@ -163,11 +173,9 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
     send_pose_target(host, target, ++sequence, true);
     cycle();
     const double error_mm = (robot.true_pose(drives.cables_mm()).position_mm - target_mm).norm();
-    error_sum_mm += error_mm;
-    error_max_mm = std::max(error_max_mm, error_mm);
+    error.add(error_mm);
     const double following_mm = setpoints_to_target_mm(target);
-    following_sum_mm += following_mm;
-    following_max_mm = std::max(following_max_mm, following_mm);
+    following.add(following_mm);
   }
   const fw::CycleStatistics& stats = runtime.statistics();
   std::printf("state %s, fault: %s\n", fw::to_string(runtime.state()), fw::to_string(runtime.active_fault()));
@@ -175,10 +183,10 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
               "(%.1f, %.1f, %.1f) mm, %ld targets at %.0f Hz\n",
               radius_mm, speed_mm_s, bend_rad, center_mm.x(), center_mm.y(), center_mm.z(), stream_cycles, rate_hz);
   std::printf("tip vs streamed target (simulated robot): mean %.3f mm, max %.3f mm\n",
-              error_sum_mm / double(stream_cycles), error_max_mm);
+              error.sum_mm / double(stream_cycles), error.max_mm);
   std::printf("  of which following (the compensated model at the setpoints vs the target): mean %.3f mm, "
               "max %.3f mm\n",
-              following_sum_mm / double(stream_cycles), following_max_mm);
+              following.sum_mm / double(stream_cycles), following.max_mm);
   std::printf("setpoints sent in %u of %ld streamed cycles; cycles %ld, poses missing %ld, overruns %u, "
               "rejected frames %u; slowest cycle on this host %.1f us\n",
               runtime.setpoints_published() - setpoints_before, stream_cycles, cycles, poses_missing, stats.overruns,
@@ -219,21 +227,21 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
   const long cycles_per_target = std::max(1L, std::lround(0.5 * rate_hz));
   platform.timer.start(period_ns);
 
-  double estimate_error_sum_mm = 0, estimate_error_max_mm = 0;
+  ErrorTally estimate_error;
   long estimate_samples = 0;
-  double target_error_sum_mm = 0, target_error_max_mm = 0;
+  ErrorTally target_error;
   long targets_sent = 0, targets_checked = 0, targets_converged = 0;
   model::Vec3<double> target_mm = model::Vec3<double>::Zero();
   std::int64_t host_max_ns = 0, host_total_ns = 0;
   long host_overruns = 0;
   // The same measures for the nominal model alone, computed alongside on the
   // host: what compensation gains.
-  double nominal_estimate_error_sum_mm = 0, nominal_estimate_error_max_mm = 0;
-  double nominal_target_error_sum_mm = 0, nominal_target_error_max_mm = 0;
+  ErrorTally nominal_estimate_error;
+  ErrorTally nominal_target_error;
   long nominal_targets_reached = 0;
   // Both sides at their commanded cables, settled: the runtime's setpoints
   // against the nominal IK's.
-  double setpoint_target_error_sum_mm = 0, setpoint_target_error_max_mm = 0;
+  ErrorTally setpoint_target_error;
   long setpoints_checked = 0;
   model::JointVector<double> nominal_ik_joints(2 * geometry.segment_count);
   for (int s = 0; s < geometry.segment_count; ++s) {
@@ -247,16 +255,14 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
     if (k % cycles_per_target == 0) {
       if (targets_sent > 0) {
         const double error_mm = (robot.true_pose(drives.cables_mm()).position_mm - target_mm).norm();
-        target_error_sum_mm += error_mm;
-        target_error_max_mm = std::max(target_error_max_mm, error_mm);
+        target_error.add(error_mm);
         ++targets_checked;
         // The request spans cycles: its setpoints are checked when the next
         // target is due.
         if (runtime.has_setpoints() && runtime.last_ik_report().outcome == protocol::IkOutcome::converged) {
           const model::CableVector<double> setpoints_mm = runtime.setpoints_mm().cast<double>();
           const double setpoint_error_mm = (robot.true_pose(setpoints_mm).position_mm - target_mm).norm();
-          setpoint_target_error_sum_mm += setpoint_error_mm;
-          setpoint_target_error_max_mm = std::max(setpoint_target_error_max_mm, setpoint_error_mm);
+          setpoint_target_error.add(setpoint_error_mm);
           ++setpoints_checked;
         }
       }
@@ -269,8 +275,7 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
       if (nominal_ik.converged()) {
         nominal_ik_joints = nominal_ik.joints;
         const double error_mm = (robot.true_pose(nominal_ik.cables_mm).position_mm - target_mm).norm();
-        nominal_target_error_sum_mm += error_mm;
-        nominal_target_error_max_mm = std::max(nominal_target_error_max_mm, error_mm);
+        nominal_target_error.add(error_mm);
         ++nominal_targets_reached;
       }
     }
@@ -295,8 +300,7 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
       const double error_mm =
           (robot.true_pose(drives.cables_mm()).position_mm - runtime.latest_pose().pose.position_mm.cast<double>())
               .norm();
-      estimate_error_sum_mm += error_mm;
-      estimate_error_max_mm = std::max(estimate_error_max_mm, error_mm);
+      estimate_error.add(error_mm);
       ++estimate_samples;
       model::JointVector<double> nominal_joints;
       model::Pose<double> nominal_pose;
@@ -304,8 +308,7 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
           model::forward_kinematics(nominal_joints, geometry, nominal_pose) == model::Status::ok) {
         const double nominal_error_mm =
             (robot.true_pose(drives.cables_mm()).position_mm - nominal_pose.position_mm).norm();
-        nominal_estimate_error_sum_mm += nominal_error_mm;
-        nominal_estimate_error_max_mm = std::max(nominal_estimate_error_max_mm, nominal_error_mm);
+        nominal_estimate_error.add(nominal_error_mm);
       }
     }
   }
@@ -319,24 +322,24 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
               host_max_ns * 1e-3, cycles > 0 ? double(host_total_ns) / double(cycles) * 1e-3 : 0.0,
               double(period_ns) * 1e-3, host_overruns);
   std::printf("pose estimate vs simulated robot: mean %.3f mm, max %.3f mm over %ld cycles\n",
-              estimate_samples > 0 ? estimate_error_sum_mm / double(estimate_samples) : 0.0, estimate_error_max_mm,
+              estimate_samples > 0 ? estimate_error.sum_mm / double(estimate_samples) : 0.0, estimate_error.max_mm,
               estimate_samples);
   std::printf("targets: %ld sent, %ld converged; tip vs target after %.2f s: mean %.3f mm, max %.3f mm over %ld\n",
               targets_sent, targets_converged, double(cycles_per_target) / rate_hz,
-              targets_checked > 0 ? target_error_sum_mm / double(targets_checked) : 0.0, target_error_max_mm,
+              targets_checked > 0 ? target_error.sum_mm / double(targets_checked) : 0.0, target_error.max_mm,
               targets_checked);
   std::printf("accuracy, nominal model only -> %s runtime:\n",
               runtime.latest_pose().compensated ? "compensated" : "uncompensated");
   std::printf("  pose estimate vs robot: mean %.3f -> %.3f mm, max %.3f -> %.3f mm\n",
-              estimate_samples > 0 ? nominal_estimate_error_sum_mm / double(estimate_samples) : 0.0,
-              estimate_samples > 0 ? estimate_error_sum_mm / double(estimate_samples) : 0.0,
-              nominal_estimate_error_max_mm, estimate_error_max_mm);
+              estimate_samples > 0 ? nominal_estimate_error.sum_mm / double(estimate_samples) : 0.0,
+              estimate_samples > 0 ? estimate_error.sum_mm / double(estimate_samples) : 0.0,
+              nominal_estimate_error.max_mm, estimate_error.max_mm);
   std::printf("  tip vs target at the commanded cables (%ld and %ld of %ld solved): mean %.3f -> %.3f mm, "
               "max %.3f -> %.3f mm\n",
               nominal_targets_reached, setpoints_checked, targets_sent,
-              nominal_targets_reached > 0 ? nominal_target_error_sum_mm / double(nominal_targets_reached) : 0.0,
-              setpoints_checked > 0 ? setpoint_target_error_sum_mm / double(setpoints_checked) : 0.0,
-              nominal_target_error_max_mm, setpoint_target_error_max_mm);
+              nominal_targets_reached > 0 ? nominal_target_error.sum_mm / double(nominal_targets_reached) : 0.0,
+              setpoints_checked > 0 ? setpoint_target_error.sum_mm / double(setpoints_checked) : 0.0,
+              nominal_target_error.max_mm, setpoint_target_error.max_mm);
   return 0;
 }
 
