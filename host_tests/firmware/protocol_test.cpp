@@ -1,7 +1,10 @@
-// firmware/protocol/cdcr.dbc and the codec's table (protocol/messages.hpp)
-// describe the same frames: every message and signal of one is in the other,
-// with the same identifier, DLC, sender, start bit, length, byte order, sign,
-// factor, offset, range, unit and value table.
+// The DBC file the build writes from the codec's table (protocol/messages.hpp,
+// by firmware/protocol/write_dbc.cpp) describes the table's frames: read back
+// with a parser of this test's own, every message and signal of one is in the
+// other, with the same identifier, DLC, sender, start bit, length, byte order,
+// sign, factor, offset, range, unit and value table. This checks the writer
+// and the file's syntax; a wrong start bit or scale in the table itself is
+// what protocol_golden_frames_test.cpp catches.
 
 #include <cstdint>
 #include <fstream>

@@ -1,7 +1,8 @@
 #pragma once
 // One CAN message as a DBC declares it (identifier or per-segment identifier
-// range, DLC, sender, signals) and the checks every decoder runs on a frame
-// before it reads a signal.
+// range, DLC, sender, signals, and the notes a DBC file carries for its
+// readers) and the checks every decoder runs on a frame before it reads a
+// signal.
 
 #include <cstddef>
 #include <cstdint>
@@ -61,6 +62,37 @@ struct MessageSpec {
   hal::CanFilter group;  // acceptance filter of the frame group the message belongs to
 
   constexpr bool carries(std::uint32_t frame_id) const { return frame_id >= id && frame_id - id < id_count; }
+};
+
+// What the DBC file says about a message beyond its bits: the node that
+// receives it, and comments for people reading the database. The DBC writer
+// (firmware/protocol/write_dbc.cpp) reads them; the runtime does not, so on a
+// board they take no flash.
+struct SignalNote {
+  const SignalSpec* signal;
+  const char* text;  // CM_ SG_
+};
+
+struct SignalNotes {
+  const SignalNote* entries = nullptr;
+  std::uint8_t count = 0;
+
+  constexpr const SignalNote* begin() const { return entries; }
+  constexpr const SignalNote* end() const { return entries + count; }
+};
+
+template <std::size_t N>
+constexpr SignalNotes signal_notes(const SignalNote (&entries)[N]) {
+  return {entries, static_cast<std::uint8_t>(N)};
+}
+
+struct MessageNotes {
+  const MessageSpec* message;
+  const char* receiver;  // DBC node
+  // CM_ BO_, or "" for none. In a per-segment message, "{segment}" stands
+  // for the segment's number.
+  const char* comment = "";
+  SignalNotes signals = {};
 };
 
 // The data bits the message's signals define.
