@@ -8,7 +8,6 @@
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
-#include <iterator>
 #include <iostream>
 #include <sstream>
 #include <stdexcept>
@@ -59,13 +58,6 @@ std::string with_segment(std::string text, int segment) {
   return text;
 }
 
-const MessageNotes& notes_of(const MessageSpec& message) {
-  for (const MessageNotes* notes : kMessageNotes) {
-    if (notes->message == &message) return *notes;
-  }
-  throw std::runtime_error(std::string(message.name) + " has no MessageNotes in kMessageNotes");
-}
-
 void check_notes(const MessageNotes& notes) {
   for (const SignalNote& note : notes.signals) {
     bool found = false;
@@ -85,35 +77,34 @@ void write_signal(std::ostream& out, const SignalSpec& signal, const char* recei
 }
 
 void write_dbc(std::ostream& out) {
-  if (std::size(kMessageNotes) != std::size(kMessages)) {
-    throw std::runtime_error("kMessageNotes and kMessages list different numbers of messages");
-  }
   out << "VERSION " << quoted(kDbcVersion, "VERSION") << "\n\n";
   out << "NS_ :\n\nBS_:\n\nBU_:";
   for (const char* node : kDbcNodes) out << ' ' << node;
   out << "\n\n";
 
-  for (const MessageSpec* message : kMessages) {
-    const MessageNotes& notes = notes_of(*message);
-    check_notes(notes);
+  for (const MessageNotes* notes : kMessageNotes) {
+    check_notes(*notes);
+    const MessageSpec* message = notes->message;
     for (int i = 0; i < message->id_count; ++i) {
       out << "BO_ " << message->id + i << ' ' << frame_name(*message, i) << ": " << int(message->dlc) << ' '
           << message->sender << '\n';
-      for (const SignalSpec* signal : message->signals) write_signal(out, *signal, notes.receiver);
+      for (const SignalSpec* signal : message->signals) write_signal(out, *signal, notes->receiver);
       out << '\n';
     }
   }
 
   out << "CM_ " << quoted(kDbcComment, "the database comment") << ";\n";
-  for (const MessageSpec* message : kMessages) {
-    const MessageNotes& notes = notes_of(*message);
+  for (const MessageNotes* notes : kMessageNotes) {
+    const MessageSpec* message = notes->message;
     for (int i = 0; i < message->id_count; ++i) {
       const std::uint32_t id = message->id + i;
       const std::string name = frame_name(*message, i);
-      if (*notes.comment != '\0') out << "CM_ BO_ " << id << ' ' << quoted(with_segment(notes.comment, i), name) << ";\n";
+      if (*notes->comment != '\0') {
+        out << "CM_ BO_ " << id << ' ' << quoted(with_segment(notes->comment, i), name) << ";\n";
+      }
       // In the signals' order, whatever the order of the notes.
       for (const SignalSpec* signal : message->signals) {
-        for (const SignalNote& note : notes.signals) {
+        for (const SignalNote& note : notes->signals) {
           if (note.signal != signal) continue;
           out << "CM_ SG_ " << id << ' ' << signal->name << ' ' << quoted(note.text, name + "." + signal->name)
               << ";\n";

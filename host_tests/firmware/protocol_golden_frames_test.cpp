@@ -12,7 +12,9 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
+#include <cstdio>
 #include <iterator>
+#include <string>
 #include <type_traits>
 #include <vector>
 
@@ -34,10 +36,23 @@ hal::CanFrame frame_of(std::uint32_t id, const Bytes& bytes) {
   return frame;
 }
 
+// "0x122 [26 9E FF FF 05 5A]", to name the golden frame a failure is about.
+std::string golden_name(std::uint32_t id, const Bytes& bytes) {
+  char text[8];
+  std::snprintf(text, sizeof text, "0x%03X", static_cast<unsigned>(id));
+  std::string name = std::string(text) + " [";
+  for (std::size_t i = 0; i < bytes.size(); ++i) {
+    std::snprintf(text, sizeof text, i == 0 ? "%02X" : " %02X", bytes[i]);
+    name += text;
+  }
+  return name + "]";
+}
+
 // Encodes `message` into a frame whose bytes are all 0xAA first, so that a
 // byte the encoder forgets to write shows.
 template <typename Message>
 void expect_encodes_to(const Message& message, std::uint32_t id, const Bytes& bytes) {
+  SCOPED_TRACE("encoding golden frame " + golden_name(id, bytes));
   hal::CanFrame frame;
   std::fill(std::begin(frame.data), std::end(frame.data), std::uint8_t{0xAA});
   if constexpr (std::is_same_v<decltype(encode(message, frame)), bool>) {
@@ -52,8 +67,9 @@ void expect_encodes_to(const Message& message, std::uint32_t id, const Bytes& by
 
 template <typename Message>
 Message decoded(std::uint32_t id, const Bytes& bytes) {
+  SCOPED_TRACE("decoding golden frame " + golden_name(id, bytes));
   Message message;
-  EXPECT_EQ(decode(frame_of(id, bytes), message), DecodeStatus::ok);
+  EXPECT_STREQ(to_string(decode(frame_of(id, bytes), message)), to_string(DecodeStatus::ok));
   return message;
 }
 
@@ -63,33 +79,28 @@ void expect_physical(double actual, double expected) {
   EXPECT_NEAR(actual, expected, 1e-9 * std::max(1.0, std::fabs(expected)));
 }
 
-// 0x100 + s, DLC 8, from the drives. L1..L4: u16 at bits 0, 16, 32, 48,
-// 0.01 mm per bit.
-TEST(GoldenFrames, CableFeedback) {
-  // Segment 2: 0x102. 100.00 mm = 10000 = 0x2710; 123.45 mm = 12345 =
-  // 0x3039; 0.01 mm = 1; 655.34 mm = 65534 = 0xFFFE.
-  const Bytes bytes{0x10, 0x27, 0x39, 0x30, 0x01, 0x00, 0xFE, 0xFF};
-  expect_encodes_to(CableFeedback{2, {100.0, 123.45, 0.01, 655.34}}, 0x102, bytes);
-  const auto feedback = decoded<CableFeedback>(0x102, bytes);
-  EXPECT_EQ(feedback.segment, 2);
-  expect_physical(feedback.lengths_mm[0], 100.0);
-  expect_physical(feedback.lengths_mm[1], 123.45);
-  expect_physical(feedback.lengths_mm[2], 0.01);
-  expect_physical(feedback.lengths_mm[3], 655.34);
+// The four lengths of a CABLE_FEEDBACK_s or CABLE_SETPOINT_s frame decode
+// as sent: every golden length is a whole number of 0.01 mm.
+template <typename CableFrame>
+void expect_cable_golden(const CableFrame& sent, std::uint32_t id, const Bytes& bytes) {
+  expect_encodes_to(sent, id, bytes);
+  const auto received = decoded<CableFrame>(id, bytes);
+  EXPECT_EQ(received.segment, sent.segment);
+  for (int k = 0; k < 4; ++k) expect_physical(received.lengths_mm[k], sent.lengths_mm[k]);
 }
 
-// 0x110 + s, DLC 8, from the runtime: the same layout as CABLE_FEEDBACK.
-TEST(GoldenFrames, CableSetpoint) {
+// CABLE_FEEDBACK_s: 0x100 + s, DLC 8, from the drives; CABLE_SETPOINT_s:
+// 0x110 + s, DLC 8, from the runtime. L1..L4: u16 at bits 0, 16, 32, 48,
+// 0.01 mm per bit.
+TEST(GoldenFrames, CableFeedbackAndSetpoint) {
+  // Segment 2: 0x102. 100.00 mm = 10000 = 0x2710; 123.45 mm = 12345 =
+  // 0x3039; 0.01 mm = 1; 655.34 mm = 65534 = 0xFFFE.
+  expect_cable_golden(CableFeedback{2, {100.0, 123.45, 0.01, 655.34}}, 0x102,
+                      Bytes{0x10, 0x27, 0x39, 0x30, 0x01, 0x00, 0xFE, 0xFF});
   // Segment 7: 0x117. 0.5 mm = 50 = 0x0032; 225 mm = 22500 = 0x57E4;
   // 300.01 mm = 30001 = 0x7531; 42.42 mm = 4242 = 0x1092.
-  const Bytes bytes{0x32, 0x00, 0xE4, 0x57, 0x31, 0x75, 0x92, 0x10};
-  expect_encodes_to(CableSetpoint{7, {0.5, 225.0, 300.01, 42.42}}, 0x117, bytes);
-  const auto setpoint = decoded<CableSetpoint>(0x117, bytes);
-  EXPECT_EQ(setpoint.segment, 7);
-  expect_physical(setpoint.lengths_mm[0], 0.5);
-  expect_physical(setpoint.lengths_mm[1], 225.0);
-  expect_physical(setpoint.lengths_mm[2], 300.01);
-  expect_physical(setpoint.lengths_mm[3], 42.42);
+  expect_cable_golden(CableSetpoint{7, {0.5, 225.0, 300.01, 42.42}}, 0x117,
+                      Bytes{0x32, 0x00, 0xE4, 0x57, 0x31, 0x75, 0x92, 0x10});
 }
 
 // 0x120, DLC 8. QW, QX, QY, QZ: i16 at bits 0, 16, 32, 48, Q15 (raw =
@@ -277,15 +288,10 @@ TEST(GoldenFrames, Status) {
 TEST(GoldenFrames, Stats) {
   // 25 us = 0x0019; 4660 = 0x1234; 0xBEEF; checksum_mismatch = 7; 12 = 0x0C.
   const Bytes bytes{0x19, 0x00, 0x34, 0x12, 0xEF, 0xBE, 0x07, 0x0C};
-  Stats sent;
-  sent.jitter_max_us = 25;
-  sent.rejected_frames = 4660;
-  sent.cycle_count = 0xBEEF;
-  sent.fault_detail = FaultDetail(model::ImageStatus::checksum_mismatch);
-  sent.stale_events = 12;
-  expect_encodes_to(sent, 0x151, bytes);
+  expect_encodes_to(Stats{25, 4660, 0xBEEF, FaultDetail(model::ImageStatus::checksum_mismatch), 12}, 0x151, bytes);
   Stats stats;
-  ASSERT_EQ(decode(frame_of(0x151, bytes), FaultCode::image_invalid, stats), DecodeStatus::ok);
+  ASSERT_STREQ(to_string(decode(frame_of(0x151, bytes), FaultCode::image_invalid, stats)),
+               to_string(DecodeStatus::ok));
   EXPECT_EQ(stats.jitter_max_us, 25);
   EXPECT_EQ(stats.rejected_frames, 4660);
   EXPECT_EQ(stats.cycle_count, 0xBEEF);

@@ -4,6 +4,7 @@
 // readers) and the checks every decoder runs on a frame before it reads a
 // signal.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 
@@ -94,6 +95,14 @@ struct MessageNotes {
   const char* comment = "";
   SignalNotes signals = {};
 };
+
+// The messages of a list of notes, in its order.
+template <std::size_t N>
+constexpr std::array<const MessageSpec*, N> messages_of(const MessageNotes* const (&notes)[N]) {
+  std::array<const MessageSpec*, N> messages{};
+  for (std::size_t i = 0; i < N; ++i) messages[i] = notes[i]->message;
+  return messages;
+}
 
 // The data bits the message's signals define.
 constexpr std::uint64_t defined_bits(const MessageSpec& message) {

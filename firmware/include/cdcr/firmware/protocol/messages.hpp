@@ -467,19 +467,7 @@ inline constexpr MessageNotes kNotes{
     signal_notes(kSignalNotes)};
 }  // namespace update_report
 
-// Every message of the protocol, as the DBC lists them.
-inline constexpr const MessageSpec* kMessages[] = {
-    &cable_feedback::kMessage,     &cable_setpoint::kMessage,   &target_orientation::kMessage,
-    &target_position_xy::kMessage, &target_position_z::kMessage, &pose_position_xy::kMessage,
-    &pose_position_z::kMessage,    &pose_orientation::kMessage, &pose_uncertainty::kMessage,
-    &ik_report::kMessage,          &status::kMessage,           &stats::kMessage,
-    &payload::kMessage,
-    &update_command::kMessage,     &update_digest::kMessage,    &update_block::kMessage,
-    &update_data::kMessage,        &update_report::kMessage,
-};
-
-// What the DBC file says about each message beyond its bits, in the order of
-// kMessages (the DBC writer refuses a message without notes).
+// Every message of the protocol with its notes, as the DBC lists them.
 inline constexpr const MessageNotes* kMessageNotes[] = {
     &cable_feedback::kNotes,     &cable_setpoint::kNotes,   &target_orientation::kNotes,
     &target_position_xy::kNotes, &target_position_z::kNotes, &pose_position_xy::kNotes,
@@ -489,5 +477,8 @@ inline constexpr const MessageNotes* kMessageNotes[] = {
     &update_command::kNotes,     &update_digest::kNotes,    &update_block::kNotes,
     &update_data::kNotes,        &update_report::kNotes,
 };
+
+// Every message of the protocol, in the same order.
+inline constexpr auto kMessages = messages_of(kMessageNotes);
 
 }  // namespace cdcr::firmware::protocol
