@@ -1,7 +1,10 @@
-// firmware/protocol/cdcr.dbc and the codec's table (protocol/messages.hpp)
-// describe the same frames: every message and signal of one is in the other,
-// with the same identifier, DLC, sender, start bit, length, byte order, sign,
-// factor, offset, range, unit and value table.
+// The DBC file the build writes from the codec's table (protocol/messages.hpp,
+// by firmware/protocol/write_dbc.cpp) describes the table's frames: read back
+// with a parser of this test's own, every message and signal of one is in the
+// other, with the same identifier, DLC, sender, start bit, length, byte order,
+// sign, factor, offset, range, unit and value table. This checks the writer
+// and the file's syntax; a wrong start bit or scale in the table itself is
+// what protocol_golden_frames_test.cpp catches.
 
 #include <cstdint>
 #include <fstream>
@@ -32,6 +35,7 @@ struct DbcSignal {
   double minimum = 0;
   double maximum = 0;
   std::string unit;
+  std::string receivers;
 };
 
 struct DbcMessage {
@@ -42,6 +46,7 @@ struct DbcMessage {
 };
 
 struct Dbc {
+  std::set<std::string> nodes;  // BU_
   std::map<std::uint32_t, DbcMessage> messages;
   std::map<std::pair<std::uint32_t, std::string>, ValueMap> value_tables;      // VAL_
   std::map<std::pair<std::uint32_t, std::string>, std::string> signal_notes;  // CM_ SG_
@@ -61,7 +66,8 @@ Dbc read_dbc(const std::string& path) {
   EXPECT_TRUE(in) << path;
   const std::regex message(R"re(^BO_ (\d+) (\w+): (\d+) (\w+)\s*$)re");
   const std::regex signal(
-      R"re(^ SG_ (\w+) : (\d+)\|(\d+)@([01])([+-]) \(([^,]+),([^)]+)\) \[([^|]+)\|([^\]]+)\] "([^"]*)" .+$)re");
+      R"re(^ SG_ (\w+) : (\d+)\|(\d+)@([01])([+-]) \(([^,]+),([^)]+)\) \[([^|]+)\|([^\]]+)\] "([^"]*)" (.+)$)re");
+  const std::regex nodes(R"re(^BU_:((?: \w+)*)\s*$)re");
   const std::regex value_table(R"re(^VAL_ (\d+) (\w+) ((?:\d+ "[^"]*" )*);\s*$)re");
   const std::regex signal_note(R"re(^CM_ SG_ (\d+) (\w+) "([^"]*)";\s*$)re");
   Dbc dbc;
@@ -82,7 +88,11 @@ Dbc read_dbc(const std::string& path) {
       EXPECT_EQ(current->signals.count(m[1]), 0u) << "signal listed twice: " << line;
       current->signals[m[1]] = DbcSignal{std::stoi(m[2]),  std::stoi(m[3]),  std::stoi(m[4]),
                                          m[5] == "-",      std::stod(m[6]),  std::stod(m[7]),
-                                         std::stod(m[8]),  std::stod(m[9]),  m[10]};
+                                         std::stod(m[8]),  std::stod(m[9]),  m[10],
+                                         m[11]};
+    } else if (std::regex_match(line, m, nodes)) {
+      std::istringstream names(m[1]);
+      for (std::string name; names >> name;) dbc.nodes.insert(name);
     } else if (std::regex_match(line, m, value_table)) {
       dbc.value_tables[{static_cast<std::uint32_t>(std::stoul(m[1])), m[2]}] = parse_values(m[3]);
     } else if (std::regex_match(line, m, signal_note)) {
@@ -194,6 +204,26 @@ TEST(DbcAgreesWithTheCodec, SameValueTables) {
   }
   for (const auto& [key, values] : dbc().value_tables) {
     EXPECT_EQ(codec_tables.count(key), 1u) << "VAL_ " << key.first << " " << key.second << " has no codec table";
+  }
+}
+
+// Every sender and receiver is a node the database declares (BU_), and a
+// message never goes to its own sender.
+TEST(DbcAgreesWithTheCodec, SendersAndReceiversAreDeclaredNodes) {
+  EXPECT_FALSE(dbc().nodes.empty()) << "no BU_ line";
+  for (const auto& [id, message] : dbc().messages) {
+    SCOPED_TRACE(message.name);
+    EXPECT_EQ(dbc().nodes.count(message.sender), 1u) << "sender " << message.sender;
+    for (const auto& [name, signal] : message.signals) {
+      std::istringstream receivers(signal.receivers);
+      int count = 0;
+      for (std::string receiver; std::getline(receivers, receiver, ',');) {
+        EXPECT_EQ(dbc().nodes.count(receiver), 1u) << name << ": receiver " << receiver;
+        EXPECT_NE(receiver, message.sender) << name;
+        ++count;
+      }
+      EXPECT_GE(count, 1) << name << " has no receiver";
+    }
   }
 }
 

@@ -20,10 +20,11 @@
  *   }
  *
  * Cable lengths and targets enter the runtime exactly as the CAN frames of
- * firmware/protocol/cdcr.dbc would carry them (lengths in 0.01 mm steps,
- * positions in 0.01 mm, quaternions in Q15), so a board with its own bus and
- * a board on the CAN protocol see the same behaviour. A board on the CAN
- * protocol gives can_send/can_receive instead, or as well.
+ * the protocol (cdcr/firmware/protocol/messages.hpp) would carry them
+ * (lengths in 0.01 mm steps, positions in 0.01 mm, quaternions in Q15), so a
+ * board with its own bus and a board on the CAN protocol see the same
+ * behaviour. A board on the CAN protocol gives can_send/can_receive instead,
+ * or as well.
  *
  * Nothing here allocates or throws; every function returns a cdcr_result.
  * Not thread-safe: call everything for one runtime from one context.

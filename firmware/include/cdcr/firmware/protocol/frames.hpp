@@ -16,6 +16,9 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <iterator>
+#include <limits>
+#include <type_traits>
 
 #include "cdcr/firmware/fault.hpp"
 #include "cdcr/firmware/fault_detail.hpp"
@@ -504,5 +507,57 @@ inline DecodeStatus decode(const hal::CanFrame& frame, UpdateReport& f) {
   f.active_sequence = static_cast<std::uint8_t>(raw_in_word(word, kActiveSequence));
   return DecodeStatus::ok;
 }
+
+// What the typed frames assume of the table, checked when this header
+// compiles: a signal widened, moved or rescaled in messages.hpp that a struct
+// field or a fast path above could no longer follow stops the build instead
+// of cutting values short on the bus.
+namespace frame_layout {
+
+// Every raw value the signal can carry fits the field it is decoded into.
+template <typename Field>
+constexpr bool fits(const SignalSpec& signal) {
+  using Value = std::conditional_t<std::is_enum_v<Field>, std::underlying_type<Field>, std::common_type<Field>>;
+  using Limits = std::numeric_limits<typename Value::type>;
+  return signal.raw_minimum >= std::int64_t{Limits::min()} && signal.raw_maximum <= std::int64_t{Limits::max()};
+}
+
+// A plain integer: one raw step per unit, no offset.
+constexpr bool is_integer(const SignalSpec& signal) { return signal.factor == 1 && signal.offset == 0; }
+
+// cable_frames: one length per signal, L1..L4.
+static_assert(std::size(cable_lengths::kSignals) == std::size(CableFeedback{}.lengths_mm));
+static_assert(std::size(cable_lengths::kSignals) == std::size(CableSetpoint{}.lengths_mm));
+static_assert(fits<TargetMode>(target_position_z::kMode) && fits<std::uint8_t>(target_position_z::kSequence));
+static_assert(fits<std::uint8_t>(pose_position_z::kSequence) && fits<std::uint8_t>(pose_uncertainty::kSequence));
+static_assert((pose_position_z::kFlagCompensated | pose_position_z::kFlagExtrapolating) <=
+              pose_position_z::kFlags.raw_maximum);
+static_assert((pose_uncertainty::kFlagExtrapolating | pose_uncertainty::kFlagOutsideRange) <=
+              pose_uncertainty::kFlags.raw_maximum);
+static_assert(fits<std::uint8_t>(ik_report::kSequence) && fits<IkOutcome>(ik_report::kOutcome) &&
+              fits<int>(ik_report::kIterations) && fits<int>(ik_report::kCycles));
+static_assert(fits<RuntimeState>(status::kState) && fits<FaultCode>(status::kFault));
+static_assert(fits<std::uint16_t>(stats::kCycleCount) && fits<std::uint8_t>(stats::kFaultDetail));
+static_assert(fits<UpdateCommand>(update_command::kCommand) && fits<std::uint16_t>(update_command::kTransferId) &&
+              fits<std::uint32_t>(update_command::kImageSize));
+static_assert(fits<std::uint8_t>(update_digest::kPart));
+static_assert(fits<std::uint16_t>(update_block::kBlock) && fits<std::uint8_t>(update_block::kLength) &&
+              fits<std::uint32_t>(update_block::kCrc));
+static_assert(fits<UpdateState>(update_report::kState) && fits<std::uint8_t>(update_report::kActiveSlot) &&
+              fits<UpdateReason>(update_report::kReason) && fits<std::uint16_t>(update_report::kNextBlock) &&
+              fits<std::uint8_t>(update_report::kWindow) && fits<std::uint16_t>(update_report::kTransferId) &&
+              fits<std::uint8_t>(update_report::kActiveSequence));
+// UpdateDigest packs its four bytes into WORD, little-endian.
+static_assert(update_digest::kWord.length_bits == 32 && !update_digest::kWord.is_signed &&
+              is_integer(update_digest::kWord));
+// UpdateData copies the frame's bytes as they are: DATA_LOW is bytes 0..3,
+// DATA_HIGH bytes 4..7, both plain unsigned words.
+static_assert(update_data::kDataLow.start_bit == 0 && update_data::kDataLow.length_bits == 32 &&
+              !update_data::kDataLow.is_signed && is_integer(update_data::kDataLow));
+static_assert(update_data::kDataHigh.start_bit == 32 && update_data::kDataHigh.length_bits == 32 &&
+              !update_data::kDataHigh.is_signed && is_integer(update_data::kDataHigh));
+static_assert(update_data::kMessage.dlc == 8 && update_data::kMessage.signals.count == 2);
+
+}  // namespace frame_layout
 
 }  // namespace cdcr::firmware::protocol

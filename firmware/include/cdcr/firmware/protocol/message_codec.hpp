@@ -1,8 +1,10 @@
 #pragma once
 // One CAN message as a DBC declares it (identifier or per-segment identifier
-// range, DLC, sender, signals) and the checks every decoder runs on a frame
-// before it reads a signal.
+// range, DLC, sender, signals, and the notes a DBC file carries for its
+// readers) and the checks every decoder runs on a frame before it reads a
+// signal.
 
+#include <array>
 #include <cstddef>
 #include <cstdint>
 
@@ -62,6 +64,45 @@ struct MessageSpec {
 
   constexpr bool carries(std::uint32_t frame_id) const { return frame_id >= id && frame_id - id < id_count; }
 };
+
+// What the DBC file says about a message beyond its bits: the node that
+// receives it, and comments for people reading the database. The DBC writer
+// (firmware/protocol/write_dbc.cpp) reads them; the runtime does not, so on a
+// board they take no flash.
+struct SignalNote {
+  const SignalSpec* signal;
+  const char* text;  // CM_ SG_
+};
+
+struct SignalNotes {
+  const SignalNote* entries = nullptr;
+  std::uint8_t count = 0;
+
+  constexpr const SignalNote* begin() const { return entries; }
+  constexpr const SignalNote* end() const { return entries + count; }
+};
+
+template <std::size_t N>
+constexpr SignalNotes signal_notes(const SignalNote (&entries)[N]) {
+  return {entries, static_cast<std::uint8_t>(N)};
+}
+
+struct MessageNotes {
+  const MessageSpec* message;
+  const char* receiver;  // DBC node
+  // CM_ BO_, or "" for none. In a per-segment message, "{segment}" stands
+  // for the segment's number.
+  const char* comment = "";
+  SignalNotes signals = {};
+};
+
+// The messages of a list of notes, in its order.
+template <std::size_t N>
+constexpr std::array<const MessageSpec*, N> messages_of(const MessageNotes* const (&notes)[N]) {
+  std::array<const MessageSpec*, N> messages{};
+  for (std::size_t i = 0; i < N; ++i) messages[i] = notes[i]->message;
+  return messages;
+}
 
 // The data bits the message's signals define.
 constexpr std::uint64_t defined_bits(const MessageSpec& message) {

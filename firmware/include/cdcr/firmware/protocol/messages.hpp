@@ -1,11 +1,13 @@
 #pragma once
 // Every message and signal of the runtime's CAN protocol, once: identifiers,
-// DLC, sender, each signal's bits, scaling, range and unit, the value tables
-// of the enums, and the acceptance filter of each frame group.
-// firmware/protocol/cdcr.dbc describes the same for candump/cantools users; a
-// host test (host_tests/firmware/protocol_test.cpp) checks that both agree,
-// field by field, in both directions. frames.hpp encodes and decodes the
-// messages from this table.
+// DLC, sender and receiver, each signal's bits, scaling, range and unit, the
+// value tables of the enums, the acceptance filter of each frame group, and
+// the comments of the DBC file. This is the protocol's only description:
+// frames.hpp encodes and decodes the messages from it, and the build writes
+// the DBC file for candump/cantools users from it
+// (firmware/protocol/write_dbc.cpp, into <build>/firmware/protocol/cdcr.dbc).
+// host_tests/firmware/protocol_golden_frames_test.cpp holds a frame of every
+// message written out by hand, so a wrong start bit or scale here fails.
 
 #include <cstdint>
 
@@ -15,6 +17,15 @@
 #include "cdcr/hal/can_bus.hpp"
 
 namespace cdcr::firmware::protocol {
+
+// The database as a whole: the DBC's VERSION, its nodes (BU_) and its
+// first comment.
+inline constexpr const char* kDbcVersion = "cdcr runtime protocol 2";
+inline constexpr const char* kDbcNodes[] = {"RUNTIME", "DRIVES", "HOST"};
+inline constexpr const char* kDbcComment =
+    "Cable-driven continuum robot runtime. Little-endian (Intel) signals. Lengths 0.01 mm, quaternions Hamilton "
+    "w-first in Q15 (1.0 = 32767). Bits no signal defines are reserved and sent as 0. Generated from the runtime's "
+    "codec table, firmware/include/cdcr/firmware/protocol/messages.hpp: change the protocol there, not here.";
 
 // Per-segment messages reserve this many identifiers (base .. base + 7).
 inline constexpr int kSegmentIdSlots = 8;
@@ -106,24 +117,30 @@ inline constexpr const SignalSpec* kSignals[] = {&kX, &kY};
 namespace cable_feedback {
 inline constexpr MessageSpec kMessage{
     "CABLE_FEEDBACK", 0x100, kSegmentIdSlots, 8, "DRIVES", signal_list(cable_lengths::kSignals), kCableFeedbackFrames};
+inline constexpr MessageNotes kNotes{
+    &kMessage, "RUNTIME", "Achieved cable lengths of segment {segment}; raw 65535 = not available, 0 is invalid."};
 }
 
 // 0x110 + s: commanded cable lengths of segment s.
 namespace cable_setpoint {
 inline constexpr MessageSpec kMessage{
     "CABLE_SETPOINT", 0x110, kSegmentIdSlots, 8, "RUNTIME", signal_list(cable_lengths::kSignals), kCableSetpointFrames};
+inline constexpr MessageNotes kNotes{&kMessage, "DRIVES", "Commanded cable lengths of segment {segment}."};
 }
 
 // 0x120: target orientation, before the commit frame of a pose target.
 namespace target_orientation {
 inline constexpr MessageSpec kMessage{
     "TARGET_ORIENTATION", 0x120, 1, 8, "HOST", signal_list(quaternion::kSignals), kTargetFrames};
+inline constexpr MessageNotes kNotes{&kMessage, "RUNTIME",
+                                     "Target orientation; must precede TARGET_POSITION_Z when MODE = 1."};
 }
 
 // 0x121: target x, y, before the commit frame.
 namespace target_position_xy {
 inline constexpr MessageSpec kMessage{
     "TARGET_POSITION_XY", 0x121, 1, 8, "HOST", signal_list(position_xy::kSignals), kTargetFrames};
+inline constexpr MessageNotes kNotes{&kMessage, "RUNTIME", "Target position x, y; must precede TARGET_POSITION_Z."};
 }
 
 // 0x122: target z; commits the target. Bits 35..39 are reserved and must be 0.
@@ -140,12 +157,25 @@ inline constexpr SignalSpec kRefuseExtrapolating{"REFUSE_EXTRAPOLATING", 34, 1, 
 inline constexpr SignalSpec kSequence{"SEQUENCE", 40, 8, false, 1, 0, 0, 255, ""};
 inline constexpr const SignalSpec* kSignals[] = {&kZ, &kMode, &kTracking, &kRefuseExtrapolating, &kSequence};
 inline constexpr MessageSpec kMessage{"TARGET_POSITION_Z", 0x122, 1, 6, "HOST", signal_list(kSignals), kTargetFrames};
+inline constexpr SignalNote kSignalNotes[] = {
+    {&kTracking,
+     "1: this target is one of a stream along a path; the solver warm-starts from its last solution and may publish "
+     "the best point so far."},
+    {&kRefuseExtrapolating,
+     "1: a solution where the model extrapolates (outside its fitted input range, or by its variance) is not sent: "
+     "IK_REPORT OUTCOME 7 (refused_extrapolating), setpoints held. No best point so far is sent for such a target."},
+};
+inline constexpr MessageNotes kNotes{&kMessage, "RUNTIME",
+                                     "Target position z; commits the target to inverse kinematics. Bits 35 to 39 are "
+                                     "reserved: a frame with any of them set is rejected as malformed.",
+                                     signal_notes(kSignalNotes)};
 }  // namespace target_position_z
 
 // 0x130: compensated tip x, y.
 namespace pose_position_xy {
 inline constexpr MessageSpec kMessage{
     "POSE_POSITION_XY", 0x130, 1, 8, "RUNTIME", signal_list(position_xy::kSignals), kPoseFrames};
+inline constexpr MessageNotes kNotes{&kMessage, "HOST"};
 }
 
 // 0x131: tip z, flags, cycle sequence.
@@ -159,12 +189,19 @@ inline constexpr std::int64_t kFlagExtrapolating = 0x02;
 inline constexpr SignalSpec kSequence{"SEQUENCE", 40, 8, false, 1, 0, 0, 255, ""};
 inline constexpr const SignalSpec* kSignals[] = {&kZ, &kFlags, &kSequence};
 inline constexpr MessageSpec kMessage{"POSE_POSITION_Z", 0x131, 1, 6, "RUNTIME", signal_list(kSignals), kPoseFrames};
+inline constexpr SignalNote kSignalNotes[] = {
+    {&kFlags,
+     "Bit 0: pose compensated by the GP model (RUN); clear in DEGRADED. Bit 1: the model extrapolates at this pose "
+     "(outside the input range it was fitted on, or by its variance; see POSE_UNCERTAINTY). The other bits are 0."},
+};
+inline constexpr MessageNotes kNotes{&kMessage, "HOST", "", signal_notes(kSignalNotes)};
 }  // namespace pose_position_z
 
 // 0x132: compensated tip orientation.
 namespace pose_orientation {
 inline constexpr MessageSpec kMessage{
     "POSE_ORIENTATION", 0x132, 1, 8, "RUNTIME", signal_list(quaternion::kSignals), kPoseFrames};
+inline constexpr MessageNotes kNotes{&kMessage, "HOST"};
 }
 
 // 0x133: how far the measured tip may lie from the compensated pose of the
@@ -184,6 +221,25 @@ inline constexpr SignalSpec kSequence{"SEQUENCE", 48, 8, false, 1, 0, 0, 255, ""
 inline constexpr const SignalSpec* kSignals[] = {&kR95Position, &kR95Orientation, &kLatentShare, &kFlags,
                                                  &kSequence};
 inline constexpr MessageSpec kMessage{"POSE_UNCERTAINTY", 0x133, 1, 7, "RUNTIME", signal_list(kSignals), kPoseFrames};
+inline constexpr SignalNote kSignalNotes[] = {
+    {&kR95Position,
+     "Radius around the compensated tip position that holds the measured position with 95 % probability, "
+     "measurement noise included; saturates at 65.535 mm."},
+    {&kR95Orientation,
+     "Angle around the compensated orientation that holds the measured one with 95 % probability; saturates at "
+     "65.535 deg."},
+    {&kLatentShare,
+     "The model's latent variance at this pose as a share of its prior: near 0 inside the training data, 1 far from "
+     "it."},
+    {&kFlags,
+     "Bit 0: extrapolating (outside the fitted input range, or LATENT_SHARE above the image's threshold). Bit 1: "
+     "outside the fitted input range. The other bits are 0."},
+};
+inline constexpr MessageNotes kNotes{
+    &kMessage, "HOST",
+    "95 % radii around the compensated pose of the cycle SEQUENCE (the POSE_POSITION_Z SEQUENCE it belongs to), "
+    "computed over a few cycles and sent when done; only with a model image that carries a variance block.",
+    signal_notes(kSignalNotes)};
 }  // namespace pose_uncertainty
 
 // 0x140: the outcome of a committed target. Bits 12..15 are reserved (0).
@@ -197,6 +253,17 @@ inline constexpr SignalSpec kOrientationResidual{"ORIENTATION_RESIDUAL", 48, 16,
 inline constexpr const SignalSpec* kSignals[] = {&kSequence, &kOutcome, &kIterations, &kCycles, &kPositionResidual,
                                                  &kOrientationResidual};
 inline constexpr MessageSpec kMessage{"IK_REPORT", 0x140, 1, 8, "RUNTIME", signal_list(kSignals), kIkReportFrames};
+inline constexpr SignalNote kSignalNotes[] = {
+    {&kIterations, "Solver iterations spent on the target, saturating at 255."},
+    {&kCycles, "Runtime cycles spent on the target, saturating at 255."},
+    {&kPositionResidual,
+     "Position residual of the solution, saturating at 65.535 mm; infinity and NaN are sent as 65.535."},
+    {&kOrientationResidual,
+     "Orientation residual of a pose target's solution, saturating at 0.65535 rad; 0 for a position target."},
+};
+inline constexpr MessageNotes kNotes{&kMessage, "HOST",
+                                     "Outcome of a committed target. Bits 12 to 15 are reserved (0).",
+                                     signal_notes(kSignalNotes)};
 }  // namespace ik_report
 
 // 0x150: heartbeat, every kStatusEveryCycles cycles.
@@ -211,6 +278,12 @@ inline constexpr SignalSpec kExecMax{"EXEC_MAX", 32, 16, false, 1, 0, 0, 65535, 
 inline constexpr SignalSpec kExecMean{"EXEC_MEAN", 48, 16, false, 1, 0, 0, 65535, "us"};
 inline constexpr const SignalSpec* kSignals[] = {&kState, &kExtrapolating, &kFault, &kOverruns, &kExecMax, &kExecMean};
 inline constexpr MessageSpec kMessage{"STATUS", 0x150, 1, 8, "RUNTIME", signal_list(kSignals), kStatusFrames};
+inline constexpr SignalNote kSignalNotes[] = {
+    {&kExtrapolating, "1: the latest pose extrapolates (POSE_POSITION_Z FLAGS bit 1)."},
+    {&kFault, "firmware::FaultCode of the active fault."},
+};
+inline constexpr MessageNotes kNotes{&kMessage, "HOST", "Heartbeat, every 10 cycles. Bits 5 to 7 are reserved (0).",
+                                     signal_notes(kSignalNotes)};
 }  // namespace status
 
 // 0x151: statistics, with each STATUS.
@@ -224,6 +297,16 @@ inline constexpr SignalSpec kStaleEvents{"STALE_EVENTS", 56, 8, false, 1, 0, 0, 
 inline constexpr const SignalSpec* kSignals[] = {&kJitterMax, &kRejectedFrames, &kCycleCount, &kFaultDetail,
                                                  &kStaleEvents};
 inline constexpr MessageSpec kMessage{"STATS", 0x151, 1, 8, "RUNTIME", signal_list(kSignals), kStatusFrames};
+inline constexpr SignalNote kSignalNotes[] = {
+    {&kFaultDetail,
+     "Detail of the FAULT in the STATUS frame sent with this one. FAULT 2 image_invalid: model::ImageStatus (0 ok, 1 "
+     "truncated, 2 bad_magic, 3 unsupported_version, 4 bad_header, 5 size_mismatch, 6 misaligned, 7 "
+     "checksum_mismatch, 8 unsupported_kind, 9 over_capacity, 10 non_finite_payload, 11 invalid_parameters). FAULT 3 "
+     "image_geometry_invalid, 6 cable_lengths_invalid and 8 target_unreachable: model::Status (0 ok, 1 "
+     "non_finite_input, 2 invalid_geometry, 3 cable_length_not_positive, 4 cable_difference_out_of_range, 5 "
+     "theta_beyond_limit, 6 invalid_segment_count, 7 ik_not_converged, 8 correction_failed). Any other FAULT: 0."},
+};
+inline constexpr MessageNotes kNotes{&kMessage, "HOST", "", signal_notes(kSignalNotes)};
 }  // namespace stats
 
 // 0x160: the tip payload the robot carries now, for a model with a payload
@@ -234,6 +317,11 @@ namespace payload {
 inline constexpr SignalSpec kPayload{"PAYLOAD", 0, 16, false, 0.001, 0, 0, 50, "kg"};
 inline constexpr const SignalSpec* kSignals[] = {&kPayload};
 inline constexpr MessageSpec kMessage{"PAYLOAD", 0x160, 1, 2, "HOST", signal_list(kSignals), kPayloadFrames};
+inline constexpr MessageNotes kNotes{
+    &kMessage, "RUNTIME",
+    "The tip payload the robot carries now, for a model image with a payload input; until one arrives the runtime "
+    "uses the image's default. A frame beyond [0, 50] kg is refused (FAULT 11 payload_invalid) and the previous "
+    "payload stays in use."};
 }  // namespace payload
 
 // Model updates (0x170..0x17F; firmware/model_update.hpp): the host writes a
@@ -304,6 +392,12 @@ inline constexpr SignalSpec kImageSize{"IMAGE_SIZE", 24, 24, false, 1, 0, 0, 167
 inline constexpr const SignalSpec* kSignals[] = {&kCommand, &kTransferId, &kImageSize};
 inline constexpr MessageSpec kMessage{"UPDATE_COMMAND", 0x170, 1, 6, "HOST", signal_list(kSignals),
                                       kUpdateRequestFrames};
+inline constexpr MessageNotes kNotes{
+    &kMessage, "RUNTIME",
+    "Model update command. START announces a transfer of IMAGE_SIZE bytes into the inactive slot, or resumes the one "
+    "in flash with the same TRANSFER_ID, size and digest; the eight UPDATE_DIGEST frames precede it. STATUS asks for "
+    "an UPDATE_REPORT, ABORT drops the transfer, COMMIT verifies the received image and makes it active, ROLLBACK "
+    "makes the other slot's image active again. Bits 4 to 7 are reserved (0)."};
 }  // namespace update_command
 
 // 0x171: bytes 4 * PART .. 4 * PART + 3 of the image's SHA-256, in order
@@ -314,6 +408,9 @@ inline constexpr SignalSpec kWord{"WORD", 8, 32, false, 1, 0, 0, 4294967295.0, "
 inline constexpr const SignalSpec* kSignals[] = {&kPart, &kWord};
 inline constexpr MessageSpec kMessage{"UPDATE_DIGEST", 0x171, 1, 5, "HOST", signal_list(kSignals),
                                       kUpdateRequestFrames};
+inline constexpr MessageNotes kNotes{&kMessage, "RUNTIME",
+                                     "Bytes 4 * PART to 4 * PART + 3 of the SHA-256 of the image to transfer; WORD "
+                                     "little-endian. Bits 3 to 7 are reserved (0)."};
 }  // namespace update_digest
 
 // 0x172: the header of block BLOCK (image bytes 64 * BLOCK ..): its length
@@ -325,6 +422,10 @@ inline constexpr SignalSpec kCrc{"CRC", 24, 32, false, 1, 0, 0, 4294967295.0, ""
 inline constexpr const SignalSpec* kSignals[] = {&kBlock, &kLength, &kCrc};
 inline constexpr MessageSpec kMessage{"UPDATE_BLOCK", 0x172, 1, 7, "HOST", signal_list(kSignals),
                                       kUpdateRequestFrames};
+inline constexpr MessageNotes kNotes{
+    &kMessage, "RUNTIME",
+    "Header of image block BLOCK (bytes 64 * BLOCK onwards): LENGTH bytes follow in UPDATE_DATA frames, CRC is the "
+    "CRC-32 of the two BLOCK bytes (little-endian) followed by the data."};
 }  // namespace update_block
 
 // 0x173: the next 8 bytes of the block whose header came last (the last
@@ -335,6 +436,8 @@ inline constexpr SignalSpec kDataHigh{"DATA_HIGH", 32, 32, false, 1, 0, 0, 42949
 inline constexpr const SignalSpec* kSignals[] = {&kDataLow, &kDataHigh};
 inline constexpr MessageSpec kMessage{"UPDATE_DATA", 0x173, 1, 8, "HOST", signal_list(kSignals),
                                       kUpdateRequestFrames};
+inline constexpr MessageNotes kNotes{
+    &kMessage, "RUNTIME", "The next 8 bytes of the block announced last; the last frame of a block is zero-padded."};
 }  // namespace update_data
 
 // 0x178: the update's state, the answer to every command and the
@@ -353,17 +456,29 @@ inline constexpr const SignalSpec* kSignals[] = {&kState,  &kActiveSlot,  &kReas
                                                  &kWindow, &kTransferId, &kActiveSequence};
 inline constexpr MessageSpec kMessage{"UPDATE_REPORT", 0x178, 1, 8, "RUNTIME", signal_list(kSignals),
                                       kUpdateReportFrames};
+inline constexpr SignalNote kSignalNotes[] = {
+    {&kActiveSlot, "The slot the running model is read from: 0 the model storage (no slot), 1 slot A, 2 slot B."},
+    {&kActiveSequence, "Low 8 bits of the active slot's sequence number; the higher valid sequence wins at boot."},
+};
+inline constexpr MessageNotes kNotes{
+    &kMessage, "HOST",
+    "State of the model update, sent for every command, every acknowledged window and every rejected frame. Blocks 0 "
+    "to NEXT_BLOCK - 1 are in flash; the host may send WINDOW blocks from NEXT_BLOCK on.",
+    signal_notes(kSignalNotes)};
 }  // namespace update_report
 
-// Every message of the protocol, as the DBC lists them.
-inline constexpr const MessageSpec* kMessages[] = {
-    &cable_feedback::kMessage,     &cable_setpoint::kMessage,   &target_orientation::kMessage,
-    &target_position_xy::kMessage, &target_position_z::kMessage, &pose_position_xy::kMessage,
-    &pose_position_z::kMessage,    &pose_orientation::kMessage, &pose_uncertainty::kMessage,
-    &ik_report::kMessage,          &status::kMessage,           &stats::kMessage,
-    &payload::kMessage,
-    &update_command::kMessage,     &update_digest::kMessage,    &update_block::kMessage,
-    &update_data::kMessage,        &update_report::kMessage,
+// Every message of the protocol with its notes, as the DBC lists them.
+inline constexpr const MessageNotes* kMessageNotes[] = {
+    &cable_feedback::kNotes,     &cable_setpoint::kNotes,   &target_orientation::kNotes,
+    &target_position_xy::kNotes, &target_position_z::kNotes, &pose_position_xy::kNotes,
+    &pose_position_z::kNotes,    &pose_orientation::kNotes, &pose_uncertainty::kNotes,
+    &ik_report::kNotes,          &status::kNotes,           &stats::kNotes,
+    &payload::kNotes,
+    &update_command::kNotes,     &update_digest::kNotes,    &update_block::kNotes,
+    &update_data::kNotes,        &update_report::kNotes,
 };
+
+// Every message of the protocol, in the same order.
+inline constexpr auto kMessages = messages_of(kMessageNotes);
 
 }  // namespace cdcr::firmware::protocol
