@@ -11,18 +11,18 @@
 
 #include <CLI/CLI.hpp>
 
-#include "cli_errors.hpp"
-#include "command_output.hpp"
-#include "fk_command.hpp"
+#include "cli/cli_errors.hpp"
+#include "cli/command_output.hpp"
+#include "cli/fk_command.hpp"
 #if CDCR_HAVE_DEPLOY
-#include "deploy_command.hpp"
+#include "cli/deploy_command.hpp"
 #endif
-#include "ik_command.hpp"
-#include "training_commands.hpp"
-#include "import_mocap_command.hpp"
-#include "inspect_command.hpp"
-#include "export_command.hpp"
-#include "simulate_command.hpp"
+#include "cli/ik_command.hpp"
+#include "cli/training_commands.hpp"
+#include "cli/import_mocap_command.hpp"
+#include "cli/inspect_command.hpp"
+#include "cli/export_command.hpp"
+#include "cli/simulate_command.hpp"
 
 namespace {
 

@@ -13,7 +13,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "cdcr/cli_errors.hpp"
+#include "cli/cli_errors.hpp"
 #include "runtime_modes.hpp"
 
 using namespace cdcr::runtime_host;

@@ -8,7 +8,7 @@
 
 #include <cdcr/firmware/runtime.hpp>
 
-#include "cdcr/cli_errors.hpp"
+#include "cli/cli_errors.hpp"
 #include "dataset/csv_dataset.hpp"
 #include "export/binary_file.hpp"
 #include "runtime_modes.hpp"

@@ -8,7 +8,7 @@
 
 #include <cdcr/firmware/runtime.hpp>
 
-#include "cdcr/cli_errors.hpp"
+#include "cli/cli_errors.hpp"
 #if CDCR_HAVE_LINUX_PLATFORM
 #include "cdcr/linux/file_flash.hpp"
 #include "cdcr/linux/mapped_model_storage.hpp"
