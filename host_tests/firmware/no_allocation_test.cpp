@@ -19,6 +19,18 @@ namespace {
 
 namespace protocol = firmware::protocol;
 
+// One millisecond of the drives, then the cycle of the next release.
+void drives_and_cycle(test_support::SimulatedPlatform& platform, sim::SimulatedCableDrives& drives, Runtime& runtime) {
+  const hal::TimerTick tick = platform.timer.wait_next();
+  drives.step(1e-3);
+  runtime.run_cycle(tick);
+}
+
+void expect_no_allocation(const test_support::AllocationCounter& counter) {
+  EXPECT_EQ(counter.operator_new_calls(), 0);
+  EXPECT_EQ(counter.malloc_calls(), 0);
+}
+
 TEST(RuntimeNoAllocation, TenThousandCyclesAfterInit) {
   test_support::SimulatedPlatform platform(test_support::small_image());
   // The recording console keeps std::strings; a board's UART does not allocate.
@@ -64,14 +76,10 @@ TEST(RuntimeNoAllocation, TenThousandCyclesAfterInit) {
       ++targets;
     }
     drives.set_silent(k >= 5000 && k < 5050);
-    const hal::TimerTick tick = platform.timer.wait_next();
-    drives.step(1e-3);
-    runtime.run_cycle(tick);
+    drives_and_cycle(platform, drives, runtime);
   }
   counter.stop();
-
-  EXPECT_EQ(counter.operator_new_calls(), 0);
-  EXPECT_EQ(counter.malloc_calls(), 0);
+  expect_no_allocation(counter);
   EXPECT_EQ(runtime.statistics().cycles, 10000u);
   EXPECT_EQ(runtime.statistics().targets_received, targets);
   EXPECT_EQ(targets, 2u + 1000u + 33u + 1u);
@@ -155,14 +163,10 @@ TEST(RuntimeNoAllocation, ModelUpdateAndRollback) {
       platform.host_node.send(rollback);
     }
     if (committed && update.active_slot() == -1) rolled_back = true;
-    const hal::TimerTick tick = platform.timer.wait_next();
-    drives.step(1e-3);
-    runtime.run_cycle(tick);
+    drives_and_cycle(platform, drives, runtime);
   }
   counter.stop();
-
-  EXPECT_EQ(counter.operator_new_calls(), 0);
-  EXPECT_EQ(counter.malloc_calls(), 0);
+  expect_no_allocation(counter);
   EXPECT_TRUE(committed);
   EXPECT_FALSE(rolled_back);  // refused: from the model storage's image there is nothing to roll back to
   EXPECT_EQ(runtime.model_update().last_reason(), protocol::UpdateReason::none);

@@ -32,6 +32,30 @@ namespace sim = cdcr::sim;
 
 namespace {
 
+sim::SimulatedPlatform& with_image(sim::SimulatedPlatform& platform, const std::string& image_path) {
+  if (!image_path.empty()) platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
+  return platform;
+}
+
+fw::Runtime& booted(fw::Runtime& runtime) {
+  runtime.init();
+  return runtime;
+}
+
+// The runtime on the simulated board (with the image, if one is given), and
+// the simulated robot whose cables it reads and moves.
+struct SimulatedLoop {
+  SimulatedLoop(const std::string& image_path, bool ideal_robot)
+      : runtime(with_image(platform, image_path).hal, fw::Geometry::prototype()),
+        geometry(booted(runtime).geometry().cast<double>()),
+        robot(geometry, ideal_robot ? sim::SimulatorConfig::nominal_only() : sim::SimulatorConfig{}) {}
+
+  sim::SimulatedPlatform platform;
+  fw::Runtime runtime;
+  model::RobotGeometry<double> geometry;
+  sim::SimulatedRobot robot;
+};
+
 // The sum and the largest of a run of errors, in mm.
 struct ErrorTally {
   double sum_mm = 0;
@@ -75,12 +99,11 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   if (!(speed_mm_s > 0) || !(speed_mm_s <= 500)) {
     throw std::invalid_argument("--circle-speed must be in (0, 500] mm/s");
   }
-  sim::SimulatedPlatform platform;
-  if (!image_path.empty()) platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
-  fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
-  runtime.init();
-  const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
-  const sim::SimulatedRobot robot(geometry, ideal_robot ? sim::SimulatorConfig::nominal_only() : sim::SimulatorConfig{});
+  SimulatedLoop loop(image_path, ideal_robot);
+  sim::SimulatedPlatform& platform = loop.platform;
+  fw::Runtime& runtime = loop.runtime;
+  const model::RobotGeometry<double>& geometry = loop.geometry;
+  const sim::SimulatedRobot& robot = loop.robot;
   // The bend that puts the nominal tip radius_mm off the axis.
   const auto joints_at = [&](double bend_rad, double direction_rad) {
     model::JointVector<double> joints(2 * geometry.segment_count);
@@ -197,13 +220,11 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
 int simulate(const std::string& image_path, double rate_hz, double seconds, bool ideal_robot) {
   require_rate(rate_hz);
   if (!(seconds > 0) || !(seconds <= 3600)) throw std::invalid_argument("--seconds must be in (0, 3600]");
-  sim::SimulatedPlatform platform;
-  if (!image_path.empty()) platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
-  fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
-  runtime.init();
-
-  const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
-  const sim::SimulatedRobot robot(geometry, ideal_robot ? sim::SimulatorConfig::nominal_only() : sim::SimulatorConfig{});
+  SimulatedLoop loop(image_path, ideal_robot);
+  sim::SimulatedPlatform& platform = loop.platform;
+  fw::Runtime& runtime = loop.runtime;
+  const model::RobotGeometry<double>& geometry = loop.geometry;
+  const sim::SimulatedRobot& robot = loop.robot;
 
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> alpha(-M_PI, M_PI), theta(0.02, 0.2);

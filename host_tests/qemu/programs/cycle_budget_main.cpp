@@ -27,9 +27,7 @@
 namespace {
 
 namespace console = cdcr::cortexm;
-namespace model = cdcr::model;
-namespace firmware = cdcr::firmware;
-namespace protocol = cdcr::firmware::protocol;
+using namespace cdcr::qemu_programs;  // the workload, and its model, firmware and protocol
 
 constexpr std::uint32_t kBudgetInstructions = cdcr::boards::mps2::kCycleBudgetInstructions;
 
