@@ -5,6 +5,17 @@
 # CDCR_WAIT_SECONDS (60): how long one wait may take before the test fails.
 wait_seconds=${CDCR_WAIT_SECONDS:-60}
 
+# The deploy scripts' places: CDCR_WORK_DIR, the capture on a tmpfs of its
+# own, and the runtime's flash folder. Sets work, capture_dir, log, flash.
+prepare_deploy_work() {
+  work=$CDCR_WORK_DIR
+  capture_dir=$work/capture
+  mkdir -p "$capture_dir"
+  mount -t tmpfs tmpfs "$capture_dir" || exit 1
+  log=$capture_dir/candump.log
+  flash=$work/flash
+}
+
 # The drives: one cangen per segment sending its FEEDBACK_<segment> frame
 # (from socketcan_check frames) every feeder_gap_ms (10 unless set).
 feeders=""

@@ -15,15 +15,9 @@
 #      and commits.
 #   CDCR_RUNTIME, CDCR_CLI, CDCR_CHECK: host-built binaries; CDCR_WORK_DIR.
 set -u
-work=$CDCR_WORK_DIR
-capture_dir=$work/capture
-mkdir -p "$capture_dir"
-mount -t tmpfs tmpfs "$capture_dir" || exit 1
-log=$capture_dir/candump.log
-flash=$work/flash
-rm -rf "$flash" "$work"/runtime.err.* "$work"/deploy.* "$work"/relay.err
-
 . "$(dirname "$0")/bus_waits.sh"
+prepare_deploy_work
+rm -rf "$flash" "$work"/runtime.err.* "$work"/deploy.* "$work"/relay.err
 
 "$CDCR_CHECK" image "$work/old.img" 24 1 || fail "cannot write the old image"
 "$CDCR_CHECK" image "$work/new.img" 40 2 || fail "cannot write the new image"

@@ -4,14 +4,9 @@
 # --flash-dir` on vcan0, the runtime asked for 1 kHz, with the drives'
 # cable frames flowing; counts the update frames with candump.
 set -u
-work=$CDCR_WORK_DIR
-capture_dir=$work/capture
-mkdir -p "$capture_dir"
-mount -t tmpfs tmpfs "$capture_dir" || exit 1
-log=$capture_dir/candump.log
-flash=$work/flash
-rm -rf "$flash"
 . "$(dirname "$0")/../../host_tests/socketcan/bus_waits.sh"
+prepare_deploy_work
+rm -rf "$flash"
 "$CDCR_CHECK" image "$work/old.img" 24 1 || fail "cannot write the old image"
 eval "$("$CDCR_CHECK" frames "$work/old.img")" || fail "cannot compute the frames"
 start_feeders
