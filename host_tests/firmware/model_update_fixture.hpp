@@ -161,6 +161,18 @@ inline firmware::protocol::UpdateReport last_report(const std::vector<hal::CanFr
   return report;
 }
 
+// The REASON of every UPDATE_REPORT among `reports`, in order.
+inline std::vector<firmware::protocol::UpdateReason> report_reasons(const std::vector<hal::CanFrame>& reports) {
+  std::vector<firmware::protocol::UpdateReason> found;
+  for (const hal::CanFrame& frame : reports) {
+    firmware::protocol::UpdateReport report;
+    if (firmware::protocol::decode(frame, report) == firmware::protocol::DecodeStatus::ok) {
+      found.push_back(report.reason);
+    }
+  }
+  return found;
+}
+
 inline std::vector<std::uint8_t> update_test_image(int training_points, std::uint32_t seed, int segments = 2,
                                                    double backbone_mm = 0) {
   SyntheticModelOptions options;

@@ -155,16 +155,7 @@ class LostFrameTest : public ::testing::Test {
     board = std::make_unique<UpdateBoard>(flash, std::vector<std::uint8_t>{});
     board->cycle();
   }
-  std::vector<UpdateReason> reasons() {
-    std::vector<UpdateReason> found;
-    for (const hal::CanFrame& frame : board->take_reports()) {
-      firmware::protocol::UpdateReport report;
-      if (firmware::protocol::decode(frame, report) == firmware::protocol::DecodeStatus::ok) {
-        found.push_back(report.reason);
-      }
-    }
-    return found;
-  }
+  std::vector<UpdateReason> reasons() { return test_support::report_reasons(board->take_reports()); }
   sim::SimFlash flash{1024, 64, 256};
   std::unique_ptr<UpdateBoard> board;
   SentImage sent{update_test_image(60, 2)};

@@ -182,16 +182,7 @@ class ModelUpdateTest : public ::testing::Test {
     board->take_reports();
   }
 
-  std::vector<UpdateReason> reasons() {
-    std::vector<UpdateReason> found;
-    for (const hal::CanFrame& frame : board->take_reports()) {
-      firmware::protocol::UpdateReport report;
-      if (firmware::protocol::decode(frame, report) == firmware::protocol::DecodeStatus::ok) {
-        found.push_back(report.reason);
-      }
-    }
-    return found;
-  }
+  std::vector<UpdateReason> reasons() { return test_support::report_reasons(board->take_reports()); }
 
   bool has_reason(UpdateReason reason) {
     for (UpdateReason r : reasons()) {
