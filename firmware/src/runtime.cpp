@@ -131,8 +131,13 @@ void Runtime::reload_model() {
 }
 
 void Runtime::handle_frame(const hal::CanFrame& frame) {
+  // The update's frames first: one mask test, where a transfer's cycle
+  // brings tens of them and would test each against every input first.
+  if (ModelUpdate::carries(frame.id)) {
+    update_.handle_frame(frame, cycle_);
+    return;
+  }
   if (frame_inputs_.take(frame, *this)) return;
-  if (ModelUpdate::carries(frame.id)) update_.handle_frame(frame, cycle_);
   // Anything else is another node's traffic: the unused id the target
   // filter passes, or everything when the controller refused the filters.
 }
