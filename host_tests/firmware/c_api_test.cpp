@@ -355,28 +355,34 @@ struct Bus {
   int filters_set = 0;
 };
 
-TEST_F(CApiRuntime, CanCallbacksCarryTheProtocol) {
-  Bus bus;
-  image = small_image();
-  config = cdcr_config{};
-  config.model_image = image.data();
-  config.model_image_size = std::uint32_t(image.size());
-  config.callbacks.user = &bus;
-  config.callbacks.can_send = [](void* user, const cdcr_can_frame* frame) {
+// The board's CAN callbacks on `bus`: what the runtime sends is kept, what
+// it receives comes from the inbox, and the filters it sets are counted.
+void connect(cdcr_callbacks& callbacks, Bus& bus) {
+  callbacks.user = &bus;
+  callbacks.can_send = [](void* user, const cdcr_can_frame* frame) {
     static_cast<Bus*>(user)->sent.push_back(*frame);
     return 0;
   };
-  config.callbacks.can_receive = [](void* user, cdcr_can_frame* frame) {
+  callbacks.can_receive = [](void* user, cdcr_can_frame* frame) {
     Bus& b = *static_cast<Bus*>(user);
     if (b.inbox.empty()) return 0;
     *frame = b.inbox.front();
     b.inbox.erase(b.inbox.begin());
     return 1;
   };
-  config.callbacks.can_set_filters = [](void* user, const cdcr_can_filter*, size_t count) {
+  callbacks.can_set_filters = [](void* user, const cdcr_can_filter*, size_t count) {
     static_cast<Bus*>(user)->filters_set = int(count);
     return 1;
   };
+}
+
+TEST_F(CApiRuntime, CanCallbacksCarryTheProtocol) {
+  Bus bus;
+  image = small_image();
+  config = cdcr_config{};
+  config.model_image = image.data();
+  config.model_image_size = std::uint32_t(image.size());
+  connect(config.callbacks, bus);
   ASSERT_EQ(cdcr_init(&runtime, &config), CDCR_OK);
   EXPECT_EQ(bus.filters_set, 3);  // cable feedback, targets, payload
   EXPECT_EQ(status().fault, CDCR_FAULT_NONE);
@@ -425,19 +431,7 @@ class CallsAndFrames {
     config.model_image_size = std::uint32_t(image.size());
     config.fallback_geometry = cdcr_geometry{2, 120.0f, 67.0f, 1.5707963f};
     for (int i = 0; i < 2; ++i) {
-      config.callbacks.user = &buses_[i];
-      config.callbacks.can_send = [](void* user, const cdcr_can_frame* frame) {
-        static_cast<Bus*>(user)->sent.push_back(*frame);
-        return 0;
-      };
-      config.callbacks.can_receive = [](void* user, cdcr_can_frame* frame) {
-        Bus& b = *static_cast<Bus*>(user);
-        if (b.inbox.empty()) return 0;
-        *frame = b.inbox.front();
-        b.inbox.erase(b.inbox.begin());
-        return 1;
-      };
-      config.callbacks.can_set_filters = [](void*, const cdcr_can_filter*, size_t) { return 1; };
+      connect(config.callbacks, buses_[i]);
       EXPECT_EQ(cdcr_init(&runtimes_[i], &config), CDCR_OK);
     }
   }
