@@ -21,6 +21,13 @@ struct Dataset {
   bool has_payload = false;
   std::vector<model::Pose<double>> poses;      // one per sample when has_poses
   bool has_poses = false;
+  // A motion sequence (the file's first column is t_s): the time of every
+  // row, strictly increasing within a session, and the first row of every
+  // session (each starts after a homing move; session_starts[0] == 0).
+  // Without a time column the rows are independent samples.
+  Eigen::VectorXd time_s;
+  std::vector<int> session_starts;
+  bool has_time = false;
   std::uint64_t content_hash = 0;              // 64-bit FNV-1a of the file's bytes
 
   int sample_count() const { return static_cast<int>(cables_mm.rows()); }

@@ -9,6 +9,7 @@
 
 #include "cdcr/model/flash_image.hpp"
 #include "cdcr/model/geometry.hpp"
+#include "cdcr/model/hysteresis.hpp"
 #include "cdcr/model/input_encoding.hpp"
 
 namespace cdcr::training {
@@ -58,6 +59,9 @@ struct TrainedModel {
   // The payload the board uses until one arrives (a payload model only):
   // the mean over the fitted rows.
   double default_payload_kg = 0.0;
+  // The cables' identified hysteresis (empty: a joints-only model). The GP's
+  // inputs are then the joints of the effective cable lengths.
+  model::HysteresisModel<double> hysteresis;
 
   // Metadata carried into the image.
   std::uint64_t dataset_hash = 0;

@@ -21,4 +21,14 @@ inline constexpr int kMaxExtraInputs = 1;
 constexpr int max_model_inputs(int segments) { return 2 * segments + kMaxExtraInputs; }
 inline constexpr int kMaxInputs = max_model_inputs(kMaxSegments);
 
+// Cables of the largest robot, four per segment.
+inline constexpr int kMaxCables = 4 * kMaxSegments;
+
+// Play operators per cable a hysteresis model may hold (hysteresis.hpp).
+inline constexpr int kMaxHysteresisOperators = 4;
+
+// Widest play operator a hysteresis model may hold (mm): the homing move
+// must take every cable twice as far to make the state known.
+inline constexpr double kMaxHysteresisWidthMm = 2.0;
+
 }  // namespace cdcr::model
