@@ -300,4 +300,18 @@ void compute_homing_lags(HysteresisModel<S>& model, const Eigen::MatrixBase<Deri
   }
 }
 
+// A session starts after the homing move: the lags are the homing lags and
+// the cables are at home, from where the robot moves to the session's first
+// row in a straight line (the caller's next update_hysteresis).
+template <typename S, int MaxSegments>
+Status start_at_home(HysteresisState<S>& state, const HysteresisModel<S>& model,
+                     const RobotGeometry<S, MaxSegments>& geometry) {
+  CableVector<S, MaxSegments> approach_mm, home_mm;
+  const Status status = homing_waypoints(geometry, approach_mm, home_mm);
+  if (status != Status::ok) return status;
+  reset_to_homing(state, model);
+  update_hysteresis(state, model, home_mm);
+  return Status::ok;
+}
+
 }  // namespace cdcr::model
