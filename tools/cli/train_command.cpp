@@ -6,6 +6,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
@@ -34,6 +35,7 @@ struct TrainCommandOptions {
   TrainingFlags training;
   bool calibrate = false;
   bool ignore_payload = false;
+  bool no_hysteresis = false;
   bool json = false;
 };
 
@@ -65,7 +67,17 @@ training::TrainingOptions training_options_for(const TrainCommandOptions& o) {
 // hold the same rows).
 struct TrainingSets {
   training::TrainingSet all, train, validation;
+  // The rows of --data in train and validation (none in validation when
+  // --validation gives them), and the --validation data.
+  std::vector<int> train_rows, validation_rows;
+  std::optional<dataset::Dataset> validation_data;
 };
+
+std::vector<int> every_row(int count) {
+  std::vector<int> rows(static_cast<std::size_t>(count));
+  for (int i = 0; i < count; ++i) rows[static_cast<std::size_t>(i)] = i;
+  return rows;
+}
 
 TrainingSets training_sets_for(const TrainCommandOptions& o, const dataset::Dataset& data,
                                const model::RobotGeometry<double>& g, model::InputEncoding encoding) {
@@ -75,7 +87,9 @@ TrainingSets training_sets_for(const TrainCommandOptions& o, const dataset::Data
     sets.all = training::make_training_set(data, g, encoding, with_payload);
     if (!o.validation_path.empty()) {
       sets.train = sets.all;
-      sets.validation = training::make_training_set(load_dataset(o.validation_path, true), g, encoding, with_payload);
+      sets.train_rows = every_row(sets.all.size());
+      sets.validation_data = load_dataset(o.validation_path, true);
+      sets.validation = training::make_training_set(*sets.validation_data, g, encoding, with_payload);
       if (sets.validation.has_payload() != sets.all.has_payload()) {
         throw InputError(fmt::format("{} {} a payload_kg column and {} {}", o.data_path,
                                      sets.all.has_payload() ? "has" : "has no", o.validation_path,
@@ -83,6 +97,7 @@ TrainingSets training_sets_for(const TrainCommandOptions& o, const dataset::Data
       }
     } else if (o.holdout == 0) {
       sets.train = sets.all;
+      sets.train_rows = every_row(sets.all.size());
     } else {
       if (o.holdout < 0) throw InputError(fmt::format("--holdout must not be negative (got {})", o.holdout));
       if (sets.all.size() - o.holdout < 2) {
@@ -92,6 +107,8 @@ TrainingSets training_sets_for(const TrainCommandOptions& o, const dataset::Data
       const training::Split split = training::random_split(sets.all.size(), o.holdout, o.training.seed);
       sets.train = sets.all.subset(split.train);
       sets.validation = sets.all.subset(split.test);
+      sets.train_rows = split.train;
+      sets.validation_rows = split.test;
     }
   } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
@@ -134,9 +151,23 @@ CommandOutput run_train(const TrainCommandOptions& o) {
 
   const auto now = std::chrono::system_clock::now();
   const auto start = std::chrono::steady_clock::now();
-  const training::ExportResult r = training::train_and_export(
-      train_set, validation_set, fitted_set, geometry, options, data.content_hash,
-      std::chrono::duration_cast<std::chrono::seconds>(now.time_since_epoch()).count());
+  const std::int64_t created_unix_s = std::chrono::duration_cast<std::chrono::seconds>(now.time_since_epoch()).count();
+  // A motion sequence: the hysteresis is identified on the training rows
+  // (or the reason it is not is reported) before the GP is fitted.
+  std::optional<training::SequenceExport> sequence;
+  if (data.has_time && !o.no_hysteresis) {
+    try {
+      sequence = training::train_and_export_sequence(
+          data, sets.train_rows, sets.validation_rows, sets.validation_data ? &*sets.validation_data : nullptr,
+          geometry, options, !o.ignore_payload, data.content_hash, created_unix_s);
+    } catch (const std::invalid_argument& e) {
+      throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
+    }
+  }
+  const training::ExportResult r =
+      sequence ? sequence->result
+               : training::train_and_export(train_set, validation_set, fitted_set, geometry, options,
+                                            data.content_hash, created_unix_s);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   try {
     exporting::write_binary_file(o.out_path, r.image.data(), r.image.size());
@@ -156,6 +187,8 @@ CommandOutput run_train(const TrainCommandOptions& o) {
   run.geometry = geometry;
   run.calibration = calibration;
   run.calibration_skipped = calibration_skipped;
+  run.sequence = sequence ? &*sequence : nullptr;
+  run.data_has_time = data.has_time;
   run.seconds = seconds;
   CommandOutput output;
   output.text = o.json ? train_report_json(run) : train_report_text(run);
@@ -197,6 +230,8 @@ void register_train_command(CLI::App& app, CommandOutput& output) {
   add_training_flags(*command, o->training);
   command->add_flag("--ignore-payload", o->ignore_payload,
                     "Train on the cables alone even when the data have a payload_kg column");
+  command->add_flag("--no-hysteresis", o->no_hysteresis,
+                    "Train the joints-only model even when the data are a motion sequence (a t_s column)");
   command->add_flag("--json", o->json, "Print one JSON object");
   command->callback([o, &output] { output = run_train(*o); });
 }

@@ -18,6 +18,113 @@ Json errors_json(const training::MeanErrors& e) {
   return j;
 }
 
+// Per cable, the K values of one of the model's arrays.
+Json per_cable(const model::HysteresisModel<double>& m, const double (*values)[model::kMaxHysteresisOperators]) {
+  Json cables = Json::array();
+  for (int c = 0; c < m.cables; ++c) cables.push_back(std::vector<double>(values[c], values[c] + m.operators));
+  return cables;
+}
+
+std::string structure_name(training::HysteresisSharing sharing, int operators) {
+  if (sharing == training::HysteresisSharing::none) return "none";
+  return fmt::format("{}, {} play operator{} per cable", training::to_string(sharing), operators,
+                     operators == 1 ? "" : "s");
+}
+
+const char* sharing_key(training::HysteresisSharing sharing) {
+  switch (sharing) {
+    case training::HysteresisSharing::none: return "none";
+    case training::HysteresisSharing::all_cables: return "all_cables";
+    case training::HysteresisSharing::per_segment: return "per_segment";
+    case training::HysteresisSharing::per_cable: return "per_cable";
+  }
+  return "?";
+}
+
+Json hysteresis_json(const TrainRun& run) {
+  if (run.sequence == nullptr) return nullptr;
+  const training::SequenceExport& s = *run.sequence;
+  const training::HysteresisIdentification& id = s.identification;
+  Json j;
+  j["identified"] = id.attempted;
+  j["skipped_reason"] = id.attempted ? Json(nullptr) : Json(id.skipped_reason);
+  j["used"] = s.uses_hysteresis();
+  j["structure"] = sharing_key(id.sharing);
+  j["operators"] = id.model.operators;
+  const model::HysteresisModel<double>& m = s.result.model.hysteresis;
+  j["widths_mm"] = per_cable(m, m.widths_mm);
+  j["weights"] = per_cable(m, m.weights);
+  j["homing_lag_mm"] = per_cable(m, m.homing_lag_mm);
+  Json candidates = Json::array();
+  for (const training::HysteresisCandidate& c : id.candidates) {
+    candidates.push_back({{"structure", sharing_key(c.sharing)},
+                          {"operators", c.operators},
+                          {"parameters", c.parameters},
+                          {"log_marginal_likelihood", c.log_marginal_likelihood},
+                          {"criterion", c.criterion},
+                          {"likelihood_evaluations", c.likelihood_evaluations}});
+  }
+  j["candidates"] = candidates;
+  j["likelihood_rows"] = id.rows;
+  j["likelihood_evaluations"] = id.likelihood_evaluations;
+  j["hyperparameter_searches"] = id.hyperparameter_searches;
+  if (s.joints_only_validation.samples > 0) {
+    j["validation"] = {{"nominal_commanded", errors_json(s.joints_only_validation.initial)},
+                       {"joints_only", errors_json(s.joints_only_validation.compensated)},
+                       {"with_hysteresis", errors_json(s.result.validation.compensated)}};
+  } else {
+    j["validation"] = nullptr;
+  }
+  return j;
+}
+
+std::string hysteresis_text(const TrainRun& run) {
+  if (run.sequence == nullptr) {
+    return run.data_has_time ? "hysteresis: not identified (--no-hysteresis); joints-only model\n" : "";
+  }
+  const training::SequenceExport& s = *run.sequence;
+  const training::HysteresisIdentification& id = s.identification;
+  std::string t;
+  if (!id.attempted) {
+    return fmt::format("hysteresis: not identified ({}); joints-only model\n", id.skipped_reason);
+  }
+  t += fmt::format("hysteresis identified on {} training rows of the sequence: {}\n", id.rows,
+                   structure_name(id.sharing, id.model.operators));
+  t += "  structure        parameters  log likelihood  criterion (- p/2 log 6N)\n";
+  for (const training::HysteresisCandidate& c : id.candidates) {
+    t += fmt::format("  {:<16} {:10d}  {:14.2f}  {:10.2f}{}\n",
+                     c.sharing == training::HysteresisSharing::none ? std::string("none")
+                                                                    : fmt::format("{} K={}", sharing_key(c.sharing), c.operators),
+                     c.parameters, c.log_marginal_likelihood, c.criterion,
+                     c.sharing == id.sharing && c.operators == id.model.operators ? "  chosen" : "");
+  }
+  t += fmt::format("  cost: {} GP likelihoods with the hyperparameters held and {} hyperparameter searches, "
+                   "besides the joints-only model's\n",
+                   id.likelihood_evaluations, id.hyperparameter_searches);
+  const model::HysteresisModel<double>& m = s.result.model.hysteresis;
+  if (!m.empty()) {
+    t += "  widths (mm) per cable:";
+    for (int c = 0; c < m.cables; ++c) {
+      t += c % 4 == 0 ? " |" : "";
+      for (int k = 0; k < m.operators; ++k) t += fmt::format("{}{:.3f}", k == 0 ? " " : "/", m.widths_mm[c][k]);
+    }
+    t += "\n  weights:";
+    for (int k = 0; k < m.operators; ++k) t += fmt::format(" {:.3f}", m.weights[0][k]);
+    t += " (every cable)\n";
+  }
+  if (s.joints_only_validation.samples > 0) {
+    t += "held-out mean error, the hysteresis  position (mm)   orientation (deg)\n";
+    t += fmt::format("  nominal model (commanded)  {:13.4f}   {:17.4f}\n", s.joints_only_validation.initial.position_mm,
+                     s.joints_only_validation.initial.orientation_deg);
+    t += fmt::format("  joints-only model          {:13.4f}   {:17.4f}\n",
+                     s.joints_only_validation.compensated.position_mm,
+                     s.joints_only_validation.compensated.orientation_deg);
+    t += fmt::format("  with the hysteresis model  {:13.4f}   {:17.4f}\n", s.result.validation.compensated.position_mm,
+                     s.result.validation.compensated.orientation_deg);
+  }
+  return t;
+}
+
 }  // namespace
 
 std::string train_report_json(const TrainRun& run) {
@@ -76,6 +183,7 @@ std::string train_report_json(const TrainRun& run) {
   }
   j["float32_fidelity"] = fidelity;
   j["float32_fidelity_target_met"] = r.fidelity_met();
+  if (run.data_has_time) j["hysteresis"] = hysteresis_json(run);
   j["image"] = {{"path", run.out_path}, {"bytes", r.image.size()}};
   return j.dump() + "\n";
 }
@@ -126,6 +234,7 @@ std::string train_report_text(const TrainRun& run) {
                    m.signal_variance[0], m.noise_variance[0]);
   t += fmt::format("  log marginal likelihood {:.6g} after {} evaluations\n", r.report.log_marginal_likelihood,
                    r.report.likelihood_evaluations);
+  t += hysteresis_text(run);
   if (r.validation.samples > 0) {
     t += "held-out mean error          position (mm)   orientation (deg)\n";
     t += fmt::format("  nominal model              {:13.4f}   {:17.4f}\n", r.validation.initial.position_mm,

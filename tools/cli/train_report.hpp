@@ -25,6 +25,10 @@ struct TrainRun {
   model::RobotGeometry<double> geometry;
   std::optional<training::Calibration> calibration;
   std::string calibration_skipped;  // why the design geometry was kept, when --calibrate was asked
+  // A motion sequence's hysteresis identification (null: the data have no
+  // t_s column, or --no-hysteresis).
+  const training::SequenceExport* sequence = nullptr;
+  bool data_has_time = false;
   double seconds = 0;
 };
 

@@ -54,7 +54,7 @@ bool same_rows(const TrainingSet& a, const TrainingSet& b) {
 ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& validation_set,
                               const TrainingSet& fitted_set, const model::RobotGeometry<double>& geometry,
                               const TrainingOptions& options, std::uint64_t dataset_hash,
-                              std::int64_t created_unix_s) {
+                              std::int64_t created_unix_s, const model::HysteresisModel<double>& hysteresis) {
   ExportResult r;
   // The shipped model's kind and size are those for the rows it is fitted
   // on; the search's model on fewer rows is of the same kind.
@@ -68,6 +68,7 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   search_options.model = shipped.kind == ModelKind::exact ? ModelChoice::exact : ModelChoice::sparse;
   search_options.inducing_points = shipped.kind == ModelKind::exact ? 0 : std::min(shipped.points, train_set.size());
   TrainedModel searched = train(train_set, geometry, search_options, &r.report);
+  searched.hysteresis = hysteresis;
   r.report.selection = shipped;
   const auto add_variance = [&](TrainedModel& m, const TrainingSet& rows) {
     if (options.variance_rank <= 0) return;
@@ -128,6 +129,45 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   r.model.metrics = metrics_of(r.validation, r.fidelity);
   r.image = exporting::write_image(r.model);
   return r;
+}
+
+SequenceExport train_and_export_sequence(const dataset::Dataset& data, const std::vector<int>& train_rows,
+                                         const std::vector<int>& validation_rows,
+                                         const dataset::Dataset* validation_data,
+                                         const model::RobotGeometry<double>& geometry, const TrainingOptions& options,
+                                         bool with_payload, std::uint64_t dataset_hash, std::int64_t created_unix_s,
+                                         const HysteresisSearchOptions& search) {
+  if (!data.has_time) throw std::invalid_argument("the data are not a motion sequence (no t_s column)");
+  if (validation_data != nullptr && !validation_data->has_time) {
+    throw std::invalid_argument(
+        "the validation data have no t_s column; a model of a sequence is validated on a sequence");
+  }
+  SequenceExport out;
+  const TrainingSet all = make_training_set(data, geometry, options.encoding, with_payload);
+  const TrainingSet train_set = all.subset(train_rows);
+  const TrainingSet validation_set = validation_data != nullptr
+                                         ? make_training_set(*validation_data, geometry, options.encoding, with_payload)
+                                         : all.subset(validation_rows);
+  out.identification = identify_hysteresis(data, train_rows, geometry, options, with_payload, search);
+  const model::HysteresisModel<double>& hysteresis = out.identification.model;
+  if (hysteresis.empty()) {
+    out.result = train_and_export(train_set, validation_set, all, geometry, options, dataset_hash, created_unix_s);
+    if (out.identification.attempted) out.joints_only_validation = out.result.validation;
+    return out;
+  }
+  const TrainingSet effective_all = make_sequence_training_set(data, hysteresis, geometry, options.encoding, with_payload);
+  const TrainingSet effective_validation =
+      validation_data != nullptr
+          ? make_sequence_training_set(*validation_data, hysteresis, geometry, options.encoding, with_payload)
+          : effective_all.subset(validation_rows);
+  out.result = train_and_export(effective_all.subset(train_rows), effective_validation, effective_all, geometry,
+                                options, dataset_hash, created_unix_s, hysteresis);
+  if (validation_set.size() > 0) {
+    const TrainedModel& joints_only = out.identification.joints_only;
+    out.joints_only_validation =
+        evaluate(validation_set, predict_error_twists(joints_only, validation_set.bends, validation_set.payload_kg));
+  }
+  return out;
 }
 
 }  // namespace cdcr::training

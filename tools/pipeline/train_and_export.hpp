@@ -9,7 +9,10 @@
 #include <utility>
 #include <vector>
 
+#include "cdcr/model/hysteresis.hpp"
+#include "dataset/dataset.hpp"
 #include "train/evaluation.hpp"
+#include "train/hysteresis_identification.hpp"
 #include "train/trainer.hpp"
 #include "train/training_set.hpp"
 
@@ -47,10 +50,40 @@ struct ExportResult {
 // Searches the hyperparameters on train_set, measures that model on
 // validation_set (which may be empty), then fits the exported model on
 // fitted_set with the same hyperparameters (train_set itself when the two
-// have the same rows).
+// have the same rows). A non-empty `hysteresis` is the model's (the sets'
+// cables_mm are then the effective lengths it gives; the float32 image path
+// is measured on the same effective lengths as the trainer, so the image's
+// own hysteresis arithmetic is not part of this check).
 ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& validation_set,
                               const TrainingSet& fitted_set, const model::RobotGeometry<double>& geometry,
                               const TrainingOptions& options, std::uint64_t dataset_hash,
-                              std::int64_t created_unix_s);
+                              std::int64_t created_unix_s, const model::HysteresisModel<double>& hysteresis = {});
+
+// cdcr train on a motion sequence: the hysteresis identified on the training
+// rows (see hysteresis_identification.hpp), then the model trained, measured
+// and exported on the effective lengths; or the joints-only model, as
+// train_and_export on the commanded rows, when the identification is
+// skipped (too few rows) or chooses none.
+struct SequenceExport {
+  ExportResult result;
+  HysteresisIdentification identification;
+  // The joints-only model of the same training rows on the validation rows
+  // (samples 0 when there are none); its `initial` is the nominal model on
+  // the commanded lengths.
+  Evaluation joints_only_validation;
+
+  bool uses_hysteresis() const { return !result.model.hysteresis.empty(); }
+};
+
+// `data` must be a sequence (has_time). train_rows and validation_rows are
+// rows of `data`; with validation_data the validation rows are all of it
+// instead (a sequence too, else std::invalid_argument), its state run from
+// its own homing. The exported model is fitted on every row of `data`.
+SequenceExport train_and_export_sequence(const dataset::Dataset& data, const std::vector<int>& train_rows,
+                                         const std::vector<int>& validation_rows,
+                                         const dataset::Dataset* validation_data,
+                                         const model::RobotGeometry<double>& geometry, const TrainingOptions& options,
+                                         bool with_payload, std::uint64_t dataset_hash, std::int64_t created_unix_s,
+                                         const HysteresisSearchOptions& search = {});
 
 }  // namespace cdcr::training

@@ -15,12 +15,15 @@ TrainingSet TrainingSet::subset(const std::vector<int>& rows) const {
   TrainingSet s;
   const auto n = static_cast<Eigen::Index>(rows.size());
   s.cables_mm.resize(n, cables_mm.cols());
+  const bool has_commanded = commanded_mm.rows() > 0;
+  if (has_commanded) s.commanded_mm.resize(n, commanded_mm.cols());
   s.bends.resize(n, bends.cols());
   s.inputs.resize(n, inputs.cols());
   if (has_payload()) s.payload_kg.resize(n);
   s.error_twists.resize(n, 6);
   for (Eigen::Index i = 0; i < n; ++i) {
     s.cables_mm.row(i) = cables_mm.row(rows[i]);
+    if (has_commanded) s.commanded_mm.row(i) = commanded_mm.row(rows[i]);
     s.bends.row(i) = bends.row(rows[i]);
     s.inputs.row(i) = inputs.row(rows[i]);
     if (has_payload()) s.payload_kg[i] = payload_kg[rows[i]];

@@ -18,7 +18,10 @@
 namespace cdcr::training {
 
 struct TrainingSet {
-  Eigen::MatrixXd cables_mm;     // samples x 4n, as commanded
+  Eigen::MatrixXd cables_mm;     // samples x 4n, as commanded (a sequence with a hysteresis model: effective)
+  // A sequence with a hysteresis model: the commanded lengths (cables_mm
+  // then holds the effective ones); empty otherwise.
+  Eigen::MatrixXd commanded_mm;
   Eigen::MatrixXd bends;         // samples x 2n, stacked bend vectors
   Eigen::VectorXd payload_kg;    // samples, or empty: the data carried no payload column
   Eigen::MatrixXd inputs;        // samples x D, encoded (and the payload last, when there is one)
