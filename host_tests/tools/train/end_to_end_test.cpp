@@ -565,3 +565,23 @@ TEST(TrainEndToEnd, TrainAndEvalReadAPayloadColumn) {
   run = run_cdcr("learning-curve --data " + train + " --sizes 40 --encodings bend-vector --models exact --restarts 0");
   EXPECT_EQ(run.exit_code, 0) << run.err;
 }
+
+// Rows without a time column are independent samples: no hysteresis is
+// identified, and neither report speaks of one; --no-hysteresis changes
+// nothing for them.
+TEST(TrainEndToEnd, RowsWithoutTimeTrainTheJointsOnlyModel) {
+  const std::string dir = testing::TempDir();
+  const std::string train = "'" + dir + "no_time_train.csv'";
+  const std::string image = "'" + dir + "no_time_model.img'";
+  ASSERT_EQ(run_cdcr("simulate --samples 80 --seed 5 --out " + train).exit_code, 0);
+  CliRun run = run_cdcr("train --data " + train + " --out " + image + " --restarts 0 --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json report = nlohmann::json::parse(run.out);
+  EXPECT_FALSE(report.contains("hysteresis")) << run.out;
+  run = run_cdcr("train --data " + train + " --out " + image + " --restarts 0");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  EXPECT_EQ(run.out.find("hysteresis"), std::string::npos) << run.out;
+  const CliRun flagged = run_cdcr("train --data " + train + " --out " + image + " --restarts 0 --no-hysteresis");
+  ASSERT_EQ(flagged.exit_code, 0) << flagged.err;
+  EXPECT_EQ(flagged.out.find("hysteresis"), std::string::npos) << flagged.out;
+}
