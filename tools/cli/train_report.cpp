@@ -113,7 +113,7 @@ std::string hysteresis_text(const TrainRun& run) {
     t += " (every cable)\n";
   }
   if (s.joints_only_validation.samples > 0) {
-    t += "held-out mean error, the hysteresis  position (mm)   orientation (deg)\n";
+    t += "held-out: hysteresis or not  position (mm)   orientation (deg)\n";
     t += fmt::format("  nominal model (commanded)  {:13.4f}   {:17.4f}\n", s.joints_only_validation.initial.position_mm,
                      s.joints_only_validation.initial.orientation_deg);
     t += fmt::format("  joints-only model          {:13.4f}   {:17.4f}\n",
@@ -237,7 +237,9 @@ std::string train_report_text(const TrainRun& run) {
   t += hysteresis_text(run);
   if (r.validation.samples > 0) {
     t += "held-out mean error          position (mm)   orientation (deg)\n";
-    t += fmt::format("  nominal model              {:13.4f}   {:17.4f}\n", r.validation.initial.position_mm,
+    const bool effective = run.sequence != nullptr && run.sequence->uses_hysteresis();
+    t += fmt::format("  nominal model{}{:13.4f}   {:17.4f}\n", effective ? " (effective)  " : "              ",
+                     r.validation.initial.position_mm,
                      r.validation.initial.orientation_deg);
     t += fmt::format("  compensated (double)       {:13.4f}   {:17.4f}\n", r.validation.compensated.position_mm,
                      r.validation.compensated.orientation_deg);
