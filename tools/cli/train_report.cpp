@@ -90,7 +90,7 @@ std::string hysteresis_text(const TrainRun& run) {
   }
   t += fmt::format("hysteresis identified on {} training rows of the sequence: {}\n", id.rows,
                    structure_name(id.sharing, id.model.operators));
-  t += "  structure        parameters  log likelihood  criterion (- p/2 log 6N)\n";
+  t += "  structure        parameters  log likelihood  criterion (less 1 per parameter)\n";
   for (const training::HysteresisCandidate& c : id.candidates) {
     t += fmt::format("  {:<16} {:10d}  {:14.2f}  {:10.2f}{}\n",
                      c.sharing == training::HysteresisSharing::none ? std::string("none")

@@ -8,14 +8,16 @@
 // Structure by evidence. Each candidate is a sharing of the widths (one
 // width for every cable, one per segment, one per cable) and a shape: K play
 // operators per cable with widths in the fixed ratio r (k + 1) / K and
-// weights w_1..w_K shared by every cable (sum <= 1). A candidate's
+// weights w_1..w_K shared by every cable (sum <= 1); when a shape of
+// several operators beats one operator with shared widths, that shape with
+// one width per cable is a candidate too. A candidate's
 // parameters are searched by coordinate descent, each coordinate by golden
 // section, maximising the GP's log marginal likelihood on the training rows
 // with the hyperparameters held (the joints-only model's, re-searched once
 // after the shared width is found); then the hyperparameters are searched
 // again for that candidate, and the candidates, "none" (the joints-only
-// model) among them, are ranked by the likelihood less half a log(6 N) per
-// parameter (the Bayesian information criterion).
+// model) among them, are ranked by the likelihood less one per parameter
+// (Akaike's information criterion).
 
 #include <string>
 #include <vector>
@@ -77,7 +79,7 @@ struct HysteresisCandidate {
   int parameters = 0;
   model::HysteresisModel<double> model;
   double log_marginal_likelihood = 0.0;  // after the hyperparameters' re-search (normalised units)
-  double criterion = 0.0;                // log_marginal_likelihood - parameters / 2 log(6 N); higher wins
+  double criterion = 0.0;                // log_marginal_likelihood - parameters; higher wins
   int likelihood_evaluations = 0;        // with the hyperparameters held
 };
 

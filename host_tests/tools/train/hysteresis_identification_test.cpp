@@ -79,9 +79,10 @@ TEST(HysteresisIdentification, RecoversKnownPerCableWidths) {
     EXPECT_NEAR(id.model.max_lag_mm(c), truth.max_lag_mm(c), 0.05) << "cable " << c;
   }
   EXPECT_EQ(model::check_hysteresis(id.model, geometry.segment_count), model::HysteresisCheck::ok);
-  // The candidates all ran, "none" first; the likelihood preferred every
-  // hysteresis model to none.
-  ASSERT_EQ(id.candidates.size(), 6u);
+  // The candidates all ran, "none" first (and a shape of several operators
+  // per cable when one beat a single operator with shared widths); the
+  // likelihood preferred every hysteresis model to none.
+  ASSERT_GE(id.candidates.size(), 6u);
   EXPECT_EQ(id.candidates.front().sharing, HysteresisSharing::none);
   for (std::size_t i = 1; i < id.candidates.size(); ++i) {
     EXPECT_GT(id.candidates[i].criterion, id.candidates.front().criterion) << i;
