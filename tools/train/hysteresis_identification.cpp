@@ -240,23 +240,36 @@ std::pair<double, double> golden_section_max(const std::function<double(double)>
 // along their sum and their difference, a valley coordinate by coordinate
 // descent would cross only slowly. Every other parameter is its own
 // direction.
-std::vector<Eigen::VectorXd> search_directions(const Shape& shape) {
+//
+// When every move is long enough to saturate the operators, only the sum
+// shows in the data: the difference then wanders with the noise. A move
+// along a difference must gain at least kSplitGain in log likelihood (the
+// price of a parameter in the ranking below), else the widths stay split
+// as they were (evenly, from the per-segment search).
+constexpr double kSplitGain = 1.0;
+
+struct SearchDirection {
+  Eigen::VectorXd step;
+  double min_gain = 0.0;
+};
+
+std::vector<SearchDirection> search_directions(const Shape& shape) {
   const int groups = shape.groups();
   const int size = shape.parameters();
-  std::vector<Eigen::VectorXd> directions;
+  std::vector<SearchDirection> directions;
   const auto unit = [&](int i) { return Eigen::VectorXd(Eigen::VectorXd::Unit(size, i)); };
   if (shape.sharing == HysteresisSharing::per_cable) {
     for (int segment = 0; segment < shape.segments; ++segment) {
       for (int pair = 0; pair < 2; ++pair) {
         const int a = 4 * segment + pair, b = 4 * segment + pair + 2;
-        directions.push_back(unit(a) + unit(b));
-        directions.push_back(unit(a) - unit(b));
+        directions.push_back({unit(a) + unit(b), 0.0});
+        directions.push_back({unit(a) - unit(b), kSplitGain});
       }
     }
   } else {
-    for (int g = 0; g < groups; ++g) directions.push_back(unit(g));
+    for (int g = 0; g < groups; ++g) directions.push_back({unit(g), 0.0});
   }
-  for (int k = 0; k < shape.operators; ++k) directions.push_back(unit(groups + k));
+  for (int k = 0; k < shape.operators; ++k) directions.push_back({unit(groups + k), 0.0});
   return directions;
 }
 
@@ -287,10 +300,11 @@ std::pair<double, double> feasible_steps(const Shape& shape, const Eigen::Vector
 Eigen::VectorXd coordinate_search(const Shape& shape, Eigen::VectorXd parameters, const KernelHyperparameters& h,
                                   Likelihood& likelihood, const model::RobotGeometry<double>& geometry,
                                   const HysteresisSearchOptions& options, bool first_sweep = true) {
-  const std::vector<Eigen::VectorXd> directions = search_directions(shape);
+  const std::vector<SearchDirection> directions = search_directions(shape);
   double current = likelihood(model_for(shape, parameters, geometry), h);
   for (int sweep = first_sweep ? 0 : 1; sweep <= options.refine_sweeps; ++sweep) {
-    for (const Eigen::VectorXd& u : directions) {
+    for (const SearchDirection& direction : directions) {
+      const Eigen::VectorXd& u = direction.step;
       auto [low, high] = feasible_steps(shape, parameters, u);
       if (sweep > 0) {
         low = std::max(low, -options.refine_span_mm);
@@ -299,6 +313,7 @@ Eigen::VectorXd coordinate_search(const Shape& shape, Eigen::VectorXd parameters
       const auto f = [&](double t) { return likelihood(model_for(shape, parameters + t * u, geometry), h); };
       const int steps = sweep == 0 ? options.first_sweep_steps : options.refine_sweep_steps;
       const auto [best, best_value] = golden_section_max(f, low, high, steps, 0.0, current);
+      if (!(best_value >= current + direction.min_gain)) continue;
       // Clamped: rounding must not leave a width a hair below zero.
       parameters = (parameters + best * u).cwiseMax(0.0);
       current = best_value;
