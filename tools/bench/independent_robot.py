@@ -21,7 +21,9 @@ code, written from the constant-curvature formulas of the kinematics notes
         dz = dx (A - (beta sign(dx z) + gamma) |z|^n),  effective = commanded - z
     with its own A, n, beta / gamma and largest lag
     z_max = (A / (beta + gamma))^(1/n) of 0.3 to 0.9 mm per cable: smooth
-    branches and a reversal slope 1 - A, unlike a play operator's corners;
+    branches whose slope grows from 1 - 2 A beta / (beta + gamma) (0.05 to
+    0.4) right after a reversal to 1 - A where z = 0 and to 1 at z_max,
+    unlike a play operator's corners;
   - a small random repeatability of every achieved bend (sigma 0.0002 rad
     per component, about 0.1 mm at the tip);
   - motion-capture noise of 0.1 mm per axis and 0.05 deg per axis.
@@ -88,7 +90,7 @@ def joints_from_cables(cables_mm, radius_mm):
 def rotation(axis, angle):
     """Rodrigues' formula for a unit axis."""
     k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
-    return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
+    return np.eye(3) + math.sin(angle) * k + 2.0 * math.sin(0.5 * angle) ** 2 * (k @ k)
 
 
 def segment_transform(alpha, theta, length_mm):
@@ -96,7 +98,8 @@ def segment_transform(alpha, theta, length_mm):
     t = np.eye(4)
     t[:3, :3] = rotation(np.array([-math.sin(alpha), math.cos(alpha), 0.0]), theta)
     if theta > 1e-6:
-        in_plane = length_mm * (1.0 - math.cos(theta)) / theta
+        # 1 - cos t as 2 sin^2(t/2): no cancellation for small bends.
+        in_plane = length_mm * 2.0 * math.sin(0.5 * theta) ** 2 / theta
         along = length_mm * math.sin(theta) / theta
     else:
         in_plane = length_mm * (theta / 2.0 - theta ** 3 / 24.0)
@@ -216,9 +219,13 @@ class Robot:
         self.repeatability_rad = 0.0002 * scale
         cables = 4 * SEGMENTS
         max_lag = rng.uniform(0.3, 0.9, cables)
-        a = rng.uniform(0.55, 0.9, cables)
         n = rng.uniform(1.0, 2.0, cables)
-        beta_share = rng.uniform(0.55, 0.9, cables)
+        # Right after a full reversal dz/dx = 2 A beta / (beta + gamma): the
+        # effective length's slope there, 1 - 2 A beta / (beta + gamma), must
+        # stay positive (the cable end never moves against the drive).
+        reversal_slope = rng.uniform(0.05, 0.4, cables)
+        beta_share = rng.uniform(0.5, 0.85, cables)
+        a = (1.0 - reversal_slope) / (2.0 * beta_share)
         beta_plus_gamma = a / max_lag ** n
         self.friction_parameters = (a, beta_share * beta_plus_gamma, (1.0 - beta_share) * beta_plus_gamma, n)
 
@@ -314,6 +321,7 @@ def main(argv=None):
     parser.add_argument("--rows", default="{},{}".format(*SESSION_ROWS), help="rows of session 0 and 1 (default 700,200)")
     parser.add_argument("--no-hysteresis", action="store_true", help="the same robot without cable friction")
     parser.add_argument("--json", action="store_true", help="print the figures as one JSON object")
+    parser.add_argument("--report", help="also write the figures as JSON to this file")
     args = parser.parse_args(argv)
     try:
         rows = [int(v) for v in args.rows.split(",")]
@@ -344,6 +352,9 @@ def main(argv=None):
             "hysteresis_tip_movement_mm": {"mean": effect[0], "max": effect[2], "orientation_deg": effect[1]},
             "nominal_error": {"position_mm": initial[0], "orientation_deg": initial[1]},
         })
+    if args.report:
+        with open(args.report, "w") as f:
+            json.dump(report, f)
     if args.json:
         print(json.dumps(report))
     else:
