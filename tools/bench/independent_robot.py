@@ -10,9 +10,10 @@ code, written from the constant-curvature formulas of the kinematics notes
     (sigma 0.6 mm) and in the angle of its anchor holes (sigma 2 deg), with a
     small twist between segments (sigma 1 deg);
   - a gravity-like sag: each segment bends further towards the horizontal
-    part of gravity in its own base frame, in proportion to the weight it
-    carries and growing with its own bend (so it depends on every joint
-    before it);
+    part of gravity in its own base frame (the robot mounted at an angle),
+    by 0.004 to 0.006 rad times the share of the robot's weight it carries,
+    growing to 2.5 times that with its own bend (so it depends on every
+    joint before it);
   - the robot's mount in the motion-capture base frame and the marker frame
     on the platform are off by a few millimetres and about a degree;
   - per-cable friction hysteresis as a rate-independent Bouc-Wen model,
@@ -215,7 +216,7 @@ class Robot:
         self.marker = transform(small_rotation(rng, scale * math.radians(1.0)), scale * rng.normal(0.0, 1.0, 3))
         gravity = np.array([-0.8, 0.35, -0.5])
         self.gravity = gravity / np.linalg.norm(gravity)
-        self.sag_rad = scale * rng.uniform(0.012, 0.02, SEGMENTS)
+        self.sag_rad = scale * rng.uniform(0.004, 0.006, SEGMENTS)
         self.repeatability_rad = 0.0002 * scale
         cables = 4 * SEGMENTS
         max_lag = rng.uniform(0.3, 0.9, cables)
