@@ -40,7 +40,8 @@ reached it (t_s, seconds from the end of the homing move).
     independent_robot.py --seed 7 --out-dir DIR [--json]
 
 writes DIR/session0.csv (training, 700 rows) and DIR/session1.csv (test,
-200 rows: new configurations and noise, the same robot) and prints, per
+200 rows: new configurations and noise, the same robot; --effective also
+writes the effective lengths in place of the commanded ones, a reference) and prints, per
 session: the noise floor (the mean error between the true and the measured
 poses, motion capture alone), the same with the repeatability (between the
 measured poses and the robot's repeatable ones: what no model can predict),
@@ -271,7 +272,8 @@ def record_session(robot, seed, session, rows, position_noise_mm=0.1, orientatio
         if robot.hysteresis:
             friction.move(commanded, waypoint)
         commanded = waypoint
-    out = {"t_s": [], "cables": [], "measured": [], "true": [], "repeatable": [], "without_hysteresis": []}
+    out = {"t_s": [], "cables": [], "effective": [], "measured": [], "true": [], "repeatable": [],
+           "without_hysteresis": []}
     t = 0.0
     noise_scale = 0.0 if robot.ideal else 1.0
     for _ in range(rows):
@@ -286,6 +288,7 @@ def record_session(robot, seed, session, rows, position_noise_mm=0.1, orientatio
         measured[:3, :3] = measured[:3, :3] @ small_rotation(rng, noise_scale * math.radians(orientation_noise_deg))
         out["t_s"].append(round(t, 3))
         out["cables"].append(commanded.copy())
+        out["effective"].append(effective.copy())
         out["measured"].append(measured)
         out["true"].append(true)
         out["repeatable"].append(robot.true_pose(effective, np.zeros((SEGMENTS, 2))))
@@ -299,7 +302,7 @@ def mean_errors(poses_a, poses_b):
     return float(np.mean(position)), float(np.mean(orientation)), float(np.max(position))
 
 
-def write_csv(path, data, seed, session, robot):
+def write_csv(path, data, seed, session, robot, cables="cables"):
     names = ["t_s"] + ["l{}_{}".format(i + 1, j + 1) for i in range(SEGMENTS) for j in range(4)]
     names += ["x", "y", "z", "qw", "qx", "qy", "qz"]
     with open(path, "w") as f:
@@ -308,9 +311,11 @@ def write_csv(path, data, seed, session, robot):
             SEGMENTS, NOMINAL_LENGTH_MM, NOMINAL_RADIUS_MM))
         f.write("# rows are a motion sequence after the homing move; t_s in seconds\n")
         f.write("# hysteresis: {}\n".format("Bouc-Wen per cable" if robot.hysteresis else "off"))
+        if cables == "effective":
+            f.write("# cable columns: the effective lengths (commanded less the friction's lag), for reference\n")
         f.write(",".join(names) + "\n")
-        for t, cables, pose in zip(data["t_s"], data["cables"], data["measured"]):
-            values = ["{:.3f}".format(t)] + ["{:.6f}".format(c) for c in cables]
+        for t, lengths, pose in zip(data["t_s"], data[cables], data["measured"]):
+            values = ["{:.3f}".format(t)] + ["{:.6f}".format(c) for c in lengths]
             values += ["{:.6f}".format(v) for v in pose[:3, 3]] + ["{:.8f}".format(v) for v in quaternion(pose[:3, :3])]
             f.write(",".join(values) + "\n")
 
@@ -323,6 +328,9 @@ def main(argv=None):
     parser.add_argument("--no-hysteresis", action="store_true", help="the same robot without cable friction")
     parser.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     parser.add_argument("--report", help="also write the figures as JSON to this file")
+    parser.add_argument("--effective", action="store_true",
+                        help="also write sessionK.effective.csv: the effective cable lengths (what a model that "
+                             "knew the friction exactly would see) in place of the commanded ones")
     args = parser.parse_args(argv)
     try:
         rows = [int(v) for v in args.rows.split(",")]
@@ -341,6 +349,9 @@ def main(argv=None):
         data = record_session(robot, args.seed, session, count)
         path = os.path.join(args.out_dir, "session{}.csv".format(session))
         write_csv(path, data, args.seed, session, robot)
+        if args.effective:
+            write_csv(os.path.join(args.out_dir, "session{}.effective.csv".format(session)), data, args.seed, session,
+                      robot, cables="effective")
         nominal = [nominal_pose(c) for c in data["cables"]]
         floor = mean_errors(data["true"], data["measured"])
         unpredictable = mean_errors(data["repeatable"], data["measured"])

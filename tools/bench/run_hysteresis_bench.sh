@@ -8,7 +8,9 @@
 #     test rows without it;
 #   - the hysteresis-aware model: the same on the motion sequences, with t_s,
 #     where this build reads a time column (otherwise it says so and goes on);
-#   - the reference: the joints-only model on the same robot without friction.
+#   - two references: the joints-only model on the same robot without
+#     friction, and on the true effective cable lengths (what a model that
+#     knew the friction exactly would reach).
 # Every error is printed against the test session's noise floor. Writes to
 # $BUILD_DIR/hysteresis_bench/.
 #
@@ -46,7 +48,7 @@ train_and_eval() {
 }
 
 echo "== the independent robot (seed $seed) =="
-"$python" tools/bench/independent_robot.py --seed "$seed" --out-dir "$work_dir/hysteresis" \
+"$python" tools/bench/independent_robot.py --seed "$seed" --out-dir "$work_dir/hysteresis" --effective \
   --report "$work_dir/robot.json" | tee "$work_dir/robot.txt"
 "$python" tools/bench/independent_robot.py --seed "$seed" --out-dir "$work_dir/no_friction" --no-hysteresis \
   --report "$work_dir/no_friction.json" >/dev/null
@@ -54,6 +56,9 @@ for dir in hysteresis no_friction; do
   for session in 0 1; do
     drop_time "$work_dir/$dir/session$session.csv" "$work_dir/$dir/joints$session.csv"
   done
+done
+for session in 0 1; do
+  drop_time "$work_dir/hysteresis/session$session.effective.csv" "$work_dir/hysteresis/effective$session.csv"
 done
 
 read -r floor_mm floor_deg nominal_mm nominal_deg < <("$python" -c '
@@ -90,6 +95,10 @@ fi
 if result=$(train_and_eval no_friction "$work_dir/no_friction/joints0.csv" "$work_dir/no_friction/joints1.csv"); then
   read -r free_mm free_deg <<<"$result"
   row "joints-only, same robot without friction" "$free_mm" "$free_deg"
+fi
+if result=$(train_and_eval effective "$work_dir/hysteresis/effective0.csv" "$work_dir/hysteresis/effective1.csv"); then
+  read -r known_mm known_deg <<<"$result"
+  row "joints-only on the true effective lengths" "$known_mm" "$known_deg"
 fi
 echo
 echo "models, reports and data in $work_dir"

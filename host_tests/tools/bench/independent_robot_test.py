@@ -195,6 +195,23 @@ class Sessions(unittest.TestCase):
                 self.assertGreater(values[0, 0], 0.0)
                 np.testing.assert_allclose(np.linalg.norm(values[:, 20:24], axis=1), 1.0, atol=1e-7)
 
+    def test_effective_lengths_lag_the_commanded_ones_within_the_friction(self):
+        with tempfile.TemporaryDirectory() as directory:
+            with redirect_stdout(io.StringIO()):
+                robot.main(["--out-dir", directory, "--rows", "40,5", "--seed", "3", "--effective"])
+            tables = []
+            for name in ("session0.csv", "session0.effective.csv"):
+                with open(os.path.join(directory, name)) as f:
+                    lines = [line for line in f.read().splitlines() if not line.startswith("#")]
+                tables.append(np.array(list(csv.reader(lines))[1:], dtype=float))
+            commanded, effective = tables
+            np.testing.assert_array_equal(commanded[:, 0], effective[:, 0])
+            np.testing.assert_array_equal(commanded[:, 17:], effective[:, 17:])
+            lag = commanded[:, 1:17] - effective[:, 1:17]
+            largest = robot.Robot(3).new_friction(np.random.default_rng(0)).max_lag_mm()
+            self.assertTrue(np.all(np.abs(lag) <= largest + 1e-6))
+            self.assertGreater(np.abs(lag).max(), 0.2)
+
 
 if __name__ == "__main__":
     unittest.main()
