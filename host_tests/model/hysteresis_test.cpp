@@ -119,6 +119,7 @@ TEST(Hysteresis, ThreeOperatorLoopFollowsTheClosedFormBranches) {
   // Saturate upwards, then a full reversal down by 2.5 mm > 2 * 0.9.
   const double top = move_to(s, m, 110.0);
   EXPECT_NEAR(top, 110.0 - (0.2 * 0.2 + 0.3 * 0.5 + 0.5 * 0.9), 1e-12);
+  EXPECT_NEAR(m.max_lag_mm(0), 0.2 * 0.2 + 0.3 * 0.5 + 0.5 * 0.9, 1e-15);
   const double descent = 2.5;
   // Descending branch from the top: the drop of the effective length after
   // d of travel is sum_k w_k max(0, d - 2 r_k) (sum w = 1).

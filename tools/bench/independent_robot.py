@@ -337,7 +337,7 @@ def main(argv=None):
     except ValueError:
         rows = []
     if len(rows) != 2 or min(rows) < 1:
-        parser.error("--rows takes two positive counts, e.g. 700,200")
+        sys.exit("independent_robot.py: error: --rows takes two positive counts, e.g. 700,200, not '{}'".format(args.rows))
     os.makedirs(args.out_dir, exist_ok=True)
 
     robot = Robot(args.seed, hysteresis=not args.no_hysteresis)
