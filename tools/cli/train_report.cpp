@@ -68,6 +68,7 @@ Json hysteresis_json(const TrainRun& run) {
   j["likelihood_rows"] = id.rows;
   j["likelihood_evaluations"] = id.likelihood_evaluations;
   j["hyperparameter_searches"] = id.hyperparameter_searches;
+  j["refinement_gain"] = id.refinement_gain;
   if (s.joints_only_validation.samples > 0) {
     j["validation"] = {{"nominal_commanded", errors_json(s.joints_only_validation.initial)},
                        {"joints_only", errors_json(s.joints_only_validation.compensated)},
@@ -97,6 +98,10 @@ std::string hysteresis_text(const TrainRun& run) {
                                                                     : fmt::format("{} K={}", sharing_key(c.sharing), c.operators),
                      c.parameters, c.log_marginal_likelihood, c.criterion,
                      c.sharing == id.sharing && c.operators == id.model.operators ? "  chosen" : "");
+  }
+  if (id.refinement_evaluations > 0) {
+    t += fmt::format("  the chosen one refined with its own hyperparameters: {:+.2f} in log likelihood\n",
+                     id.refinement_gain);
   }
   t += fmt::format("  cost: {} GP likelihoods with the hyperparameters held and {} hyperparameter searches, "
                    "besides the joints-only model's\n",

@@ -360,6 +360,13 @@ HysteresisIdentification identify_hysteresis(const dataset::Dataset& data, const
   // against 0.97 mm); on a sequence without hysteresis Akaike's still
   // chooses none.
   constexpr double penalty_per_parameter = 1.0;
+  // Beside each candidate: its structure, parameters and hyperparameters.
+  struct Searched {
+    Shape shape;
+    Eigen::VectorXd parameters;
+    KernelHyperparameters hyperparameters;
+  };
+  std::vector<Searched> searched;
   const auto add_candidate = [&](const Shape& shape, const Eigen::VectorXd& parameters, const SearchResult& search,
                                  int evaluations_before) {
     HysteresisCandidate c;
@@ -371,6 +378,7 @@ HysteresisIdentification identify_hysteresis(const dataset::Dataset& data, const
     c.criterion = search.log_marginal_likelihood - penalty_per_parameter * double(c.parameters);
     c.likelihood_evaluations = likelihood.evaluations() - evaluations_before;
     result.candidates.push_back(c);
+    searched.push_back({shape, parameters, search.hyperparameters});
   };
   const int segments = geometry.segment_count;
 
@@ -446,6 +454,23 @@ HysteresisIdentification identify_hysteresis(const dataset::Dataset& data, const
                                      [](const HysteresisCandidate& a, const HysteresisCandidate& b) {
                                        return a.criterion < b.criterion;
                                      });
+  // The winner was searched with the hyperparameters of one shared width,
+  // which take much of its hysteresis for noise: its parameters are refined
+  // once more with its own (then those searched again), kept if better.
+  const Searched& winner = searched[static_cast<std::size_t>(best - result.candidates.begin())];
+  if (winner.shape.sharing != HysteresisSharing::none) {
+    const int before_refinement = likelihood.evaluations();
+    const Eigen::VectorXd refined =
+        coordinate_search(winner.shape, winner.parameters, winner.hyperparameters, likelihood, geometry, options, false);
+    const SearchResult search = research_from(model_for(winner.shape, refined, geometry), winner.hyperparameters);
+    result.refinement_evaluations = likelihood.evaluations() - before_refinement;
+    if (search.log_marginal_likelihood > best->log_marginal_likelihood) {
+      result.refinement_gain = search.log_marginal_likelihood - best->log_marginal_likelihood;
+      best->model = model_for(winner.shape, refined, geometry);
+      best->log_marginal_likelihood = search.log_marginal_likelihood;
+      best->criterion = search.log_marginal_likelihood - penalty_per_parameter * double(best->parameters);
+    }
+  }
   result.model = best->model;
   result.sharing = best->sharing;
   result.likelihood_evaluations = likelihood.evaluations();

@@ -92,6 +92,11 @@ struct HysteresisIdentification {
   int rows = 0;  // training rows the likelihood saw
   std::vector<HysteresisCandidate> candidates;
   int likelihood_evaluations = 0;  // Cholesky factors with the hyperparameters held
+  // The chosen candidate's last refinement, with its own hyperparameters:
+  // its evaluations (part of likelihood_evaluations) and what it gained in
+  // log likelihood (0: kept as it was).
+  int refinement_evaluations = 0;
+  double refinement_gain = 0.0;
   int hyperparameter_searches = 0; // L-BFGS-B searches besides the joints-only model's
   // The joints-only model on the same training rows (train() with the same
   // options): the start of the search and the figure to beat.
