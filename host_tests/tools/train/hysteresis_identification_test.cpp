@@ -60,7 +60,7 @@ TEST(SequenceTrainingSet, KeepsTheCommandedLengthsAndFitsOnTheEffectiveOnes) {
 // The known operator (K = 1, weight 1, per-cable widths 0.3 to 0.7 mm) on
 // 500 rows in two sessions, a smooth error of a few millimetres and 0.05 mm
 // of noise. The per-cable structure is chosen, every width is within
-// 0.05 mm of the truth (0.025 mm seen), the weight within 0.05 of 1
+// 0.05 mm of the truth (0.02 mm seen), the weight within 0.05 of 1
 // (0.985 seen), and so is the lag far from a reversal, w r, what moves the
 // tip most.
 TEST(HysteresisIdentification, RecoversKnownPerCableWidths) {
