@@ -69,6 +69,7 @@ Json hysteresis_json(const TrainRun& run) {
   j["likelihood_evaluations"] = id.likelihood_evaluations;
   j["hyperparameter_searches"] = id.hyperparameter_searches;
   j["refinement_gain"] = id.refinement_gain;
+  j["noise_variance_floor"] = s.noise_variance_floor > 0.0 ? Json(s.noise_variance_floor) : Json(nullptr);
   if (s.joints_only_validation.samples > 0) {
     j["validation"] = {{"nominal_commanded", errors_json(s.joints_only_validation.initial)},
                        {"joints_only", errors_json(s.joints_only_validation.compensated)},
@@ -116,6 +117,10 @@ std::string hysteresis_text(const TrainRun& run) {
     t += "\n  weights:";
     for (int k = 0; k < m.operators; ++k) t += fmt::format(" {:.3f}", m.weights[0][k]);
     t += " (every cable)\n";
+  }
+  if (s.noise_variance_floor > 0.0) {
+    t += fmt::format("  noise variance kept at {:.4g} or more (normalised) for the float32 image's fidelity\n",
+                     s.noise_variance_floor);
   }
   if (s.joints_only_validation.samples > 0) {
     t += "held-out: hysteresis or not  position (mm)   orientation (deg)\n";

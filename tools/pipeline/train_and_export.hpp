@@ -64,6 +64,10 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
 // and exported on the effective lengths; or the joints-only model, as
 // train_and_export on the commanded rows, when the identification is
 // skipped (too few rows) or chooses none.
+// Retrainings with a raised noise floor, at most, when the float32 image
+// of a sequence's model misses the fidelity target.
+inline constexpr int kNoiseFloorAttempts = 4;
+
 struct SequenceExport {
   ExportResult result;
   HysteresisIdentification identification;
@@ -71,6 +75,9 @@ struct SequenceExport {
   // (samples 0 when there are none); its `initial` is the nominal model on
   // the commanded lengths.
   Evaluation joints_only_validation;
+  // The noise variance's lower bound (normalised units) the search was given
+  // to keep the float32 image within the fidelity target; 0: not raised.
+  double noise_variance_floor = 0.0;
 
   bool uses_hysteresis() const { return !result.model.hysteresis.empty(); }
 };
