@@ -88,6 +88,18 @@ sim::SimulatorConfig make_config(const SimulateCommandOptions& options, const mo
                        "drop --payload-range");
     }
     config.use_hysteresis_session();
+    if (options.hysteresis_lag_mm) {
+      const std::vector<double> range = parse_number_list(*options.hysteresis_lag_mm, "--hysteresis-lag");
+      require_count(range, 2, "--hysteresis-lag", "LO,HI in mm");
+      require_finite(range, "--hysteresis-lag");
+      if (!(range[0] >= 0.0 && range[0] <= range[1])) {
+        throw InputError(fmt::format("--hysteresis-lag must satisfy 0 <= LO <= HI (got {}, {} mm)", range[0], range[1]));
+      }
+      config.hysteresis.max_lag_min_mm = range[0];
+      config.hysteresis.max_lag_max_mm = range[1];
+    }
+  } else if (options.hysteresis_lag_mm) {
+    throw InputError("--hysteresis-lag needs --hysteresis");
   }
   config.geometric.enabled = !options.no_geometric;
   config.curvature.enabled = !options.no_curvature;
@@ -215,6 +227,9 @@ void register_simulate_command(CLI::App& app, CommandOutput& output) {
                                 sim::HysteresisSessionDefaults::kRepeatabilitySigmaRad,
                                 sim::HysteresisSessionDefaults::kMocapPositionSigmaMm,
                                 sim::HysteresisSessionDefaults::kMocapRotationSigmaRad * model::kDegreesPerRadian));
+  command->add_option("--hysteresis-lag", options->hysteresis_lag_mm,
+                      "With --hysteresis: the range every cable's maximum lag is drawn from, mm")
+      ->type_name("LO,HI");
   command->add_flag("--json", options->json, "Print one JSON object instead of the summary");
   command->callback([options, &output] { output = run_simulate(*options); });
 }

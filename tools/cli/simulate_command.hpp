@@ -41,6 +41,7 @@ struct SimulateCommandOptions {
   // Cable friction hysteresis (source 7) with the session noise of
   // sim::HysteresisSessionDefaults; the dataset is a motion sequence (t_s).
   bool hysteresis = false;
+  std::optional<std::string> hysteresis_lag_mm;  // "LO,HI": the range of every cable's maximum lag; needs hysteresis
   bool json = false;
 };
 
