@@ -56,6 +56,26 @@ TEST(SimulateHysteresis, RefusesAPayloadWithTheSequence) {
   }
 }
 
+TEST(SimulateHysteresis, TheLagRangeNeedsTheHysteresisAndAnOrderedRange) {
+  SimulateCommandOptions options;
+  options.samples = 5;
+  options.hysteresis_lag_mm = "0.4,0.7";
+  EXPECT_THROW(run_simulate(options), InputError);
+  options.hysteresis = true;
+  options.hysteresis_lag_mm = "0.7,0.4";
+  try {
+    run_simulate(options);
+    FAIL() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "--hysteresis-lag must satisfy 0 <= LO <= HI (got 0.7, 0.4 mm)");
+  }
+  // No friction, no memory: the tip is where the same commands put it without it.
+  options.hysteresis_lag_mm = "0,0";
+  options.json = true;
+  const CommandOutput output = run_simulate(options);
+  EXPECT_NE(output.text.find("\"mean_position_mm\":0.0"), std::string::npos) << output.text;
+}
+
 TEST(SimulateHysteresis, WithoutItTheRowsAreSamples) {
   SimulateCommandOptions options;
   options.samples = 5;
