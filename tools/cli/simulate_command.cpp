@@ -155,7 +155,7 @@ std::string hysteresis_comment(const sim::SimulatorConfig& config, const sim::Co
   return fmt::format(
       "hysteresis: per cable a maximum lag uniform in [{}, {}] mm ({} play operators); the robot's state before "
       "homing is unknown\n"
-      "motion sequence (column t_s, s from the start of the homing move): homing move (every segment bent {} rad "
+      "motion sequence (column t_s, s from the end of the homing move): homing move (every segment bent {} rad "
       "towards alpha = 45 deg, then straight), then row to row along straight lines in cable space at {} mm/s, "
       "settling {} s before each row\n"
       "noise: repeatability sigma {} rad, mocap {} mm, {} deg\n"

@@ -76,7 +76,7 @@ std::vector<CollectedSample> collect(SimulatedRobot& robot, WorkspaceSampler& sa
   double time_s = 0.0;
   model::CableVector<double> position_mm;
   if (sequence) {
-    time_s = home(robot);
+    home(robot);  // t = 0: at home, settled
     position_mm = current_cables(*robot.friction());
   }
   for (int i = 0; i < samples; ++i) {

@@ -27,7 +27,7 @@ struct CollectedSample {
   double payload_kg = 0.0;               // carried while measured, known (not noise)
   Measurement measurement;
   // In a motion sequence (hysteresis on): when the row was measured (s from
-  // the start of the homing move), and the true pose the same commanded
+  // the end of the homing move), and the true pose the same commanded
   // cables give without the hysteresis.
   bool in_sequence = false;
   double time_s = 0.0;

@@ -203,7 +203,8 @@ struct HysteresisConfig {
 // moves at most at cable_speed, all arrive together (a move lasts the
 // largest cable change / speed), and the robot settles for settle_s before
 // each row is measured (and at each stop of the homing move). t = 0 is the
-// start of the homing move.
+// end of the homing move: the robot at home, settled (as the independent
+// robot of tools/bench records its sessions).
 struct MotionSequenceConfig {
   double cable_speed_mm_per_s = 10.0;
   double settle_s = 0.5;

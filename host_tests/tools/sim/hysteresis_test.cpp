@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <random>
 #include <stdexcept>
 #include <vector>
@@ -238,8 +239,11 @@ TEST(SimulatorHysteresis, ASessionIsAMotionSequenceThatStartsWithHoming) {
   ASSERT_EQ(model::homing_waypoints(kPrototype, approach_mm, home_mm), model::Status::ok);
   const double speed = config.motion.cable_speed_mm_per_s;
   const double settle = config.motion.settle_s;
-  // Powered up at home: out to the approach and back, then to the first row.
-  double expected_s = 2.0 * ((approach_mm - home_mm).cwiseAbs().maxCoeff() / speed + settle);
+  // t = 0 at home after the homing move (powered up at home, out to the
+  // approach and back: twice the same travel and settling).
+  EXPECT_NEAR(home(*std::make_unique<SimulatedRobot>(kPrototype, config)),
+              2.0 * ((approach_mm - home_mm).cwiseAbs().maxCoeff() / speed + settle), 1e-12);
+  double expected_s = 0.0;
   Cables previous = home_mm;
   for (const CollectedSample& sample : samples) {
     ASSERT_TRUE(sample.in_sequence);

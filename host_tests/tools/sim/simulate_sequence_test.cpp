@@ -35,7 +35,7 @@ TEST(SimulateHysteresis, WritesAMotionSequence) {
   ASSERT_TRUE(data.has_time);
   EXPECT_EQ(data.sample_count(), 25);
   EXPECT_EQ(data.session_starts, (std::vector<int>{0}));
-  EXPECT_GT(data.time_s[0], 0.0);  // the homing move comes first
+  EXPECT_GT(data.time_s[0], 0.0);  // t = 0 at home: the first row is a move and a settling later
   const std::string text = text_of(*options.out_path);
   EXPECT_NE(text.find("# motion sequence (column t_s"), std::string::npos);
   EXPECT_NE(text.find("\nt_s,l1_1,"), std::string::npos);
