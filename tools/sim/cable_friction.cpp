@@ -33,17 +33,17 @@ CableFriction::CableFriction(int cables, const HysteresisConfig& config, std::ui
       weights_[c][k] = total_weight * density[k] / density_sum;
       lag_per_width += weights_[c][k] * (k + 0.5) / kOperators;
     }
-    const double widest_mm = max_lag / lag_per_width;
+    const double widest_mm = max_lag / lag_per_width;  // R_c
     for (int k = 0; k < kOperators; ++k) widths_mm_[c][k] = widest_mm * (k + 0.5) / kOperators;
+    density_width_mm_[c] = widest_mm;
     max_lag_mm_[c] = max_lag;
   }
   // The power-up state: what a random history left. Moves of up to twice the
   // widest play in either direction reach every state a real robot can be in.
   RandomStream history(session_seed, StreamId::hysteresis_state);
   for (int c = 0; c < cables; ++c) {
-    const double widest_mm = widths_mm_[c][kOperators - 1] * kOperators / (kOperators - 0.5);
     for (int move = 0; move < HysteresisConfig::kPowerUpMoves; ++move) {
-      const double dx = history.uniform(-2.0 * widest_mm, 2.0 * widest_mm);
+      const double dx = history.uniform(-2.0 * density_width_mm_[c], 2.0 * density_width_mm_[c]);
       for (int k = 0; k < kOperators; ++k) {
         const double r = widths_mm_[c][k];
         lags_mm_[c][k] = std::clamp(lags_mm_[c][k] + dx, -r, r);

@@ -56,6 +56,7 @@ class CableFriction {
   int cables_ = 0;
   bool has_position_ = false;
   std::array<double, model::kMaxCables> max_lag_mm_{};
+  std::array<double, model::kMaxCables> density_width_mm_{};  // R_c: the widths' density spans (0, R_c]
   std::array<double, model::kMaxCables> commanded_mm_{};
   std::array<std::array<double, kOperators>, model::kMaxCables> widths_mm_{};
   std::array<std::array<double, kOperators>, model::kMaxCables> weights_{};
