@@ -75,7 +75,7 @@ row() {
 
 echo
 echo "== test session (200 rows) =="
-row "noise floor (motion capture)" "$floor_mm" "$floor_deg"
+row "noise floor" "$floor_mm" "$floor_deg"
 row "nominal model" "$nominal_mm" "$nominal_deg"
 if result=$(train_and_eval joints_only "$work_dir/hysteresis/joints0.csv" "$work_dir/hysteresis/joints1.csv"); then
   read -r joints_mm joints_deg <<<"$result"
