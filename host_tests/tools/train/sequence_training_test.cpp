@@ -83,8 +83,12 @@ TEST(SequenceTraining, AValidationSequenceIsRunFromItsOwnHoming) {
 
   dataset::Dataset no_time = validation.data;
   no_time.has_time = false;
-  EXPECT_THROW(train_and_export_sequence(train.data, rows, {}, &no_time, geometry, quick_options(), true, 0, 0),
-               std::invalid_argument);
+  try {
+    train_and_export_sequence(train.data, rows, {}, &no_time, geometry, quick_options(), true, 0, 0);
+    ADD_FAILURE() << "validation rows without time were accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "the validation data have no t_s column; a model of a sequence is validated on a sequence");
+  }
 }
 
 // Too few rows to identify anything: the joints-only model, the very one
@@ -111,8 +115,12 @@ TEST(SequenceTraining, RowsWithoutTimeAreNotASequence) {
   s.data.has_time = false;
   std::vector<int> rows(60);
   std::iota(rows.begin(), rows.end(), 0);
-  EXPECT_THROW(train_and_export_sequence(s.data, rows, {}, nullptr, geometry, quick_options(), true, 0, 0),
-               std::invalid_argument);
+  try {
+    train_and_export_sequence(s.data, rows, {}, nullptr, geometry, quick_options(), true, 0, 0);
+    ADD_FAILURE() << "rows without time were trained as a sequence";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_STREQ(e.what(), "the data are not a motion sequence (no t_s column)");
+  }
 }
 
 }  // namespace
