@@ -107,6 +107,9 @@ std::string format_text(const std::string& path, const ImageReport& r) {
       row("variance factor", h.variance_offset == 0 && h.variance_rank == 0
                                  ? std::string("none")
                                  : fmt::format("offset {}, rank {}", h.variance_offset, h.variance_rank));
+      if (h.hysteresis_cables != 0 || h.hysteresis_operators != 0) {
+        row("hysteresis", fmt::format("{} cables, {} operators each", h.hysteresis_cables, h.hysteresis_operators));
+      }
     }
 
     t += "dims\n";
@@ -165,6 +168,28 @@ std::string format_text(const std::string& path, const ImageReport& r) {
     for (std::size_t k = 0; k < 6; ++k) {
       t += fmt::format("  {:<16}{:>16}{:>16}{:>16}{:>16}\n", fmt::format("{} ({})", kOutputNames[k], kOutputUnits[k]),
                        p.output_mean[k], p.output_scale[k], p.signal_variance[k], p.noise_variance[k]);
+    }
+  }
+  if (r.hysteresis) {
+    // effective length = commanded - sum_k weight_k lag_k, each lag within
+    // +-width (model/include/cdcr/model/hysteresis.hpp).
+    const ImageHysteresis& b = *r.hysteresis;
+    t += fmt::format("cable hysteresis ({} play operators per cable; lags at home after the homing move)
+",
+                     b.operators);
+    t += fmt::format("  {:<9}{:>4}{:>16}{:>12}{:>18}
+", "cable", "k", "width (mm)", "weight", "homing lag (mm)");
+    for (int c = 0; c < b.cables && c < static_cast<int>(kMaxListedRows); ++c) {
+      for (int k = 0; k < b.operators; ++k) {
+        const std::size_t i = static_cast<std::size_t>(c * b.operators + k);
+        t += fmt::format("  {:<9}{:>4}{:>16}{:>12}{:>18}
+", k == 0 ? fmt::format("{}", c + 1) : std::string(), k + 1,
+                         b.widths_mm[i], b.weights[i], b.homing_lags_mm[i]);
+      }
+    }
+    if (b.cables > static_cast<int>(kMaxListedRows)) {
+      t += fmt::format("  ({} more cables not listed)
+", b.cables - static_cast<int>(kMaxListedRows));
     }
   }
   if (r.max_abs_input || r.max_abs_alpha) {
@@ -261,6 +286,8 @@ Json format_json(const std::string& path, const ImageReport& r) {
     if (!is_v1(h)) {
       header["variance_offset"] = h.variance_offset;
       header["variance_rank"] = h.variance_rank;
+      header["hysteresis_cables"] = h.hysteresis_cables;
+      header["hysteresis_operators"] = h.hysteresis_operators;
     }
   }
   header["trailing_bytes"] = r.trailing_bytes ? Json(*r.trailing_bytes) : Json(nullptr);
@@ -322,6 +349,16 @@ Json format_json(const std::string& path, const ImageReport& r) {
     j["hyperparameters"] = nullptr;
     j["input_range"] = nullptr;
     j["default_payload_kg"] = nullptr;
+  }
+  if (r.hysteresis) {
+    const ImageHysteresis& b = *r.hysteresis;
+    j["hysteresis"] = {{"cables", b.cables},
+                       {"operators", b.operators},
+                       {"widths_mm", floats_json(b.widths_mm)},
+                       {"weights", floats_json(b.weights)},
+                       {"homing_lags_mm", floats_json(b.homing_lags_mm)}};
+  } else {
+    j["hysteresis"] = nullptr;
   }
   j["training_set"] = {{"max_abs_kernel_coordinate", r.max_abs_input ? float_json(*r.max_abs_input) : Json(nullptr)},
                        {"max_abs_alpha", r.max_abs_alpha ? float_json(*r.max_abs_alpha) : Json(nullptr)}};
