@@ -228,6 +228,28 @@ TEST(RuntimeReplay, ThePayloadColumnMustMatchTheImage) {
   EXPECT_EQ(run_replay(dir, "payload.img", "loaded.csv"), 0);
 }
 
+// An image that models the cables' hysteresis needs the rows as a motion
+// sequence (a t_s column): rows without time are refused in one line.
+TEST(RuntimeReplay, AHysteresisImageNeedsAMotionSequence) {
+  test_support::SyntheticModelOptions options;
+  options.hysteresis_operators = 2;
+  const std::vector<std::uint8_t> image = exporting::write_image(test_support::synthetic_trained_model(options));
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_hysteresis";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream out(dir / "hysteresis.img", std::ios::binary);
+    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
+  }
+  { std::ofstream(dir / "plain.csv") << "l1_1,l1_2,l1_3,l1_4,l2_1,l2_2,l2_3,l2_4\n120,120,120,120,95.5,95.5,95.5,95.5\n"; }
+  const std::string err = (dir / "err.txt").string();
+  EXPECT_EQ(run_replay(dir, "hysteresis.img", "plain.csv", " 2>\"" + err + "\""), 1);
+  std::ifstream refused(err);
+  const std::string message((std::istreambuf_iterator<char>(refused)), std::istreambuf_iterator<char>());
+  EXPECT_NE(message.find("needs a motion sequence (a t_s column), but the rows have no time"), std::string::npos)
+      << message;
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+}
+
 TEST(RuntimeReplay, CorruptImageIsOneLineErrorWithExitOne) {
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_bad";
   std::filesystem::create_directories(dir);

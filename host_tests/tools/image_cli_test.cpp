@@ -458,6 +458,81 @@ TEST_F(ImageCli, InspectOfASparseModel) {
   EXPECT_NE(text.out.find("  model kind          2 (sparse-gp)\n"), std::string::npos) << text.out;
 }
 
+// A v2.2 image's hysteresis block: its counts in the header, its values
+// in the text and the JSON, and the check that passed on them.
+TEST_F(ImageCli, InspectShowsTheHysteresisBlock) {
+  test_support::SyntheticModelOptions options;
+  options.hysteresis_operators = 2;
+  const training::TrainedModel m = test_support::synthetic_trained_model(options);
+  const fs::path path = save("hysteresis.img", exporting::write_image(m));
+  const CliResult run = cdcr("inspect --json " + quoted(path));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["version"], "2.2");
+  EXPECT_EQ(j["header"]["hysteresis_cables"], 8);
+  EXPECT_EQ(j["header"]["hysteresis_operators"], 2);
+  ASSERT_TRUE(j["hysteresis"].is_object()) << run.out;
+  EXPECT_EQ(j["hysteresis"]["cables"], 8);
+  EXPECT_EQ(j["hysteresis"]["operators"], 2);
+  ASSERT_EQ(j["hysteresis"]["widths_mm"].size(), 16u);
+  EXPECT_EQ(j["hysteresis"]["widths_mm"][3].get<float>(), static_cast<float>(m.hysteresis.widths_mm[1][1]));
+  EXPECT_EQ(j["hysteresis"]["weights"][4].get<float>(), static_cast<float>(m.hysteresis.weights[2][0]));
+  EXPECT_EQ(j["hysteresis"]["homing_lags_mm"][15].get<float>(), static_cast<float>(m.hysteresis.homing_lag_mm[7][1]));
+  EXPECT_EQ(j["checks"]["hysteresis"]["passed"], true);
+  bool listed = false;
+  for (const json& block : j["blocks"]) listed = listed || block["name"] == "hysteresis";
+  EXPECT_TRUE(listed);
+
+  const CliResult text = cdcr("inspect " + quoted(path));
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("  hysteresis          8 cables, 2 operators each\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("cable hysteresis (2 play operators per cable"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("  hysteresis  pass"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("8 cables x 2 play operators: widths within [0, 2] mm"), std::string::npos) << text.out;
+
+  // A joints-only image says it has none.
+  const json plain = json::parse(cdcr("inspect --json " + quoted(save("model.img", image))).out);
+  EXPECT_TRUE(plain["hysteresis"].is_null());
+  EXPECT_EQ(plain["checks"]["hysteresis"]["detail"], "no hysteresis block");
+}
+
+// A bad value in the block, under a valid CRC: the check names it.
+TEST_F(ImageCli, InspectNamesABadHysteresisValue) {
+  test_support::SyntheticModelOptions options;
+  options.hysteresis_operators = 1;
+  Bytes bad = exporting::write_image(test_support::synthetic_trained_model(options));
+  const model::ImageLayout layout = model::image_layout(5, 4, 2, 2, 0, 0, model::image_hysteresis_floats(8, 1));
+  put<float>(bad, layout.hysteresis_offset + 4 * 2, 3.5f);  // cable 3's width
+  put<std::uint32_t>(bad, bad.size() - 4, model::crc32(bad.data(), bad.size() - 4));
+  const CliResult run = cdcr("inspect --json " + quoted(save("bad_hysteresis.img", bad)));
+  EXPECT_EQ(run.exit_code, 1);
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["status"], "invalid_parameters");
+  EXPECT_EQ(j["failed_check"], "hysteresis");
+  EXPECT_NE(j["checks"]["hysteresis"]["detail"].get<std::string>().find("hysteresis_width[2] 3.5, expected at most 2"),
+            std::string::npos)
+      << j["checks"]["hysteresis"]["detail"];
+}
+
+// An image with a hysteresis block evaluated on rows without time (not a
+// motion sequence): one line saying so, exit 1.
+TEST_F(ImageCli, EvalOfAHysteresisImageNeedsAMotionSequence) {
+  const fs::path data = dir / "data.csv";
+  ASSERT_EQ(cdcr("simulate --samples 12 --seed 4 --out " + quoted(data)).exit_code, 0);
+  test_support::SyntheticModelOptions options;
+  options.segments = dataset::read_dataset_csv(data.string()).segment_count;
+  options.hysteresis_operators = 1;
+  const fs::path path = save("hysteresis.img", exporting::write_image(test_support::synthetic_trained_model(options)));
+  const CliResult run = cdcr("eval --model " + quoted(path) + " --data " + quoted(data));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_TRUE(one_line(run.err)) << run.err;
+  EXPECT_NE(run.err.find("needs a motion sequence (a t_s column), but the rows have no time"), std::string::npos)
+      << run.err;
+  options.hysteresis_operators = 0;
+  const fs::path plain = save("plain.img", exporting::write_image(test_support::synthetic_trained_model(options)));
+  EXPECT_EQ(cdcr("eval --model " + quoted(plain) + " --data " + quoted(data)).exit_code, 0);
+}
+
 // A v1 image, built from its specification, goes through every tool that
 // reads images, as before.
 TEST_F(ImageCli, V1ImageLoadsEverywhere) {

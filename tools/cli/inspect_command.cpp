@@ -174,22 +174,18 @@ std::string format_text(const std::string& path, const ImageReport& r) {
     // effective length = commanded - sum_k weight_k lag_k, each lag within
     // +-width (model/include/cdcr/model/hysteresis.hpp).
     const ImageHysteresis& b = *r.hysteresis;
-    t += fmt::format("cable hysteresis ({} play operators per cable; lags at home after the homing move)
-",
+    t += fmt::format("cable hysteresis ({} play operators per cable; lags at home after the homing move)\n",
                      b.operators);
-    t += fmt::format("  {:<9}{:>4}{:>16}{:>12}{:>18}
-", "cable", "k", "width (mm)", "weight", "homing lag (mm)");
+    t += fmt::format("  {:<9}{:>4}{:>16}{:>12}{:>18}\n", "cable", "k", "width (mm)", "weight", "homing lag (mm)");
     for (int c = 0; c < b.cables && c < static_cast<int>(kMaxListedRows); ++c) {
       for (int k = 0; k < b.operators; ++k) {
         const std::size_t i = static_cast<std::size_t>(c * b.operators + k);
-        t += fmt::format("  {:<9}{:>4}{:>16}{:>12}{:>18}
-", k == 0 ? fmt::format("{}", c + 1) : std::string(), k + 1,
+        t += fmt::format("  {:<9}{:>4}{:>16}{:>12}{:>18}\n", k == 0 ? fmt::format("{}", c + 1) : std::string(), k + 1,
                          b.widths_mm[i], b.weights[i], b.homing_lags_mm[i]);
       }
     }
     if (b.cables > static_cast<int>(kMaxListedRows)) {
-      t += fmt::format("  ({} more cables not listed)
-", b.cables - static_cast<int>(kMaxListedRows));
+      t += fmt::format("  ({} more cables not listed)\n", b.cables - static_cast<int>(kMaxListedRows));
     }
   }
   if (r.max_abs_input || r.max_abs_alpha) {
