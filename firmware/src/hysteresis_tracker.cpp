@@ -1,5 +1,7 @@
 #include "cdcr/firmware/hysteresis_tracker.hpp"
 
+#include <cmath>
+
 #include "cdcr/model/chain.hpp"
 #include "cdcr/model/image_hysteresis.hpp"
 #include "cdcr/model/series.hpp"
@@ -33,6 +35,7 @@ void HysteresisTracker::bind(const RobotModel& model) {
   active_ = model.compensated && model::hysteresis_from_image(model.image, model_) &&
             model_.cables == 4 * model.geometry.segment_count;
   if (!active_) model_ = model::HysteresisModel<Scalar>{};
+  geometry_ = model.geometry;
   model::reset_unknown(state_, model_);
   known_ = state_.known();
   widening_ = false;
@@ -45,6 +48,22 @@ const Cables& HysteresisTracker::track(const Cables& commanded_mm) {
   // The lag intervals only shrink: once known, the state stays known.
   if (!known_) known_ = state_.known();
   model::effective_lengths(state_, model_, effective_mm_, &uncertainty_mm_);
+  for (int s = 0; s < geometry_.segment_count; ++s) {
+    // l3 - l1 and l2 - l4 span a chord of at most 4 r sin(theta_max / 2)
+    // (segment.hpp); the means of the two pairs stay.
+    Scalar* e = effective_mm_.data() + 4 * s;
+    const Scalar limit = Scalar(4) * geometry_.segments[s].anchor_radius_mm *
+                         std::sin(Scalar(0.5) * geometry_.segments[s].theta_max_rad) * Scalar(0.999999);
+    const Scalar chord = std::hypot(e[2] - e[0], e[1] - e[3]);
+    if (!(chord > limit)) continue;
+    const Scalar scale = limit / chord;
+    const Scalar mean_13 = Scalar(0.5) * (e[0] + e[2]), half_31 = Scalar(0.5) * scale * (e[2] - e[0]);
+    const Scalar mean_24 = Scalar(0.5) * (e[1] + e[3]), half_24 = Scalar(0.5) * scale * (e[1] - e[3]);
+    e[0] = mean_13 - half_31;
+    e[2] = mean_13 + half_31;
+    e[1] = mean_24 + half_24;
+    e[3] = mean_24 - half_24;
+  }
   return effective_mm_;
 }
 
@@ -52,6 +71,11 @@ void HysteresisTracker::homed(const Geometry& geometry) {
   if (!active_ || model::start_at_home(state_, model_, geometry) != model::Status::ok) return;
   known_ = state_.known();
   uncertainty_mm_.setZero(model_.cables);
+}
+
+void HysteresisTracker::commanded_for(Cables& cables_mm) const {
+  if (!active_ || !state_.has_position) return;
+  for (int c = 0; c < model_.cables; ++c) cables_mm[c] = model::commanded_for_effective(state_, model_, c, cables_mm[c]);
 }
 
 // The bend of segment i follows its cables as u = (l3 - l1) / (2 r s),

@@ -333,5 +333,49 @@ TEST_F(RuntimeHysteresisTest, R95IsWiderWhileTheStateIsUnknownByTheCablesUncerta
   EXPECT_LT(known.r95_position_mm, unknown.r95_position_mm);
 }
 
+// IK with the cables' hysteresis: the solver finds the effective lengths
+// that reach the target, and the setpoints are the commanded lengths that
+// produce them from the state the drives' moves leave. The same target,
+// approached from either side, is reached both times (the runtime's pose on
+// the effective lengths of the drives' lengths, its own model), with
+// setpoints that differ by the play the cables take up on the way.
+TEST_F(RuntimeHysteresisTest, IkReachesATargetApproachedFromEitherSide) {
+  boot_with(hysteresis_model());
+  drives->set_silent(false);
+  cycles(2);
+  send_frame(protocol::Homing{});
+  cycles(2);
+  ASSERT_TRUE(runtime->hysteresis().known());
+  const model::Pose<double> start = runtime->latest_pose().pose.cast<double>();
+  const Eigen::Vector3d target = start.position_mm + Eigen::Vector3d(1.0, -3.0, 0.0);
+  std::uint8_t sequence = 1;
+  // A position target, then cycles until IK is done and the drives hold
+  // the setpoints; returns the tip's distance from the target.
+  const auto go_to = [&](const Eigen::Vector3d& p) {
+    send_position_target(p.x(), p.y(), p.z(), sequence++);
+    cycles_until_ik_done();
+    protocol::IkReport report;
+    EXPECT_TRUE(last_ik_report(report));
+    EXPECT_EQ(report.outcome, protocol::IkOutcome::converged)
+        << model::to_string(runtime->last_ik_report().model_status) << " iterations " << report.iterations << " residual "
+        << report.position_residual_mm;
+    int settling = 0;
+    do {
+      cycles(1);
+    } while (++settling < 2000 && (drives->cables_mm() - drives->setpoints_mm()).cwiseAbs().maxCoeff() > 1e-9);
+    cycles(3);
+    return (runtime->latest_pose().pose.position_mm.cast<double>() - p).norm();
+  };
+  const Eigen::Vector3d step(3.0, 0.0, 0.0);
+  EXPECT_LT(go_to(target - step), 0.05);
+  EXPECT_LT(go_to(target), 0.05) << "approached from -x";
+  const Cables from_below = runtime->setpoints_mm();
+  EXPECT_LT(go_to(target + step), 0.05);
+  EXPECT_LT(go_to(target), 0.05) << "approached from +x";
+  const Cables from_above = runtime->setpoints_mm();
+  // The same effective lengths, commanded differently from either side.
+  EXPECT_GT((from_below - from_above).cwiseAbs().maxCoeff(), 0.1f);
+}
+
 }  // namespace
 }  // namespace cdcr::firmware

@@ -16,6 +16,7 @@
 // (model::gaussian_radius_95), so the radii widen while the state is unknown
 // and are the GP's own, unchanged, once it is known.
 
+#include "cdcr/firmware/capacity.hpp"
 #include "cdcr/firmware/kinematics.hpp"
 #include "cdcr/model/hysteresis.hpp"
 
@@ -33,10 +34,19 @@ class HysteresisTracker {
   // The drives' lengths of a complete cable set: moves the state (from the
   // previous set in a straight line) and returns the lengths to estimate the
   // pose on, the effective ones; without a block, or for lengths that are not
-  // finite (the kinematics refuses them), `commanded_mm` itself.
+  // finite (the kinematics refuses them), `commanded_mm` itself. A segment
+  // cannot bend beyond its limit: where the estimated lags would put it
+  // there (at the edge of the workspace), its effective cable differences
+  // are scaled back to the limit.
   const Cables& track(const Cables& commanded_mm);
   // The robot has just completed the homing move and is at home.
   void homed(const Geometry& geometry);
+
+  // IK's setpoints: the commanded lengths that bring each cable's effective
+  // length to `cables_mm` (in place), moving in a straight line from the
+  // latest lengths the drives reported (model::commanded_for_effective);
+  // without a block, or before any lengths, unchanged.
+  void commanded_for(Cables& cables_mm) const;
 
   // A pose variance begins on `estimate`: keeps the tip covariance the
   // unknown state adds there (none once known).
@@ -54,6 +64,7 @@ class HysteresisTracker {
   bool known_ = true;
   model::HysteresisModel<Scalar> model_;
   model::HysteresisState<Scalar> state_;
+  Geometry geometry_;
   Cables effective_mm_;
   Cables uncertainty_mm_;
   // The covariance added at the pose of the variance in progress: position

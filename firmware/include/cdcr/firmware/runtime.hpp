@@ -178,7 +178,7 @@ class Runtime {
   HysteresisTracker hysteresis_;
 
   FrameInputs frame_inputs_;
-  IkRequest ik_{model_, outbox_};
+  IkRequest ik_{model_, outbox_, &hysteresis_};
   CycleScheduler scheduler_;
   std::uint32_t ik_units_last_cycle_ = 0;
 
