@@ -35,7 +35,14 @@ void HysteresisTracker::bind(const RobotModel& model) {
   active_ = model.compensated && model::hysteresis_from_image(model.image, model_) &&
             model_.cables == 4 * model.geometry.segment_count;
   if (!active_) model_ = model::HysteresisModel<Scalar>{};
-  geometry_ = model.geometry;
+  // l3 - l1 and l2 - l4 span a chord of at most 4 r sin(theta_max / 2)
+  // (segment.hpp), a little less here so the kinematics' rounding allowance
+  // is not needed.
+  segments_ = model.geometry.segment_count;
+  for (int s = 0; s < segments_; ++s) {
+    chord_limit_mm_[s] = Scalar(4) * model.geometry.segments[s].anchor_radius_mm *
+                         std::sin(Scalar(0.5) * model.geometry.segments[s].theta_max_rad) * Scalar(0.999999);
+  }
   model::reset_unknown(state_, model_);
   known_ = state_.known();
   widening_ = false;
@@ -48,12 +55,10 @@ const Cables& HysteresisTracker::track(const Cables& commanded_mm) {
   // The lag intervals only shrink: once known, the state stays known.
   if (!known_) known_ = state_.known();
   model::effective_lengths(state_, model_, effective_mm_, &uncertainty_mm_);
-  for (int s = 0; s < geometry_.segment_count; ++s) {
-    // l3 - l1 and l2 - l4 span a chord of at most 4 r sin(theta_max / 2)
-    // (segment.hpp); the means of the two pairs stay.
+  for (int s = 0; s < segments_; ++s) {
+    // The means of the two pairs stay.
     Scalar* e = effective_mm_.data() + 4 * s;
-    const Scalar limit = Scalar(4) * geometry_.segments[s].anchor_radius_mm *
-                         std::sin(Scalar(0.5) * geometry_.segments[s].theta_max_rad) * Scalar(0.999999);
+    const Scalar limit = chord_limit_mm_[s];
     const Scalar chord = std::hypot(e[2] - e[0], e[1] - e[3]);
     if (!(chord > limit)) continue;
     const Scalar scale = limit / chord;

@@ -64,7 +64,8 @@ class HysteresisTracker {
   bool known_ = true;
   model::HysteresisModel<Scalar> model_;
   model::HysteresisState<Scalar> state_;
-  Geometry geometry_;
+  int segments_ = 0;
+  Scalar chord_limit_mm_[kMaxSegments] = {};  // per segment, the largest |(l3 - l1, l2 - l4)|
   Cables effective_mm_;
   Cables uncertainty_mm_;
   // The covariance added at the pose of the variance in progress: position
