@@ -70,9 +70,9 @@ inline constexpr int kMaxVarianceRank = static_cast<int>(model::kMaxVarianceRank
 // and the effective length; and, in a cycle that begins a pose variance while
 // the state is unknown, the nominal Jacobian that widens the radii. Measured
 // under QEMU by qemu.cycle_budget_hysteresis_<board> (16 cables x 2
-// operators: a cable set's tracking at most about 2,400 instructions on the
-// M7 and 2,600 on the M4F, the widening 2,951 and 4,818; the 142 units
-// charged are 6,674 and 7,668 instructions there). The widening is charged
+// operators: a cable set's tracking at most 2,162 instructions on the M7
+// and 2,210 on the M4F, the widening 2,951 and 4,818; the 142 units charged
+// are 6,674 and 7,668 instructions there). The widening is charged
 // in every cycle, though it runs only while the state is unknown.
 inline constexpr std::uint32_t kHysteresisUnitsPerOperator = 1;
 inline constexpr std::uint32_t kHysteresisWideningUnits = 110;
