@@ -27,6 +27,12 @@ void check_accepted(const Dataset& data, std::string_view text, PoseColumns pose
   require(data.poses.size() == (data.has_poses ? static_cast<std::size_t>(data.sample_count()) : 0u));
   require(data.payload_kg.size() == (data.has_payload ? data.sample_count() : 0));
   require(data.payload_kg.allFinite() && (data.payload_kg.array() >= 0.0).all());
+  // A motion sequence: strictly increasing, split where the gaps are; never with a payload.
+  require(data.time_s.size() == (data.has_time ? data.sample_count() : 0));
+  require(!(data.has_time && data.has_payload));
+  for (Eigen::Index i = 1; i < data.time_s.size(); ++i) require(data.time_s[i] > data.time_s[i - 1]);
+  require(data.has_time ? data.session_starts == session_starts_from_times(data.time_s)
+                        : data.session_starts.empty());
   for (const auto& pose : data.poses) {
     require(pose.all_finite());
     const double orthonormality = (pose.rotation.transpose() * pose.rotation - Eigen::Matrix3d::Identity()).cwiseAbs().maxCoeff();
@@ -36,6 +42,13 @@ void check_accepted(const Dataset& data, std::string_view text, PoseColumns pose
   const Dataset back = parse_dataset_csv(format_dataset_csv(data, "fuzz"), poses);
   require(back.segment_count == data.segment_count && back.has_poses == data.has_poses);
   require(back.has_payload == data.has_payload && back.payload_kg.size() == data.payload_kg.size());
+  require(back.has_time == data.has_time && back.time_s.size() == data.time_s.size());
+  require(back.session_starts == data.session_starts);
+  for (Eigen::Index i = 0; i < data.time_s.size(); ++i) {
+    const double a = data.time_s[i];
+    const double b = back.time_s[i];
+    require(a == b && std::signbit(a) == std::signbit(b));
+  }
   for (Eigen::Index i = 0; i < data.payload_kg.size(); ++i) {
     const double a = data.payload_kg[i];
     const double b = back.payload_kg[i];

@@ -140,6 +140,13 @@ int main(int argc, char** argv) {
   write(root / "csv" / "payload_poses.csv",
         cdcr::dataset::format_dataset_csv(small_dataset(2, 3, true, true), "measured with a payload"));
   write(root / "csv" / "payload_cables.csv", cdcr::dataset::format_dataset_csv(small_dataset(1, 2, false, true)));
+  // A motion sequence of two sessions (a pause of more than 30 s between them).
+  cdcr::dataset::Dataset sequence = small_dataset(2, 4, true);
+  sequence.has_time = true;
+  sequence.time_s.resize(4);
+  sequence.time_s << 0.75, 1.5, 40.0, 41.25;
+  sequence.session_starts = cdcr::dataset::session_starts_from_times(sequence.time_s);
+  write(root / "csv" / "time_sequence.csv", cdcr::dataset::format_dataset_csv(sequence, "a motion sequence"));
   write(root / "csv" / "crlf_bom_comments.csv",
         std::string("\xEF\xBB\xBF# exported\r\n\r\nl1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy,qz\r\n"
                     "120,+121.5,119, 118 ,1e1,-0,240,1,0,0,0\r\n# end\r\n"));

@@ -31,8 +31,8 @@ void register_import_mocap_command(CLI::App& app, CommandOutput& output) {
       "import-mocap",
       "Build a dataset from commanded cable lengths and a Qualisys (QTM) 6DOF TSV export: row i of the cable "
       "file is paired with captured frame i, and the pose written is T_base^-1 * T_end (eq. 21)");
-  command->add_option("--cables", options->cables_path, "Dataset CSV with the commanded cable lengths and, optionally, the payload (pose columns, if any, "
-                      "are ignored)")
+  command->add_option("--cables", options->cables_path, "Dataset CSV with the commanded cable lengths and, optionally, the time (t_s: a motion "
+                      "sequence, carried into the output) or the payload (pose columns, if any, are ignored)")
       ->type_name("FILE")
       ->required();
   command->add_option("--mocap", options->mocap_path, "QTM 6DOF export (.tsv): X Y Z in mm, Rot[0..8] column-major")
@@ -42,7 +42,8 @@ void register_import_mocap_command(CLI::App& app, CommandOutput& output) {
   command->add_option("--end-body", options->end_body, "Rigid body on the end platform")->type_name("NAME")->required();
   command->add_option("--out", options->out_path, "Dataset CSV to write")->type_name("FILE")->required();
   command->add_flag("--skip-lost", options->skip_lost,
-                    "Drop frames (and their cable rows) where either body was not tracked, instead of failing");
+                    "Drop frames (and their cable rows) where either body was not tracked, instead of failing (not in a "
+                    "motion sequence: its rows cannot be dropped)");
   command->callback([options, &output] { output = run_import_mocap(*options); });
 }
 

@@ -18,6 +18,9 @@
 #include "number_list.hpp"
 #include "sim/data_collection.hpp"
 
+#include <cdcr/model/hysteresis.hpp>
+#include <cdcr/model/units.hpp>
+
 namespace cdcr::cli {
 namespace {
 
@@ -78,6 +81,26 @@ sim::SimulatorConfig make_config(const SimulateCommandOptions& options, const mo
     throw InputError(fmt::format("--workspace-theta-max ({} rad) exceeds --theta-max ({} rad)",
                                  config.workspace_theta_max_rad, design_theta_max_rad));
   }
+  // The session noise first: --noise-scale and the --no-* switches apply to it.
+  if (options.hysteresis) {
+    if (options.payload_range_kg) {
+      throw InputError("--hysteresis records a motion sequence (a t_s column), which cannot carry a payload column: "
+                       "drop --payload-range");
+    }
+    config.use_hysteresis_session();
+    if (options.hysteresis_lag_mm) {
+      const std::vector<double> range = parse_number_list(*options.hysteresis_lag_mm, "--hysteresis-lag");
+      require_count(range, 2, "--hysteresis-lag", "LO,HI in mm");
+      require_finite(range, "--hysteresis-lag");
+      if (!(range[0] >= 0.0 && range[0] <= range[1])) {
+        throw InputError(fmt::format("--hysteresis-lag must satisfy 0 <= LO <= HI (got {}, {} mm)", range[0], range[1]));
+      }
+      config.hysteresis.max_lag_min_mm = range[0];
+      config.hysteresis.max_lag_max_mm = range[1];
+    }
+  } else if (options.hysteresis_lag_mm) {
+    throw InputError("--hysteresis-lag needs --hysteresis");
+  }
   config.geometric.enabled = !options.no_geometric;
   config.curvature.enabled = !options.no_curvature;
   config.compliance.enabled = !options.no_compliance;
@@ -94,7 +117,8 @@ sim::SimulatorConfig make_config(const SimulateCommandOptions& options, const mo
   return config;
 }
 
-dataset::Dataset to_dataset(const std::vector<sim::CollectedSample>& samples, int segment_count, bool payload) {
+dataset::Dataset to_dataset(const std::vector<sim::CollectedSample>& samples, int segment_count, bool payload,
+                            bool sequence) {
   dataset::Dataset data;
   data.segment_count = segment_count;
   data.has_poses = true;
@@ -107,6 +131,12 @@ dataset::Dataset to_dataset(const std::vector<sim::CollectedSample>& samples, in
     if (payload) data.payload_kg[static_cast<Eigen::Index>(i)] = samples[i].payload_kg;
     data.poses.push_back(samples[i].measurement.measured_pose);
   }
+  if (sequence) {
+    data.has_time = true;
+    data.time_s.resize(static_cast<Eigen::Index>(samples.size()));
+    for (std::size_t i = 0; i < samples.size(); ++i) data.time_s[static_cast<Eigen::Index>(i)] = samples[i].time_s;
+    data.session_starts = dataset::session_starts_from_times(data.time_s);
+  }
   return data;
 }
 
@@ -117,6 +147,25 @@ std::string payload_comment(const sim::SimulatorConfig& config) {
                      config.gravity.enabled
                          ? fmt::format("on top of the {} kg end platform", config.gravity.platform_mass_kg)
                          : std::string("weightless: gravity is off"));
+}
+
+std::string hysteresis_comment(const sim::SimulatorConfig& config, const sim::CollectionSummary& summary) {
+  if (!config.hysteresis.enabled) return {};
+  const sim::HysteresisConfig& h = config.hysteresis;
+  return fmt::format(
+      "hysteresis: per cable a maximum lag uniform in [{}, {}] mm ({} play operators); the robot's state before "
+      "homing is unknown\n"
+      "motion sequence (column t_s, s from the end of the homing move): homing move (every segment bent {} rad "
+      "towards alpha = 45 deg, then straight), then row to row along straight lines in cable space at {} mm/s, "
+      "settling {} s before each row\n"
+      "noise: repeatability sigma {} rad, mocap {} mm, {} deg\n"
+      "hysteresis moves the tip (same commands without it): mean {:.6g} mm, max {:.6g} mm\n",
+      h.max_lag_min_mm, h.max_lag_max_mm, sim::HysteresisConfig::kOperators, model::kHomingBendRad,
+      config.motion.cable_speed_mm_per_s, config.motion.settle_s,
+      config.repeatability.enabled ? config.repeatability.bend_sigma_rad : 0.0,
+      config.mocap_noise.enabled ? config.mocap_noise.position_sigma_mm : 0.0,
+      config.mocap_noise.enabled ? config.mocap_noise.rotation_sigma_rad * model::kDegreesPerRadian : 0.0,
+      summary.hysteresis.mean_position_mm, summary.hysteresis.max_position_mm);
 }
 
 std::string dataset_comment(const model::RobotGeometry<double>& geometry,
@@ -131,7 +180,7 @@ std::string dataset_comment(const model::RobotGeometry<double>& geometry,
              on_off(config.geometric.enabled), on_off(config.curvature.enabled), on_off(config.compliance.enabled),
              on_off(config.gravity.enabled), on_off(config.repeatability.enabled),
              on_off(config.mocap_noise.enabled)) +
-         payload_comment(config) +
+         payload_comment(config) + hysteresis_comment(config, summary) +
          fmt::format("initial mean error (nominal model vs measured): {:.6g} mm, {:.6g} deg\n",
                      summary.initial.position_mm, summary.initial.orientation_deg) +
          fmt::format("noise floor (true vs measured pose): {:.6g} mm, {:.6g} deg", summary.noise_floor.position_mm,
@@ -170,6 +219,17 @@ void register_simulate_command(CLI::App& app, CommandOutput& output) {
                       "Payload on the end platform, drawn per sample uniform in [LO, HI] kg; writes the payload_kg "
                       "column")
       ->type_name("LO,HI");
+  command->add_flag("--hysteresis", options->hysteresis,
+                    fmt::format("With cable friction hysteresis (maximum lag {}-{} mm per cable) and a low-noise "
+                                "session (repeatability {} rad, mocap {} mm, {} deg): records a motion sequence that "
+                                "starts with the homing move, with a t_s column",
+                                sim::HysteresisConfig{}.max_lag_min_mm, sim::HysteresisConfig{}.max_lag_max_mm,
+                                sim::HysteresisSessionDefaults::kRepeatabilitySigmaRad,
+                                sim::HysteresisSessionDefaults::kMocapPositionSigmaMm,
+                                sim::HysteresisSessionDefaults::kMocapRotationSigmaRad * model::kDegreesPerRadian));
+  command->add_option("--hysteresis-lag", options->hysteresis_lag_mm,
+                      "With --hysteresis: the range every cable's maximum lag is drawn from, mm")
+      ->type_name("LO,HI");
   command->add_flag("--json", options->json, "Print one JSON object instead of the summary");
   command->callback([options, &output] { output = run_simulate(*options); });
 }
@@ -195,7 +255,8 @@ CommandOutput run_simulate(const SimulateCommandOptions& options) {
 
   if (options.out_path) {
     try {
-      const dataset::Dataset data = to_dataset(samples, geometry.segment_count, config.payload.enabled);
+      const dataset::Dataset data =
+          to_dataset(samples, geometry.segment_count, config.payload.enabled, summary.sequence);
       dataset::write_dataset_csv(*options.out_path, data, dataset_comment(geometry, config, summary));
     } catch (const dataset::DatasetError& error) {
       throw InputError(error.what());
@@ -211,6 +272,13 @@ CommandOutput run_simulate(const SimulateCommandOptions& options) {
     result["noise_floor"] = {{"position_mm", summary.noise_floor.position_mm},
                              {"orientation_deg", summary.noise_floor.orientation_deg}};
     if (config.payload.enabled) result["payload_kg"] = {{"min", config.payload.min_kg}, {"max", config.payload.max_kg}};
+    if (summary.sequence) {
+      result["hysteresis"] = {{"mean_position_mm", summary.hysteresis.mean_position_mm},
+                              {"max_position_mm", summary.hysteresis.max_position_mm},
+                              {"mean_orientation_deg", summary.hysteresis.mean_orientation_deg},
+                              {"max_orientation_deg", summary.hysteresis.max_orientation_deg}};
+      result["duration_s"] = samples.back().time_s;
+    }
     output.text = result.dump() + "\n";
   } else {
     output.text = fmt::format("samples: {}\n", summary.samples);
@@ -221,6 +289,14 @@ CommandOutput run_simulate(const SimulateCommandOptions& options) {
     output.text += fmt::format("initial mean error: {:.3f} mm, {:.3f} deg\nnoise floor: {:.3f} mm, {:.3f} deg\n",
                                summary.initial.position_mm, summary.initial.orientation_deg,
                                summary.noise_floor.position_mm, summary.noise_floor.orientation_deg);
+    if (summary.sequence) {
+      output.text += fmt::format(
+          "hysteresis moves the tip (against the same commands without it): mean {:.3f} mm, max {:.3f} mm; "
+          "{:.3f} deg, {:.3f} deg\nmotion sequence: homing move, then {} rows in {:.1f} s\n",
+          summary.hysteresis.mean_position_mm, summary.hysteresis.max_position_mm,
+          summary.hysteresis.mean_orientation_deg, summary.hysteresis.max_orientation_deg, summary.samples,
+          samples.back().time_s);
+    }
     if (options.out_path) output.text += fmt::format("dataset: {}\n", *options.out_path);
   }
   return output;

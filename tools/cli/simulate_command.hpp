@@ -2,7 +2,8 @@
 // cdcr simulate: a dataset from the simulated robot, collected as in the
 // paper's experiment (Section V-B): random joint variables, cables commanded
 // through the nominal inverse, the end-platform pose as the motion-capture
-// system reports it.
+// system reports it. With --hysteresis, a motion sequence: the homing move,
+// then row to row along straight lines in cable space, with a t_s column.
 
 #include <cstdint>
 #include <optional>
@@ -37,6 +38,10 @@ struct SimulateCommandOptions {
   bool no_mocap_noise = false;
   double noise_scale = 1.0;
   std::optional<std::string> payload_range_kg;  // "LO,HI"; unset: no payload, no payload column
+  // Cable friction hysteresis (source 7) with the session noise of
+  // sim::HysteresisSessionDefaults; the dataset is a motion sequence (t_s).
+  bool hysteresis = false;
+  std::optional<std::string> hysteresis_lag_mm;  // "LO,HI": the range of every cable's maximum lag; needs hysteresis
   bool json = false;
 };
 

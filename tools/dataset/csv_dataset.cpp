@@ -19,6 +19,7 @@ using detail::kUtf8ByteOrderMark;
 using detail::split_fields;
 using detail::trim_blanks;
 
+constexpr const char* kTimeColumn = "t_s";
 constexpr const char* kPayloadColumn = "payload_kg";
 constexpr const char* kPoseColumns[] = {"x", "y", "z", "qw", "qx", "qy", "qz"};
 constexpr int kPoseColumnCount = 7;
@@ -45,15 +46,22 @@ double parse_number(std::string_view field, int line, const std::string& column)
 struct Header {
   int line = 0;
   int segment_count = 0;
+  bool has_time = false;
   bool has_payload = false;
   bool has_poses = false;
 
+  int first_cable_column() const { return has_time ? 1 : 0; }
   int cable_columns() const { return 4 * segment_count; }
-  int columns() const { return cable_columns() + (has_payload ? 1 : 0) + (has_poses ? kPoseColumnCount : 0); }
+  int payload_column() const { return first_cable_column() + cable_columns(); }
+  int columns() const {
+    return first_cable_column() + cable_columns() + (has_payload ? 1 : 0) + (has_poses ? kPoseColumnCount : 0);
+  }
   std::string column_name(int index) const {
-    if (index < cable_columns()) return cable_column_name(index / 4, index % 4);
-    if (has_payload && index == cable_columns()) return kPayloadColumn;
-    return kPoseColumns[index - cable_columns() - (has_payload ? 1 : 0)];
+    if (has_time && index == 0) return kTimeColumn;
+    const int cable = index - first_cable_column();
+    if (cable < cable_columns()) return cable_column_name(cable / 4, cable % 4);
+    if (has_payload && index == payload_column()) return kPayloadColumn;
+    return kPoseColumns[index - payload_column() - (has_payload ? 1 : 0)];
   }
 };
 
@@ -64,21 +72,35 @@ Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
   if (first != detail::NumberStatus::not_a_number && first != detail::NumberStatus::empty) {
     throw DatasetError(line_number, "missing header: the first line must name the columns (l1_1,l1_2,...), found data");
   }
+  // The time column has one place: first.
+  const bool has_time = fields[0] == kTimeColumn;
+  const int first_cable = has_time ? 1 : 0;
+  for (int i = 1; i < static_cast<int>(fields.size()); ++i) {
+    if (fields[i] == kTimeColumn) {
+      throw DatasetError(line_number, "header column " + std::to_string(i + 1) + " is '" + kTimeColumn +
+                                          "', which belongs first, before the cable columns");
+    }
+  }
   int cables = 0;
-  while (cables < static_cast<int>(fields.size()) && !fields[cables].empty() && fields[cables][0] == 'l') ++cables;
+  while (first_cable + cables < static_cast<int>(fields.size()) && !fields[first_cable + cables].empty() &&
+         fields[first_cable + cables][0] == 'l') {
+    ++cables;
+  }
   // The payload column has one place: right after the cable columns.
   for (int i = 0; i < static_cast<int>(fields.size()); ++i) {
-    if (fields[i] == kPayloadColumn && (i != cables || cables == 0 || cables % 4 != 0)) {
+    if (fields[i] == kPayloadColumn && (i != first_cable + cables || cables == 0 || cables % 4 != 0)) {
       throw DatasetError(line_number, "header column " + std::to_string(i + 1) + " is '" + kPayloadColumn +
                                           "', which belongs right after the cable columns and before x,y,z,...");
     }
   }
   if (cables == 0 || cables % 4 != 0) {
-    throw DatasetError(line_number, "header must start with cable columns l1_1,l1_2,l1_3,l1_4,... (a multiple of 4), found " +
+    throw DatasetError(line_number, std::string("header must start with ") + (has_time ? "t_s, then " : "") +
+                                        "cable columns l1_1,l1_2,l1_3,l1_4,... (a multiple of 4), found " +
                                         std::to_string(cables));
   }
   Header h;
   h.line = line_number;
+  h.has_time = has_time;
   h.segment_count = cables / 4;
   if (h.segment_count > model::kMaxSegments) {
     throw DatasetError(line_number, std::to_string(cables) + " cable columns make " + std::to_string(h.segment_count) +
@@ -87,13 +109,18 @@ Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
   }
   for (int i = 0; i < cables; ++i) {
     const std::string expected = cable_column_name(i / 4, i % 4);
-    if (fields[i] != expected) {
-      throw DatasetError(line_number, "header column " + std::to_string(i + 1) + " is " + quoted(fields[i]) +
-                                          ", expected '" + expected + "'");
+    if (fields[first_cable + i] != expected) {
+      throw DatasetError(line_number, "header column " + std::to_string(first_cable + i + 1) + " is " +
+                                          quoted(fields[first_cable + i]) + ", expected '" + expected + "'");
     }
   }
-  h.has_payload = cables < static_cast<int>(fields.size()) && fields[cables] == kPayloadColumn;
-  const int first_pose = cables + (h.has_payload ? 1 : 0);
+  h.has_payload = h.payload_column() < static_cast<int>(fields.size()) && fields[h.payload_column()] == kPayloadColumn;
+  if (h.has_time && h.has_payload) {
+    throw DatasetError(line_number, std::string("a time column (") + kTimeColumn + ") together with a payload column (" +
+                                        kPayloadColumn + ") is not supported: record a motion sequence without "
+                                        "payload, or payload samples without time");
+  }
+  const int first_pose = h.payload_column() + (h.has_payload ? 1 : 0);
   const int rest = static_cast<int>(fields.size()) - first_pose;
   if (rest == 0) {
     if (poses == PoseColumns::required) {
@@ -172,6 +199,8 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses) {
   Header header;
   bool have_header = false;
   std::vector<double> values;
+  std::string previous_time;  // the last row's t_s field, for messages
+  int rows_read = 0;
   detail::LineReader lines(text);
   for (std::string_view raw; lines.next(raw);) {
     const std::string_view line = trim_blanks(raw);
@@ -188,21 +217,39 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses) {
       throw DatasetError(line_number, "expected " + std::to_string(expected) + " fields, found " +
                                           std::to_string(fields.size()));
     }
+    const std::size_t row_start = values.size();
     for (int i = 0; i < expected; ++i) values.push_back(parse_number(fields[i], line_number, header.column_name(i)));
+    if (header.has_time) {
+      const double time_s = values[row_start];
+      if (rows_read > 0) {
+        const double previous_s = values[row_start - static_cast<std::size_t>(expected)];
+        if (!(time_s > previous_s)) {
+          throw DatasetError(line_number, std::string("column ") + kTimeColumn + ": " + quoted(fields[0]) +
+                                              " is not after the previous row's " + detail::quoted(std::string_view(previous_time)) +
+                                              "; the time of a motion sequence must strictly increase");
+        }
+        if (time_s - previous_s > kSessionGapSeconds) data.session_starts.push_back(rows_read);
+      } else {
+        data.session_starts.push_back(0);
+      }
+      previous_time = std::string(fields[0]);
+    }
     if (header.has_payload) {
-      const std::size_t payload = values.size() - static_cast<std::size_t>(expected - header.cable_columns());
+      const std::size_t payload = row_start + static_cast<std::size_t>(header.payload_column());
       if (values[payload] < 0.0) {
         throw DatasetError(line_number, std::string("column ") + kPayloadColumn + ": " +
-                                            quoted(fields[header.cable_columns()]) +
+                                            quoted(fields[header.payload_column()]) +
                                             " is negative; a payload is a mass, zero or more kg");
       }
     }
+    ++rows_read;
     if (header.has_poses) {
       data.poses.push_back(pose_from_fields(values.data() + values.size() - kPoseColumnCount, line_number));
     }
   }
   if (!have_header) throw DatasetError(0, "no header line (expected l1_1,l1_2,...): the file is empty or only comments");
   data.segment_count = header.segment_count;
+  data.has_time = header.has_time;
   data.has_payload = header.has_payload;
   data.has_poses = header.has_poses;
   const int columns = header.columns();
@@ -210,8 +257,9 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses) {
   if (rows == 0) throw DatasetError(header.line, "no data rows after the header");
   const Eigen::Map<const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>> all(values.data(), rows,
                                                                                                      columns);
-  data.cables_mm = all.leftCols(header.cable_columns());
-  if (header.has_payload) data.payload_kg = all.col(header.cable_columns());
+  data.cables_mm = all.middleCols(header.first_cable_column(), header.cable_columns());
+  if (header.has_time) data.time_s = all.col(0);
+  if (header.has_payload) data.payload_kg = all.col(header.payload_column());
   return data;
 }
 
@@ -225,6 +273,15 @@ Dataset read_dataset_csv(const std::string& path, PoseColumns poses) {
   } catch (const DatasetError& e) {
     throw DatasetError(path, e);
   }
+}
+
+std::vector<int> session_starts_from_times(const Eigen::VectorXd& time_s) {
+  std::vector<int> starts;
+  if (time_s.size() > 0) starts.push_back(0);
+  for (Eigen::Index i = 1; i < time_s.size(); ++i) {
+    if (time_s[i] - time_s[i - 1] > kSessionGapSeconds) starts.push_back(static_cast<int>(i));
+  }
+  return starts;
 }
 
 std::string format_dataset_csv(const Dataset& data, const std::string& comment) {
@@ -246,12 +303,30 @@ std::string format_dataset_csv(const Dataset& data, const std::string& comment) 
       throw std::invalid_argument("dataset has a payload that is NaN, Inf or negative");
     }
   }
+  if (data.has_time) {
+    if (data.has_payload) throw std::invalid_argument("dataset has both a time and a payload column: not supported");
+    if (data.time_s.size() != data.sample_count()) {
+      throw std::invalid_argument("dataset has " + std::to_string(data.time_s.size()) + " times for " +
+                                  std::to_string(data.sample_count()) + " samples");
+    }
+    if (!data.time_s.allFinite()) throw std::invalid_argument("dataset has a time that is NaN or Inf");
+    for (Eigen::Index i = 1; i < data.time_s.size(); ++i) {
+      if (!(data.time_s[i] > data.time_s[i - 1])) {
+        throw std::invalid_argument("dataset time does not strictly increase at row " + std::to_string(i + 1));
+      }
+    }
+    if (data.session_starts != session_starts_from_times(data.time_s)) {
+      throw std::invalid_argument("dataset session starts are not where the time has gaps of more than " +
+                                  std::to_string(kSessionGapSeconds) + " s: a reader would split it differently");
+    }
+  }
   std::ostringstream out;
   out << std::setprecision(std::numeric_limits<double>::max_digits10);
   if (!comment.empty()) {
     std::istringstream lines(comment);
     for (std::string line; std::getline(lines, line);) out << "# " << line << '\n';
   }
+  if (data.has_time) out << kTimeColumn << ',';
   for (int i = 0; i < 4 * data.segment_count; ++i) out << (i ? "," : "") << cable_column_name(i / 4, i % 4);
   if (data.has_payload) out << ',' << kPayloadColumn;
   if (data.has_poses) {
@@ -259,6 +334,7 @@ std::string format_dataset_csv(const Dataset& data, const std::string& comment) 
   }
   out << '\n';
   for (int r = 0; r < data.sample_count(); ++r) {
+    if (data.has_time) out << data.time_s[r] << ',';
     for (Eigen::Index c = 0; c < data.cables_mm.cols(); ++c) out << (c ? "," : "") << data.cables_mm(r, c);
     if (data.has_payload) out << ',' << data.payload_kg[r];
     if (data.has_poses) {

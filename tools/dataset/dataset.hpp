@@ -14,6 +14,12 @@
 
 namespace cdcr::dataset {
 
+// In a motion sequence, a pause longer than this between two rows starts a new
+// session: the robot may have been switched off or moved by hand, so the
+// session must start with a homing move like the first one (tools/README.md,
+// "Dataset format").
+inline constexpr double kSessionGapSeconds = 30.0;
+
 struct Dataset {
   int segment_count = 0;
   Eigen::MatrixXd cables_mm;                   // samples x 4n, columns l1_1, l1_2, ..., ln_4

@@ -258,11 +258,17 @@ MocapImport import_mocap(const Dataset& commanded, const MocapCapture& capture, 
     const auto& base_pose = frame.body_in_camera[base];
     const auto& end_pose = frame.body_in_camera[end];
     if (!base_pose || !end_pose) {
+      const std::string& lost = !base_pose ? options.base_body : options.end_body;
+      if (commanded.has_time) {
+        // The robot still moved through the row; without it the path from
+        // row to row, which the hysteresis depends on, would be wrong.
+        throw DatasetError(frame.line, "frame " + std::to_string(frame.frame_number) + ": body " + quoted(lost) +
+                                           " was not tracked, and a row of a motion sequence (t_s) cannot be dropped");
+      }
       if (options.lost_frames == LostFrames::skip) {
         result.skipped_frames.push_back(frame.frame_number);
         continue;
       }
-      const std::string& lost = !base_pose ? options.base_body : options.end_body;
       throw LostTrackingError(frame.line, "frame " + std::to_string(frame.frame_number) + ": body " + quoted(lost) +
                                               " was not tracked");
     }
@@ -282,6 +288,12 @@ MocapImport import_mocap(const Dataset& commanded, const MocapCapture& capture, 
   result.data.cables_mm = commanded.cables_mm(kept_rows, Eigen::all);
   result.data.has_payload = commanded.has_payload;
   if (commanded.has_payload) result.data.payload_kg = commanded.payload_kg(kept_rows);
+  // A motion sequence keeps its commanded times (no row is dropped from one).
+  result.data.has_time = commanded.has_time;
+  if (commanded.has_time) {
+    result.data.time_s = commanded.time_s;
+    result.data.session_starts = commanded.session_starts;
+  }
   return result;
 }
 

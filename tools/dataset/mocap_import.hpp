@@ -85,6 +85,13 @@ struct MocapImport {
 // count). Throws DatasetError: line 0 for a count mismatch, the column header
 // line for a missing body; LostTrackingError with the frame's line for a lost
 // body under LostFrames::reject.
+//
+// A motion sequence (the commanded file has t_s) keeps the commanded file's
+// times and sessions: they say when each row was commanded and measured, on
+// the clock the sequence was planned with (the capture's Time column is
+// another clock and is not used). No row of a sequence can be dropped: a lost
+// body there is a DatasetError with the frame's line, even under
+// LostFrames::skip.
 MocapImport import_mocap(const Dataset& commanded, const MocapCapture& capture, const MocapImportOptions& options);
 
 }  // namespace cdcr::dataset

@@ -45,6 +45,10 @@ int main(int argc, char** argv) {
   app.add_option("--rate", rate_hz, "cycle rate for --sim, Hz")->capture_default_str();
   app.add_option("--seconds", seconds, "simulated duration for --sim")->capture_default_str();
   app.add_flag("--ideal-robot", ideal_robot, "--sim with every simulated error source off (the nominal model)");
+  bool hysteresis = false;
+  app.add_flag("--hysteresis", hysteresis,
+               "--sim with the cables' friction hysteresis (as cdcr simulate --hysteresis): the tip depends on the "
+               "path of the drives");
   app.add_flag("--circle", circle,
                "--sim following a streamed circle (a TRACKING pose target every cycle), once round");
   app.add_option("--circle-radius", circle_radius_mm, "--circle radius, mm")->capture_default_str();
@@ -57,6 +61,7 @@ int main(int argc, char** argv) {
       throw CLI::ValidationError("one of --replay, --sim or --can is required");
     }
     if (circle && !run_sim) throw CLI::ValidationError("--circle needs --sim");
+    if (hysteresis && !run_sim) throw CLI::ValidationError("--hysteresis needs --sim");
     if (!flash_dir.empty() && can_interface.empty()) throw CLI::ValidationError("--flash-dir needs --can");
     if (spin_option->count() > 0 && can_interface.empty()) throw CLI::ValidationError("--spin needs --can");
     if (!replay_path.empty() && (image_path.empty() || out_path.empty())) {
@@ -73,8 +78,9 @@ int main(int argc, char** argv) {
       return run_on_socketcan(image_path, can_interface, rate_hz, app.count("--seconds") > 0 ? seconds : 0.0,
                               flash_dir, spin);
     }
-    if (run_sim && circle) return follow_circle(image_path, rate_hz, circle_radius_mm, circle_speed_mm_s, ideal_robot);
-    return run_sim ? simulate(image_path, rate_hz, seconds, ideal_robot) : replay(image_path, replay_path, out_path);
+    const SimulatedRobotChoice robot{ideal_robot, hysteresis};
+    if (run_sim && circle) return follow_circle(image_path, rate_hz, circle_radius_mm, circle_speed_mm_s, robot);
+    return run_sim ? simulate(image_path, rate_hz, seconds, robot) : replay(image_path, replay_path, out_path);
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());
     return kExitUsage;

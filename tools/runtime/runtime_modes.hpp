@@ -12,12 +12,22 @@ namespace cdcr::runtime_host {
 // possible, into a pose CSV.
 int replay(const std::string& image_path, const std::string& cables_path, const std::string& out_path);
 
+// The simulated robot of --sim: --ideal-robot turns every error source off;
+// --hysteresis turns the cables' friction hysteresis on (source 7 of
+// tools/sim/simulator_config.hpp, as `cdcr simulate --hysteresis`): the
+// friction follows every change of the drives' lengths, so the tip depends
+// on the path.
+struct SimulatedRobotChoice {
+  bool ideal_robot = false;
+  bool hysteresis = false;
+};
+
 // --sim: the closed loop with simulated drives and robot over the virtual
 // bus, at a fixed rate in lockstep simulated time; the six demo targets.
-int simulate(const std::string& image_path, double rate_hz, double seconds, bool ideal_robot);
+int simulate(const std::string& image_path, double rate_hz, double seconds, const SimulatedRobotChoice& robot);
 // --sim --circle: the same loop following a streamed circle.
 int follow_circle(const std::string& image_path, double rate_hz, double radius_mm, double speed_mm_s,
-                  bool ideal_robot);
+                  const SimulatedRobotChoice& robot);
 
 // --can: the runtime itself on a SocketCAN interface, in real time, until
 // `seconds` have passed (0: no limit) or SIGINT/SIGTERM.

@@ -42,13 +42,19 @@ fw::Runtime& booted(fw::Runtime& runtime) {
   return runtime;
 }
 
+sim::SimulatorConfig robot_config(const SimulatedRobotChoice& choice) {
+  sim::SimulatorConfig config = choice.ideal_robot ? sim::SimulatorConfig::nominal_only() : sim::SimulatorConfig{};
+  config.hysteresis.enabled = choice.hysteresis;
+  return config;
+}
+
 // The runtime on the simulated board (with the image, if one is given), and
 // the simulated robot whose cables it reads and moves.
 struct SimulatedLoop {
-  SimulatedLoop(const std::string& image_path, bool ideal_robot)
+  SimulatedLoop(const std::string& image_path, const SimulatedRobotChoice& choice)
       : runtime(with_image(platform, image_path).hal, fw::Geometry::prototype()),
         geometry(booted(runtime).geometry().cast<double>()),
-        robot(geometry, ideal_robot ? sim::SimulatorConfig::nominal_only() : sim::SimulatorConfig{}) {}
+        robot(geometry, robot_config(choice)) {}
 
   sim::SimulatedPlatform platform;
   fw::Runtime runtime;
@@ -93,17 +99,17 @@ void send_pose_target(cdcr::hal::CanBus& host, const model::Pose<double>& target
 }  // namespace
 
 int follow_circle(const std::string& image_path, double rate_hz, double radius_mm, double speed_mm_s,
-                  bool ideal_robot) {
+                  const SimulatedRobotChoice& robot_choice) {
   require_rate(rate_hz);
   if (!(radius_mm > 0) || !(radius_mm <= 100)) throw std::invalid_argument("--circle-radius must be in (0, 100] mm");
   if (!(speed_mm_s > 0) || !(speed_mm_s <= 500)) {
     throw std::invalid_argument("--circle-speed must be in (0, 500] mm/s");
   }
-  SimulatedLoop loop(image_path, ideal_robot);
+  SimulatedLoop loop(image_path, robot_choice);
   sim::SimulatedPlatform& platform = loop.platform;
   fw::Runtime& runtime = loop.runtime;
   const model::RobotGeometry<double>& geometry = loop.geometry;
-  const sim::SimulatedRobot& robot = loop.robot;
+  sim::SimulatedRobot& robot = loop.robot;
   // The bend that puts the nominal tip radius_mm off the axis.
   const auto joints_at = [&](double bend_rad, double direction_rad) {
     model::JointVector<double> joints(2 * geometry.segment_count);
@@ -129,6 +135,9 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   model::CableVector<double> start_cables;
   model::cables_from_joints(joints_at(0.5 * bend_rad, 0.0), geometry, start_cables);
   sim::SimulatedCableDrives drives(platform.bus.node(1), start_cables, 50.0);
+  // The lengths that bend the segments: the drives' through the friction,
+  // which follows every step of the drives (the drives' own with it off).
+  model::CableVector<double> effective_cables = robot.move_cables(drives.cables_mm());
   cdcr::hal::CanBus& host = platform.bus.node(2);
   host.set_filters(&protocol::kIkReportFrames, 1);
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
@@ -140,6 +149,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   const auto cycle = [&] {
     const cdcr::hal::TimerTick tick = platform.timer.wait_next();
     drives.step(dt_s);
+    effective_cables = robot.move_cables(drives.cables_mm());
     const std::uint32_t poses = runtime.statistics().poses_published;
     const auto begin = std::chrono::steady_clock::now();
     runtime.run_cycle(tick);
@@ -195,7 +205,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
     center_mm += target_mm / double(stream_cycles);
     send_pose_target(host, target, ++sequence, true);
     cycle();
-    const double error_mm = (robot.true_pose(drives.cables_mm()).position_mm - target_mm).norm();
+    const double error_mm = (robot.true_pose(effective_cables).position_mm - target_mm).norm();
     error.add(error_mm);
     const double following_mm = setpoints_to_target_mm(target);
     following.add(following_mm);
@@ -217,14 +227,14 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   return 0;
 }
 
-int simulate(const std::string& image_path, double rate_hz, double seconds, bool ideal_robot) {
+int simulate(const std::string& image_path, double rate_hz, double seconds, const SimulatedRobotChoice& robot_choice) {
   require_rate(rate_hz);
   if (!(seconds > 0) || !(seconds <= 3600)) throw std::invalid_argument("--seconds must be in (0, 3600]");
-  SimulatedLoop loop(image_path, ideal_robot);
+  SimulatedLoop loop(image_path, robot_choice);
   sim::SimulatedPlatform& platform = loop.platform;
   fw::Runtime& runtime = loop.runtime;
   const model::RobotGeometry<double>& geometry = loop.geometry;
-  const sim::SimulatedRobot& robot = loop.robot;
+  sim::SimulatedRobot& robot = loop.robot;
 
   std::mt19937 rng(7);
   std::uniform_real_distribution<double> alpha(-M_PI, M_PI), theta(0.02, 0.2);
@@ -239,6 +249,9 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
   model::CableVector<double> start_cables;
   model::cables_from_joints(random_joints(), geometry, start_cables);
   sim::SimulatedCableDrives drives(platform.bus.node(1), start_cables, 50.0);
+  // The lengths that bend the segments: the drives' through the friction,
+  // which follows every step of the drives (the drives' own with it off).
+  model::CableVector<double> effective_cables = robot.move_cables(drives.cables_mm());
   cdcr::hal::CanBus& host = platform.bus.node(2);
   host.set_filters(&protocol::kIkReportFrames, 1);
 
@@ -273,9 +286,10 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
   for (long k = 0; k < cycles; ++k) {
     const cdcr::hal::TimerTick tick = platform.timer.wait_next();
     drives.step(dt_s);
+    effective_cables = robot.move_cables(drives.cables_mm());
     if (k % cycles_per_target == 0) {
       if (targets_sent > 0) {
-        const double error_mm = (robot.true_pose(drives.cables_mm()).position_mm - target_mm).norm();
+        const double error_mm = (robot.true_pose(effective_cables).position_mm - target_mm).norm();
         target_error.add(error_mm);
         ++targets_checked;
         // The request spans cycles: its setpoints are checked when the next
@@ -319,7 +333,7 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
     }
     if (runtime.has_pose()) {
       const double error_mm =
-          (robot.true_pose(drives.cables_mm()).position_mm - runtime.latest_pose().pose.position_mm.cast<double>())
+          (robot.true_pose(effective_cables).position_mm - runtime.latest_pose().pose.position_mm.cast<double>())
               .norm();
       estimate_error.add(error_mm);
       ++estimate_samples;
@@ -328,7 +342,7 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, bool
       if (model::joints_from_cables(drives.cables_mm(), geometry, nominal_joints) == model::Status::ok &&
           model::forward_kinematics(nominal_joints, geometry, nominal_pose) == model::Status::ok) {
         const double nominal_error_mm =
-            (robot.true_pose(drives.cables_mm()).position_mm - nominal_pose.position_mm).norm();
+            (robot.true_pose(effective_cables).position_mm - nominal_pose.position_mm).norm();
         nominal_estimate_error.add(nominal_error_mm);
       }
     }

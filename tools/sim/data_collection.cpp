@@ -4,6 +4,7 @@
 #include <string>
 
 #include <cdcr/model/chain.hpp>
+#include <cdcr/model/hysteresis.hpp>
 #include <cdcr/model/pose_error_summary.hpp>
 
 #include "sim/random_stream.hpp"
@@ -23,7 +24,46 @@ model::Pose<double> nominal_pose(const model::CableVector<double>& cables_mm,
   return pose;
 }
 
+model::CableVector<double> current_cables(const CableFriction& friction) {
+  model::CableVector<double> cables(friction.cables());
+  for (int c = 0; c < friction.cables(); ++c) cables[c] = friction.commanded_mm()[static_cast<std::size_t>(c)];
+  return cables;
+}
+
 }  // namespace
+
+double move_and_settle_s(const model::CableVector<double>& from_mm, const model::CableVector<double>& to_mm,
+                         const MotionSequenceConfig& motion) {
+  return (to_mm - from_mm).cwiseAbs().maxCoeff() / motion.cable_speed_mm_per_s + motion.settle_s;
+}
+
+double home(SimulatedRobot& robot) {
+  model::CableVector<double> approach_mm, home_mm;
+  const model::Status status = model::homing_waypoints(robot.nominal_geometry(), approach_mm, home_mm);
+  if (status != model::Status::ok) {
+    throw std::invalid_argument(std::string("homing move: ") + model::to_string(status));
+  }
+  const CableFriction* friction = robot.friction();
+  if (friction != nullptr) {
+    const double travel_mm = model::homing_travel_mm(approach_mm, home_mm);
+    const double widest_mm = friction->largest_width_mm();
+    if (!(travel_mm >= 2.0 * widest_mm)) {
+      throw std::invalid_argument("the homing move takes every cable " + std::to_string(travel_mm) +
+                                  " mm, less than twice the widest friction play (" + std::to_string(widest_mm) +
+                                  " mm): the state at home would depend on the state before");
+    }
+  }
+  // Just powered up, the robot stands straight: at home, with an unknown state.
+  const model::CableVector<double> start_mm =
+      friction != nullptr && friction->has_position() ? current_cables(*friction) : home_mm;
+  robot.move_cables(start_mm);
+  const MotionSequenceConfig& motion = robot.config().motion;
+  double duration_s = move_and_settle_s(start_mm, approach_mm, motion);
+  robot.move_cables(approach_mm);
+  duration_s += move_and_settle_s(approach_mm, home_mm, motion);
+  robot.move_cables(home_mm);
+  return duration_s;
+}
 
 std::vector<CollectedSample> collect(SimulatedRobot& robot, WorkspaceSampler& sampler, int samples) {
   if (samples < 0) throw std::invalid_argument("the sample count must not be negative");
@@ -31,6 +71,14 @@ std::vector<CollectedSample> collect(SimulatedRobot& robot, WorkspaceSampler& sa
   RandomStream payloads(robot.config().session_seed(), StreamId::payload);
   std::vector<CollectedSample> result;
   result.reserve(static_cast<std::size_t>(samples));
+  // With the hysteresis the session is a motion sequence that starts with the homing move.
+  const bool sequence = robot.friction() != nullptr;
+  double time_s = 0.0;
+  model::CableVector<double> position_mm;
+  if (sequence) {
+    home(robot);  // t = 0: at home, settled
+    position_mm = current_cables(*robot.friction());
+  }
   for (int i = 0; i < samples; ++i) {
     const WorkspaceSample command = sampler.next();
     CollectedSample sample;
@@ -38,6 +86,13 @@ std::vector<CollectedSample> collect(SimulatedRobot& robot, WorkspaceSampler& sa
     sample.cables_mm = command.cables_mm;
     sample.nominal_pose = nominal_pose(command.cables_mm, robot.nominal_geometry());
     if (payload.enabled) sample.payload_kg = payloads.uniform(payload.min_kg, payload.max_kg);
+    if (sequence) {
+      time_s += move_and_settle_s(position_mm, command.cables_mm, robot.config().motion);
+      position_mm = command.cables_mm;
+      sample.in_sequence = true;
+      sample.time_s = time_s;
+      sample.frictionless_pose = robot.true_pose(command.cables_mm, sample.payload_kg);
+    }
     sample.measurement = robot.measure(command.cables_mm, sample.payload_kg);
     result.push_back(sample);
   }
@@ -68,6 +123,14 @@ CollectionSummary summarize(const std::vector<CollectedSample>& samples) {
   summary.samples = static_cast<int>(samples.size());
   summary.initial = mean_pose_error(measured, nominal);
   summary.noise_floor = mean_pose_error(measured, truth);
+  summary.sequence = !samples.empty() && samples.front().in_sequence;
+  if (summary.sequence) {
+    std::vector<model::Pose<double>> frictionless;
+    for (const CollectedSample& s : samples) frictionless.push_back(s.frictionless_pose);
+    const model::PoseErrorSummary e = model::summarize_pose_errors(frictionless.data(), truth.data(), truth.size());
+    summary.hysteresis = HysteresisEffect{e.mean_position_mm, e.max_position_mm, e.mean_orientation_deg,
+                                          e.max_orientation_deg};
+  }
   return summary;
 }
 

@@ -19,6 +19,8 @@ enum class StreamId : std::uint64_t {
   workspace = 2,
   noise = 3,
   payload = 4,
+  hysteresis = 5,        // the friction of every cable: a property of the robot (seed)
+  hysteresis_state = 6,  // the friction state at power-up (session seed)
 };
 
 class RandomStream {

@@ -20,6 +20,15 @@ using Pose = model::Pose<double>;
 constexpr int kMaxGravityIterations = 200;
 constexpr double kGravityToleranceRad = 1e-13;
 
+void check_cables(const model::CableVector<double>& cables_mm, int segment_count) {
+  if (cables_mm.size() != 4 * segment_count) {
+    throw std::invalid_argument("expected " + std::to_string(4 * segment_count) + " cable lengths, got " +
+                                std::to_string(cables_mm.size()));
+  }
+  if (!cables_mm.allFinite()) throw std::invalid_argument("cable lengths must be finite");
+  if (!(cables_mm.minCoeff() > 0.0)) throw std::invalid_argument("cable lengths must be positive");
+}
+
 }  // namespace
 
 SimulatedRobot::SimulatedRobot(const model::RobotGeometry<double>& nominal, const SimulatorConfig& config)
@@ -41,6 +50,9 @@ SimulatedRobot::SimulatedRobot(const model::RobotGeometry<double>& nominal, cons
     const double cables = 2.0 * k * radius_mm_[i] * radius_mm_[i];
     stiffness_n_mm_per_rad_[i] = EI / length_mm_[i] + cables;
     bend_retained_[i] = cables / stiffness_n_mm_per_rad_[i];
+  }
+  if (config_.hysteresis.enabled) {
+    friction_.emplace(4 * nominal.segment_count, config_.hysteresis, config_.seed, config_.session_seed());
   }
 }
 
@@ -113,12 +125,7 @@ model::JointVector<double> SimulatedRobot::gravity_equilibrium(const model::Join
 model::JointVector<double> SimulatedRobot::achieved_bends(const model::CableVector<double>& cables_mm,
                                                           double payload_kg) const {
   const int n = nominal_.segment_count;
-  if (cables_mm.size() != 4 * n) {
-    throw std::invalid_argument("expected " + std::to_string(4 * n) + " cable lengths, got " +
-                                std::to_string(cables_mm.size()));
-  }
-  if (!cables_mm.allFinite()) throw std::invalid_argument("cable lengths must be finite");
-  if (!(cables_mm.minCoeff() > 0.0)) throw std::invalid_argument("cable lengths must be positive");
+  check_cables(cables_mm, n);
   if (!(std::isfinite(payload_kg) && payload_kg >= 0.0)) {
     throw std::invalid_argument("payload must be finite and not negative (got " + std::to_string(payload_kg) + " kg)");
   }
@@ -141,9 +148,22 @@ Pose SimulatedRobot::true_pose(const model::CableVector<double>& cables_mm, doub
   return pose_from_bends(achieved_bends(cables_mm, payload_kg));
 }
 
+model::CableVector<double> SimulatedRobot::move_cables(const model::CableVector<double>& commanded_mm) {
+  check_cables(commanded_mm, nominal_.segment_count);
+  if (!friction_) return commanded_mm;
+  friction_->move_to(commanded_mm);
+  return friction_->effective_mm();
+}
+
 Measurement SimulatedRobot::measure(const model::CableVector<double>& cables_mm, double payload_kg) {
-  const model::JointVector<double> bends = achieved_bends(cables_mm, payload_kg);
+  // The same checks, in the same order, as achieved_bends, before the friction moves.
+  check_cables(cables_mm, nominal_.segment_count);
+  if (!(std::isfinite(payload_kg) && payload_kg >= 0.0)) {
+    throw std::invalid_argument("payload must be finite and not negative (got " + std::to_string(payload_kg) + " kg)");
+  }
   Measurement m;
+  m.effective_cables_mm = move_cables(cables_mm);
+  const model::JointVector<double> bends = achieved_bends(m.effective_cables_mm, payload_kg);
   m.true_pose = pose_from_bends(bends);
 
   const RepeatabilityConfig& repeatability = config_.repeatability;

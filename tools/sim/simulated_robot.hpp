@@ -19,6 +19,12 @@
 // measure() then perturbs the achieved bends (repeatability) and the reported
 // pose (mocap noise).
 //
+// With the hysteresis on (source 7), the robot has a state: the friction of
+// every cable (CableFriction) between the commanded lengths and the effective
+// ones that enter step 1. move_cables() and measure() move the cables there
+// along a straight line in cable space and update it; true_pose() stays a
+// function of the lengths given (pass it effective lengths).
+//
 // A given seed is a given physical robot: its imperfections are drawn once,
 // at construction. The per-sample noise has its own random stream, so
 // true_pose() is a deterministic function of the cables and the payload.
@@ -28,11 +34,13 @@
 // Zero is the robot without a payload, bit for bit.
 
 #include <array>
+#include <optional>
 
 #include <cdcr/model/geometry.hpp>
 #include <cdcr/model/se3.hpp>
 #include <cdcr/model/types.hpp>
 
+#include "sim/cable_friction.hpp"
 #include "sim/random_stream.hpp"
 #include "sim/robot_deviations.hpp"
 #include "sim/simulator_config.hpp"
@@ -42,6 +50,7 @@ namespace cdcr::sim {
 struct Measurement {
   model::Pose<double> true_pose;      // systematic errors only, what true_pose() returns
   model::Pose<double> measured_pose;  // plus repeatability and mocap noise
+  model::CableVector<double> effective_cables_mm;  // the commanded ones minus the friction's lag (source 7)
 };
 
 class SimulatedRobot {
@@ -66,9 +75,18 @@ class SimulatedRobot {
 
   model::Pose<double> true_pose(const model::CableVector<double>& cables_mm, double payload_kg = 0.0) const;
 
-  // One sample: draws the per-sample noise from the noise stream (whether or
-  // not the noise sources are enabled, so each source's draws do not depend
-  // on the other's switch).
+  // The friction of the cables, or nullptr with the hysteresis off.
+  const CableFriction* friction() const { return friction_ ? &*friction_ : nullptr; }
+
+  // The cables move to `commanded_mm` along a straight line in cable space
+  // (the friction's first move only records where they are); returns the
+  // effective lengths there: the commanded ones with the hysteresis off.
+  // Throws std::invalid_argument as achieved_bends does, before moving.
+  model::CableVector<double> move_cables(const model::CableVector<double>& commanded_mm);
+
+  // One sample: moves the cables there (move_cables), then draws the
+  // per-sample noise from the noise stream (whether or not the noise sources
+  // are enabled, so each source's draws do not depend on the other's switch).
   Measurement measure(const model::CableVector<double>& cables_mm, double payload_kg = 0.0);
 
  private:
@@ -93,6 +111,7 @@ class SimulatedRobot {
   std::array<double, model::kMaxSegments> stiffness_n_mm_per_rad_{};
   std::array<double, model::kMaxSegments> bend_retained_{};  // 2 k r^2 / K
   RandomStream noise_;
+  std::optional<CableFriction> friction_;
 };
 
 }  // namespace cdcr::sim

@@ -30,6 +30,13 @@ SimulatorConfig SimulatorConfig::nominal_only() {
   return config;
 }
 
+void SimulatorConfig::use_hysteresis_session() {
+  hysteresis.enabled = true;
+  repeatability.bend_sigma_rad = HysteresisSessionDefaults::kRepeatabilitySigmaRad;
+  mocap_noise.position_sigma_mm = HysteresisSessionDefaults::kMocapPositionSigmaMm;
+  mocap_noise.rotation_sigma_rad = HysteresisSessionDefaults::kMocapRotationSigmaRad;
+}
+
 void SimulatorConfig::validate() const {
   require(std::isfinite(workspace_theta_max_rad) && workspace_theta_max_rad > 0.0 &&
               workspace_theta_max_rad <= model::kPi,
@@ -70,6 +77,20 @@ void SimulatorConfig::validate() const {
   require_sigma(repeatability.bend_sigma_rad, "repeatability sigma");
   require_sigma(mocap_noise.position_sigma_mm, "mocap position sigma");
   require_sigma(mocap_noise.rotation_sigma_rad, "mocap rotation sigma");
+
+  const HysteresisConfig& h = hysteresis;
+  require(std::isfinite(h.max_lag_min_mm) && std::isfinite(h.max_lag_max_mm) && h.max_lag_min_mm >= 0.0 &&
+              h.max_lag_min_mm <= h.max_lag_max_mm,
+          "hysteresis maximum lag range must satisfy 0 <= min <= max (mm), both finite");
+  require(std::isfinite(h.total_weight_min) && std::isfinite(h.total_weight_max) && h.total_weight_min > 0.0 &&
+              h.total_weight_min <= h.total_weight_max && h.total_weight_max <= 1.0,
+          "hysteresis total weight range must satisfy 0 < min <= max <= 1");
+  require(std::isfinite(h.density_slope_max) && h.density_slope_max >= 0.0 && h.density_slope_max < 1.0,
+          "hysteresis density slope must lie in [0, 1)");
+  require(std::isfinite(motion.cable_speed_mm_per_s) && motion.cable_speed_mm_per_s > 0.0,
+          "motion sequence cable speed must be positive");
+  require(std::isfinite(motion.settle_s) && motion.settle_s > 0.0,
+          "motion sequence settling time must be positive");
 }
 
 }  // namespace cdcr::sim

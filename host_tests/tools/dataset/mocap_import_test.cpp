@@ -565,4 +565,64 @@ TEST(ImportMocapCommand, ThroughTheExecutable) {
   EXPECT_EQ(usage.err.rfind("cdcr: usage: --out is required", 0), 0u) << usage.err;
 }
 
+// ---------------------------------------------------------------------------
+// Motion sequences: the commanded file's t_s goes into the dataset.
+
+Dataset commanded_sequence(int rows) {
+  Dataset data = commanded_cables(rows);
+  data.has_time = true;
+  data.time_s.resize(rows);
+  // A pause of a minute before row 3 starts a second session.
+  for (int r = 0; r < rows; ++r) data.time_s[r] = 1.5 * (r + 1) + (r >= 3 ? 60.0 : 0.0);
+  data.session_starts = cdcr::dataset::session_starts_from_times(data.time_s);
+  return data;
+}
+
+TEST(MocapImport, KeepsTheTimeOfAMotionSequence) {
+  const KnownCapture k = known_capture(6, 5);
+  const Dataset commanded = commanded_sequence(6);
+  ASSERT_EQ(commanded.session_starts, (std::vector<int>{0, 3}));
+  const MocapImport result = cdcr::dataset::import_mocap(
+      commanded, cdcr::dataset::parse_qtm_6d_tsv(qtm_tsv({k.base, k.end})), bodies("Base", "End platform"));
+  ASSERT_TRUE(result.data.has_time);
+  EXPECT_EQ(result.data.time_s, commanded.time_s);
+  EXPECT_EQ(result.data.session_starts, commanded.session_starts);
+
+  // Without a time column the rows stay independent samples.
+  const MocapImport samples = cdcr::dataset::import_mocap(
+      commanded_cables(6), cdcr::dataset::parse_qtm_6d_tsv(qtm_tsv({k.base, k.end})), bodies("Base", "End platform"));
+  EXPECT_FALSE(samples.data.has_time);
+  EXPECT_EQ(samples.data.time_s.size(), 0);
+}
+
+// The robot moved through a row whose frame was lost: dropping it would
+// leave a path the robot did not take.
+TEST(MocapImport, RefusesToDropARowOfAMotionSequence) {
+  const KnownCapture k = capture_with_lost_frames(6, {}, {3});
+  for (const LostFrames lost : {LostFrames::reject, LostFrames::skip}) {
+    const DatasetError e =
+        import_rejection(commanded_sequence(6), qtm_tsv({k.base, k.end}), bodies("Base", "End platform", lost));
+    EXPECT_STREQ(e.what(),
+                 "line 15: frame 4: body 'End platform' was not tracked, and a row of a motion sequence (t_s) cannot "
+                 "be dropped");
+  }
+}
+
+TEST(ImportMocapCommand, WritesTheTimeColumnBack) {
+  const KnownCapture k = known_capture(6, 9);
+  const Dataset commanded = commanded_sequence(6);
+  const Files files = write_inputs("time", commanded, qtm_tsv({k.base, k.end}));
+  cdcr::cli::run_import_mocap(command_options(files));
+  std::ifstream file(files.out);
+  std::string line;
+  while (std::getline(file, line) && line.rfind('#', 0) == 0) {
+  }
+  EXPECT_EQ(line.rfind("t_s,l1_1,", 0), 0u) << line;
+  const Dataset written = cdcr::dataset::read_dataset_csv(files.out, cdcr::dataset::PoseColumns::required);
+  ASSERT_TRUE(written.has_time);
+  EXPECT_EQ(written.time_s, commanded.time_s);
+  EXPECT_EQ(written.session_starts, (std::vector<int>{0, 3}));
+  EXPECT_EQ(written.cables_mm, commanded.cables_mm);
+}
+
 }  // namespace

@@ -71,7 +71,7 @@ struct HysteresisModel {
 enum class HysteresisCheck : std::uint8_t {
   ok = 0,
   bad_counts,         // cables not 4 per segment, or operators outside 1..capacity
-  bad_width,          // a width not finite or negative
+  bad_width,          // a width not finite, negative or above kMaxHysteresisWidthMm
   bad_weight,         // a weight not finite, negative, or a cable's weights summing above 1
   bad_homing_lag,     // a homing lag not finite or outside [-width, width]
 };
@@ -88,7 +88,10 @@ HysteresisCheck check_hysteresis(const HysteresisModel<S>& model, int segment_co
       const S width = model.widths_mm[c][k];
       const S weight = model.weights[c][k];
       const S lag = model.homing_lag_mm[c][k];
-      if (!std::isfinite(width) || !(width >= S(0))) return HysteresisCheck::bad_width;
+      // Wider operators than the limit would not all close on the homing move.
+      if (!std::isfinite(width) || !(width >= S(0)) || !(width <= S(kMaxHysteresisWidthMm))) {
+        return HysteresisCheck::bad_width;
+      }
       if (!std::isfinite(weight) || !(weight >= S(0))) return HysteresisCheck::bad_weight;
       if (!std::isfinite(lag) || !(std::abs(lag) <= width)) return HysteresisCheck::bad_homing_lag;
       weight_sum += weight;
@@ -197,51 +200,63 @@ void effective_lengths(const HysteresisState<S>& state, const HysteresisModel<S>
 
 // The commanded length of one cable that brings its effective length to
 // `effective_target_mm`, moving in a straight line from the state's position
-// (the inverse of the operator on the one-directional move it takes). The
-// effective length is a continuous, non-decreasing, piecewise linear function
-// of the commanded one; where it is flat (a dead band with sum w_k = 1) and
-// the target is already met, the cable stays.
+// (the inverse of update_hysteresis and effective_lengths on the
+// one-directional move it takes). The effective length is a continuous,
+// non-decreasing, piecewise linear function of the commanded one; where it is
+// flat (a dead band with sum w_k = 1) and the target is already met, the
+// cable stays.
+//
+// The estimate uses the midpoint of each lag's interval, and update_hysteresis
+// clamps both ends of the interval, not the midpoint: while the state is
+// unknown an operator acts as two operators of half its weight, one at each
+// end, which saturate at different points of the move. With a known lag the
+// two ends coincide and it is the operator itself.
 template <typename S>
 S commanded_for_effective(const HysteresisState<S>& state, const HysteresisModel<S>& model, int cable,
                           S effective_target_mm) {
+  constexpr int kEnds = 2 * kMaxHysteresisOperators;
   const S x0 = state.commanded_mm[cable];
-  S lag0[kMaxHysteresisOperators];
-  S e0 = x0;
+  // The effective length now, summed as effective_lengths does.
+  S lag = S(0);
   for (int k = 0; k < state.operators; ++k) {
-    lag0[k] = S(0.5) * (state.lag_low_mm[cable][k] + state.lag_high_mm[cable][k]);
-    e0 -= model.weights[cable][k] * lag0[k];
+    lag += model.weights[cable][k] * S(0.5) * (state.lag_low_mm[cable][k] + state.lag_high_mm[cable][k]);
   }
-  const S need = effective_target_mm - e0;
+  const S need = effective_target_mm - (x0 - lag);
   if (need == S(0)) return x0;
   const S direction = need > S(0) ? S(1) : S(-1);
-  // Walk the breakpoints in the direction of travel: operator k saturates
-  // after a travel of r_k - direction * lag_k, and from there on adds w_k to
-  // the slope 1 - sum(w) of the unsaturated ones.
-  S travel_to_saturation[kMaxHysteresisOperators];
-  bool saturated[kMaxHysteresisOperators];
+  // Walk the breakpoints in the direction of travel: the interval end e of
+  // operator k saturates after a travel of r_k - direction * e, and from
+  // there on adds w_k / 2 to the slope 1 - sum(w / 2) of the unsaturated ends.
+  const int ends = 2 * state.operators;
+  S travel_to_saturation[kEnds];
+  S end_weight[kEnds];
+  bool saturated[kEnds];
   S slope = S(1);
-  for (int k = 0; k < state.operators; ++k) {
-    travel_to_saturation[k] = std::max(S(0), model.widths_mm[cable][k] - direction * lag0[k]);
-    saturated[k] = travel_to_saturation[k] == S(0);
-    if (!saturated[k]) slope -= model.weights[cable][k];
+  for (int i = 0; i < ends; ++i) {
+    const int k = i / 2;
+    const S end = (i % 2 == 0) ? state.lag_low_mm[cable][k] : state.lag_high_mm[cable][k];
+    end_weight[i] = S(0.5) * model.weights[cable][k];
+    travel_to_saturation[i] = std::max(S(0), model.widths_mm[cable][k] - direction * end);
+    saturated[i] = travel_to_saturation[i] == S(0);
+    if (!saturated[i]) slope -= end_weight[i];
   }
   S travelled = S(0);
   S remaining = std::abs(need);  // effective length still to gain, in the direction of travel
   for (;;) {
-    // The next operator to saturate.
+    // The next end to saturate.
     int next = -1;
-    for (int k = 0; k < state.operators; ++k) {
-      if (!saturated[k] && (next < 0 || travel_to_saturation[k] < travel_to_saturation[next])) next = k;
+    for (int i = 0; i < ends; ++i) {
+      if (!saturated[i] && (next < 0 || travel_to_saturation[i] < travel_to_saturation[next])) next = i;
     }
     const S span = next < 0 ? S(0) : travel_to_saturation[next] - travelled;
     if (next < 0 || (slope > S(0) && slope * span >= remaining)) {
-      // slope > 0 here: with every operator saturated it is 1.
+      // slope > 0 here: with every end saturated it is 1.
       return x0 + direction * (travelled + remaining / slope);
     }
     remaining -= slope * span;
     travelled = travel_to_saturation[next];
     saturated[next] = true;
-    slope += model.weights[cable][next];
+    slope += end_weight[next];
   }
 }
 

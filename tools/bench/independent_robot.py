@@ -1,0 +1,391 @@
+#!/usr/bin/env python3
+"""A cable-driven continuum robot that is not the project's simulator.
+
+An independent source of calibration data for the hysteresis work: its own
+code, written from the constant-curvature formulas of the kinematics notes
+(not from tools/sim), with its own geometry and its own errors:
+
+  - four segments, nominal L = 110 mm and r = 60 mm (the model is told
+    these); each real segment differs in length (sigma 1 mm), anchor radius
+    (sigma 0.6 mm) and in the angle of its anchor holes (sigma 2 deg), with a
+    small twist between segments (sigma 1 deg);
+  - a gravity-like sag: each segment bends further towards the horizontal
+    part of gravity in its own base frame (the robot mounted at an angle),
+    by 0.004 to 0.006 rad times the share of the robot's weight it carries,
+    growing to 2.5 times that with its own bend (so it depends on every
+    joint before it);
+  - the robot's mount in the motion-capture base frame and the marker frame
+    on the platform are off by a few millimetres and about a degree;
+  - per-cable friction hysteresis as a rate-independent Bouc-Wen model,
+    integrated in small steps of the commanded length (RK4, at most
+    0.05 mm a step) along every straight move in cable space:
+        dz = dx (A - (beta sign(dx z) + gamma) |z|^n),  effective = commanded - z
+    with its own A, n, beta / gamma and largest lag
+    z_max = (A / (beta + gamma))^(1/n) of 0.3 to 0.9 mm per cable: smooth
+    branches whose slope grows from 1 - 2 A beta / (beta + gamma) (0.05 to
+    0.4) right after a reversal to 1 - A where z = 0 and to 1 at z_max,
+    unlike a play operator's corners;
+  - a random repeatability of every achieved bend (sigma 0.001 rad per
+    component, about 0.6 mm at the tip: the noise floor of the robot the
+    hysteresis figures were first measured on, 0.66 mm with 0.1 mm of
+    motion-capture noise);
+  - motion-capture noise of 0.1 mm per axis and 0.05 deg per axis.
+
+A session: power-up with unknown friction state, the homing move (every
+segment bends 0.1 rad towards alpha = 45 deg, then straight again, straight
+lines in cable space), then random configurations (alpha uniform, theta
+uniform in [0, 0.2] rad per segment) visited in sequence along straight
+lines in cable space. Each row is the commanded cable lengths (the nominal
+inverse, eq. 2) and the measured platform pose, with the time the robot
+reached it (t_s, seconds from the end of the homing move).
+
+    independent_robot.py --seed 7 --out-dir DIR [--json]
+
+writes DIR/session0.csv (training, 700 rows) and DIR/session1.csv (test,
+200 rows: new configurations and noise, the same robot; --effective also
+writes the effective lengths in place of the commanded ones, a reference) and prints, per
+session: the noise floor (the mean error between the measured poses and the
+robot's repeatable ones: what no model can predict, as the simulator
+defines it), the motion capture's share alone (true against measured poses),
+the tip movement the hysteresis causes (the true poses against the same
+commands without friction) and the nominal model's error.
+Only numpy; deterministic from the seed.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+
+import numpy as np
+
+SEGMENTS = 4
+NOMINAL_LENGTH_MM = 110.0
+NOMINAL_RADIUS_MM = 60.0
+WORKSPACE_THETA_MAX_RAD = 0.2
+HOMING_BEND_RAD = 0.1
+HOMING_ALPHA_RAD = math.pi / 4.0
+SESSION_ROWS = (700, 200)
+BOUC_WEN_STEP_MM = 0.05
+CABLE_SPEED_MM_PER_S = 15.0
+DWELL_S = 0.4
+
+
+# --- constant-curvature kinematics (shared/notes/kinematics-conventions.md) ---
+
+def cable_lengths(alpha, theta, length_mm, radius_mm):
+    """Eq. (2): l_j = 2 (L/theta) sin(theta/2) - 2 r cos(alpha + (j-1) pi/2) sin(theta/2)."""
+    half = 0.5 * theta
+    # 2 (L/theta) sin(theta/2) = L sin(h)/h, exact at theta = 0.
+    backbone = length_mm * (math.sin(half) / half if half > 1e-8 else 1.0 - half * half / 6.0)
+    return np.array([backbone - 2.0 * radius_mm * math.cos(alpha + j * math.pi / 2.0) * math.sin(half)
+                     for j in range(4)])
+
+
+def joints_from_cables(cables_mm, radius_mm):
+    """alpha = atan2(l2 - l4, l3 - l1), theta = 2 asin(hypot(l3 - l1, l4 - l2) / (4 r))."""
+    l1, l2, l3, l4 = cables_mm
+    alpha = math.atan2(l2 - l4, l3 - l1)
+    theta = 2.0 * math.asin(min(1.0, math.hypot(l3 - l1, l4 - l2) / (4.0 * radius_mm)))
+    return alpha, theta
+
+
+def rotation(axis, angle):
+    """Rodrigues' formula for a unit axis."""
+    k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
+    return np.eye(3) + math.sin(angle) * k + 2.0 * math.sin(0.5 * angle) ** 2 * (k @ k)
+
+
+def segment_transform(alpha, theta, length_mm):
+    """R = Rot((-sin a, cos a, 0), theta), p = (L/theta)((1 - cos t) cos a, (1 - cos t) sin a, sin t)."""
+    t = np.eye(4)
+    t[:3, :3] = rotation(np.array([-math.sin(alpha), math.cos(alpha), 0.0]), theta)
+    if theta > 1e-6:
+        # 1 - cos t as 2 sin^2(t/2): no cancellation for small bends.
+        in_plane = length_mm * 2.0 * math.sin(0.5 * theta) ** 2 / theta
+        along = length_mm * math.sin(theta) / theta
+    else:
+        in_plane = length_mm * (theta / 2.0 - theta ** 3 / 24.0)
+        along = length_mm * (1.0 - theta * theta / 6.0)
+    t[:3, 3] = [in_plane * math.cos(alpha), in_plane * math.sin(alpha), along]
+    return t
+
+
+def nominal_pose(cables_mm, length_mm=NOMINAL_LENGTH_MM, radius_mm=NOMINAL_RADIUS_MM):
+    """Eq. (13): the product of the segments' transforms, from all 4 N cables."""
+    pose = np.eye(4)
+    for i in range(len(cables_mm) // 4):
+        alpha, theta = joints_from_cables(cables_mm[4 * i:4 * i + 4], radius_mm)
+        pose = pose @ segment_transform(alpha, theta, length_mm)
+    return pose
+
+
+def transform(rotation_matrix, translation):
+    t = np.eye(4)
+    t[:3, :3] = rotation_matrix
+    t[:3, 3] = translation
+    return t
+
+
+def quaternion(r):
+    """Unit quaternion (w, x, y, z), w >= 0, of a rotation matrix."""
+    trace = r[0, 0] + r[1, 1] + r[2, 2]
+    if trace > 0.0:
+        s = 2.0 * math.sqrt(1.0 + trace)
+        q = [0.25 * s, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s]
+    elif r[0, 0] > r[1, 1] and r[0, 0] > r[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + r[0, 0] - r[1, 1] - r[2, 2])
+        q = [(r[2, 1] - r[1, 2]) / s, 0.25 * s, (r[0, 1] + r[1, 0]) / s, (r[0, 2] + r[2, 0]) / s]
+    elif r[1, 1] > r[2, 2]:
+        s = 2.0 * math.sqrt(1.0 + r[1, 1] - r[0, 0] - r[2, 2])
+        q = [(r[0, 2] - r[2, 0]) / s, (r[0, 1] + r[1, 0]) / s, 0.25 * s, (r[1, 2] + r[2, 1]) / s]
+    else:
+        s = 2.0 * math.sqrt(1.0 + r[2, 2] - r[0, 0] - r[1, 1])
+        q = [(r[1, 0] - r[0, 1]) / s, (r[0, 2] + r[2, 0]) / s, (r[1, 2] + r[2, 1]) / s, 0.25 * s]
+    q = np.array(q)
+    q /= np.linalg.norm(q)
+    return -q if q[0] < 0.0 else q
+
+
+def angle_between_deg(ra, rb):
+    cosine = 0.5 * (np.trace(ra.T @ rb) - 1.0)
+    return math.degrees(math.acos(max(-1.0, min(1.0, cosine))))
+
+
+def small_rotation(rng, sigma_rad):
+    """A rotation by a normal vector of sigma_rad per axis."""
+    v = rng.normal(0.0, sigma_rad, 3)
+    angle = np.linalg.norm(v)
+    return np.eye(3) if angle == 0.0 else rotation(v / angle, angle)
+
+
+# --- the homing move --------------------------------------------------------
+
+def homing_waypoints(length_mm=NOMINAL_LENGTH_MM, radius_mm=NOMINAL_RADIUS_MM, segments=SEGMENTS):
+    """The approach (every segment bent 0.1 rad towards alpha = 45 deg) and home (straight)."""
+    approach = np.concatenate([cable_lengths(HOMING_ALPHA_RAD, HOMING_BEND_RAD, length_mm, radius_mm)
+                               for _ in range(segments)])
+    home = np.concatenate([cable_lengths(0.0, 0.0, length_mm, radius_mm) for _ in range(segments)])
+    return approach, home
+
+
+# --- friction: rate-independent Bouc-Wen per cable --------------------------
+
+class BoucWen:
+    """dz/dx = A - (beta sign(dx z) + gamma) |z|^n per cable; effective = commanded - z."""
+
+    def __init__(self, a, beta, gamma, n):
+        self.a, self.beta, self.gamma, self.n = (np.asarray(v, dtype=float) for v in (a, beta, gamma, n))
+        self.z = np.zeros_like(self.a)
+
+    def max_lag_mm(self):
+        return (self.a / (self.beta + self.gamma)) ** (1.0 / self.n)
+
+    def _slope(self, z, direction):
+        return self.a - (self.beta * np.sign(direction * z) + self.gamma) * np.abs(z) ** self.n
+
+    def move(self, start_mm, end_mm):
+        """Integrates z along the straight line start -> end in small steps; returns the effective lengths at the end."""
+        delta = np.asarray(end_mm, dtype=float) - np.asarray(start_mm, dtype=float)
+        steps = max(1, int(math.ceil(np.abs(delta).max() / BOUC_WEN_STEP_MM)))
+        h = delta / steps
+        z = self.z
+        for _ in range(steps):
+            k1 = h * self._slope(z, h)
+            k2 = h * self._slope(z + 0.5 * k1, h)
+            k3 = h * self._slope(z + 0.5 * k2, h)
+            k4 = h * self._slope(z + k3, h)
+            z = z + (k1 + 2.0 * k2 + 2.0 * k3 + k4) / 6.0
+        self.z = z
+        return np.asarray(end_mm, dtype=float) - z
+
+
+# --- the physical robot -------------------------------------------------------
+
+class Robot:
+    """The robot's imperfections, drawn once from the seed; ideal=True turns every one off."""
+
+    def __init__(self, seed, ideal=False, hysteresis=True):
+        rng = np.random.default_rng([seed, 1000])
+        self.ideal = ideal
+        self.hysteresis = hysteresis and not ideal
+        scale = 0.0 if ideal else 1.0
+        self.length_mm = NOMINAL_LENGTH_MM + scale * rng.normal(0.0, 1.0, SEGMENTS)
+        self.radius_mm = NOMINAL_RADIUS_MM + scale * rng.normal(0.0, 0.6, SEGMENTS)
+        self.anchor_offset_rad = scale * rng.normal(0.0, math.radians(2.0), SEGMENTS)
+        self.twist_rad = scale * rng.normal(0.0, math.radians(1.0), SEGMENTS)
+        self.base = transform(small_rotation(rng, scale * math.radians(0.7)), scale * rng.normal(0.0, 1.5, 3))
+        self.marker = transform(small_rotation(rng, scale * math.radians(1.0)), scale * rng.normal(0.0, 1.0, 3))
+        gravity = np.array([-0.8, 0.35, -0.5])
+        self.gravity = gravity / np.linalg.norm(gravity)
+        self.sag_rad = scale * rng.uniform(0.004, 0.006, SEGMENTS)
+        self.repeatability_rad = 0.001 * scale
+        cables = 4 * SEGMENTS
+        max_lag = rng.uniform(0.3, 0.9, cables)
+        n = rng.uniform(1.0, 2.0, cables)
+        # Right after a full reversal dz/dx = 2 A beta / (beta + gamma): the
+        # effective length's slope there, 1 - 2 A beta / (beta + gamma), must
+        # stay positive (the cable end never moves against the drive).
+        reversal_slope = rng.uniform(0.05, 0.4, cables)
+        beta_share = rng.uniform(0.5, 0.85, cables)
+        a = (1.0 - reversal_slope) / (2.0 * beta_share)
+        beta_plus_gamma = a / max_lag ** n
+        self.friction_parameters = (a, beta_share * beta_plus_gamma, (1.0 - beta_share) * beta_plus_gamma, n)
+
+    def new_friction(self, rng):
+        """The friction state at power-up: anywhere within each cable's range."""
+        friction = BoucWen(*self.friction_parameters)
+        friction.z = rng.uniform(-1.0, 1.0, friction.a.shape) * friction.max_lag_mm()
+        return friction
+
+    def true_pose(self, effective_mm, bend_noise):
+        """The platform's pose in the motion-capture base frame for the lengths that bend the segments."""
+        pose = self.base.copy()
+        for i in range(SEGMENTS):
+            alpha, theta = joints_from_cables(effective_mm[4 * i:4 * i + 4], self.radius_mm[i])
+            bend = theta * np.array([math.cos(alpha + self.anchor_offset_rad[i]),
+                                     math.sin(alpha + self.anchor_offset_rad[i])])
+            # The sag: towards gravity's part across this segment's base, in
+            # proportion to the weight it carries, stiffness falling with bend.
+            local_gravity = pose[:3, :3].T @ self.gravity
+            carried = (SEGMENTS - i) / SEGMENTS
+            bend = bend + self.sag_rad[i] * carried * (1.0 + 1.5 * theta / WORKSPACE_THETA_MAX_RAD) * local_gravity[:2]
+            bend = bend + bend_noise[i]
+            pose = pose @ segment_transform(math.atan2(bend[1], bend[0]), float(np.hypot(*bend)), self.length_mm[i])
+            pose = pose @ transform(rotation(np.array([0.0, 0.0, 1.0]), self.twist_rad[i]), np.zeros(3))
+        return pose @ self.marker
+
+
+def random_configuration(rng):
+    alphas = rng.uniform(-math.pi, math.pi, SEGMENTS)
+    thetas = rng.uniform(0.0, WORKSPACE_THETA_MAX_RAD, SEGMENTS)
+    return np.concatenate([cable_lengths(a, t, NOMINAL_LENGTH_MM, NOMINAL_RADIUS_MM) for a, t in zip(alphas, thetas)])
+
+
+def record_session(robot, seed, session, rows, position_noise_mm=0.1, orientation_noise_deg=0.05):
+    """One session's rows and figures: power-up, homing, then `rows` configurations in sequence."""
+    rng = np.random.default_rng([seed, session])
+    friction = robot.new_friction(rng)
+    # Power-up where the last session left the robot, then the homing move.
+    commanded = random_configuration(rng)
+    approach, home = homing_waypoints()
+    for waypoint in (approach, home):
+        if robot.hysteresis:
+            friction.move(commanded, waypoint)
+        commanded = waypoint
+    out = {"t_s": [], "cables": [], "effective": [], "measured": [], "true": [], "repeatable": [],
+           "without_hysteresis": []}
+    t = 0.0
+    noise_scale = 0.0 if robot.ideal else 1.0
+    for _ in range(rows):
+        target = random_configuration(rng)
+        effective = friction.move(commanded, target) if robot.hysteresis else target.copy()
+        t += np.abs(target - commanded).max() / CABLE_SPEED_MM_PER_S + DWELL_S * rng.uniform(0.8, 1.2)
+        commanded = target
+        bend_noise = rng.normal(0.0, robot.repeatability_rad, (SEGMENTS, 2))
+        true = robot.true_pose(effective, bend_noise)
+        measured = true.copy()
+        measured[:3, 3] += noise_scale * rng.normal(0.0, position_noise_mm, 3)
+        measured[:3, :3] = measured[:3, :3] @ small_rotation(rng, noise_scale * math.radians(orientation_noise_deg))
+        out["t_s"].append(round(t, 3))
+        out["cables"].append(commanded.copy())
+        out["effective"].append(effective.copy())
+        out["measured"].append(measured)
+        out["true"].append(true)
+        out["repeatable"].append(robot.true_pose(effective, np.zeros((SEGMENTS, 2))))
+        out["without_hysteresis"].append(robot.true_pose(commanded, bend_noise))
+    return out
+
+
+def mean_errors(poses_a, poses_b):
+    position = [np.linalg.norm(a[:3, 3] - b[:3, 3]) for a, b in zip(poses_a, poses_b)]
+    orientation = [angle_between_deg(a[:3, :3], b[:3, :3]) for a, b in zip(poses_a, poses_b)]
+    return float(np.mean(position)), float(np.mean(orientation)), float(np.max(position))
+
+
+def write_csv(path, data, seed, session, robot, cables="cables"):
+    names = ["t_s"] + ["l{}_{}".format(i + 1, j + 1) for i in range(SEGMENTS) for j in range(4)]
+    names += ["x", "y", "z", "qw", "qx", "qy", "qz"]
+    with open(path, "w") as f:
+        f.write("# independent robot (tools/bench/independent_robot.py): seed {}, session {}\n".format(seed, session))
+        f.write("# nominal geometry: {} segments, L = {} mm, r = {} mm\n".format(
+            SEGMENTS, NOMINAL_LENGTH_MM, NOMINAL_RADIUS_MM))
+        f.write("# rows are a motion sequence after the homing move; t_s in seconds\n")
+        f.write("# hysteresis: {}\n".format("Bouc-Wen per cable" if robot.hysteresis else "off"))
+        if cables == "effective":
+            f.write("# cable columns: the effective lengths (commanded less the friction's lag), for reference\n")
+        f.write(",".join(names) + "\n")
+        for t, lengths, pose in zip(data["t_s"], data[cables], data["measured"]):
+            values = ["{:.3f}".format(t)] + ["{:.6f}".format(c) for c in lengths]
+            values += ["{:.6f}".format(v) for v in pose[:3, 3]] + ["{:.8f}".format(v) for v in quaternion(pose[:3, :3])]
+            f.write(",".join(values) + "\n")
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--seed", type=int, default=7, help="names the robot and its sessions (default 7)")
+    parser.add_argument("--out-dir", required=True, help="writes session0.csv and session1.csv here")
+    parser.add_argument("--rows", default="{},{}".format(*SESSION_ROWS), help="rows of session 0 and 1 (default 700,200)")
+    parser.add_argument("--no-hysteresis", action="store_true", help="the same robot without cable friction")
+    parser.add_argument("--json", action="store_true", help="print the figures as one JSON object")
+    parser.add_argument("--report", help="also write the figures as JSON to this file")
+    parser.add_argument("--effective", action="store_true",
+                        help="also write sessionK.effective.csv: the effective cable lengths (what a model that "
+                             "knew the friction exactly would see) in place of the commanded ones")
+    args = parser.parse_args(argv)
+    try:
+        rows = [int(v) for v in args.rows.split(",")]
+    except ValueError:
+        rows = []
+    if len(rows) != 2 or min(rows) < 1:
+        sys.exit("independent_robot.py: error: --rows takes two positive counts, e.g. 700,200, not '{}'".format(args.rows))
+    os.makedirs(args.out_dir, exist_ok=True)
+
+    robot = Robot(args.seed, hysteresis=not args.no_hysteresis)
+    report = {"seed": args.seed, "hysteresis": robot.hysteresis,
+              "max_lag_mm": {"min": float(robot.new_friction(np.random.default_rng(0)).max_lag_mm().min()),
+                             "max": float(robot.new_friction(np.random.default_rng(0)).max_lag_mm().max())},
+              "sessions": []}
+    for session, count in enumerate(rows):
+        data = record_session(robot, args.seed, session, count)
+        path = os.path.join(args.out_dir, "session{}.csv".format(session))
+        write_csv(path, data, args.seed, session, robot)
+        if args.effective:
+            write_csv(os.path.join(args.out_dir, "session{}.effective.csv".format(session)), data, args.seed, session,
+                      robot, cables="effective")
+        nominal = [nominal_pose(c) for c in data["cables"]]
+        motion_capture = mean_errors(data["true"], data["measured"])
+        floor = mean_errors(data["repeatable"], data["measured"])
+        effect = mean_errors(data["true"], data["without_hysteresis"])
+        initial = mean_errors(nominal, data["measured"])
+        report["sessions"].append({
+            "session": session, "rows": count, "file": path,
+            "noise_floor": {"position_mm": floor[0], "orientation_deg": floor[1]},
+            "motion_capture": {"position_mm": motion_capture[0], "orientation_deg": motion_capture[1]},
+            "hysteresis_tip_movement_mm": {"mean": effect[0], "max": effect[2], "orientation_deg": effect[1]},
+            "nominal_error": {"position_mm": initial[0], "orientation_deg": initial[1]},
+        })
+    if args.report:
+        with open(args.report, "w") as f:
+            json.dump(report, f)
+    if args.json:
+        print(json.dumps(report))
+    else:
+        print("independent robot, seed {}: cable friction {} (largest lag per cable {:.2f} to {:.2f} mm)".format(
+            args.seed, "Bouc-Wen" if robot.hysteresis else "off", report["max_lag_mm"]["min"], report["max_lag_mm"]["max"]))
+        for s in report["sessions"]:
+            print("  session {} ({} rows) -> {}".format(s["session"], s["rows"], s["file"]))
+            print("    noise floor          {:.3f} mm / {:.4f} deg".format(
+                s["noise_floor"]["position_mm"], s["noise_floor"]["orientation_deg"]))
+            print("    motion capture alone {:.3f} mm / {:.4f} deg".format(
+                s["motion_capture"]["position_mm"], s["motion_capture"]["orientation_deg"]))
+            print("    hysteresis moves tip {:.3f} mm mean, {:.3f} mm max".format(
+                s["hysteresis_tip_movement_mm"]["mean"], s["hysteresis_tip_movement_mm"]["max"]))
+            print("    nominal model error  {:.3f} mm / {:.4f} deg".format(
+                s["nominal_error"]["position_mm"], s["nominal_error"]["orientation_deg"]))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
