@@ -1,9 +1,8 @@
-// The C API (cdcr/cdcr.h): the runtime behind the HAL made of the caller's
-// callbacks (hal/callbacks), placed in the caller's storage. Cable lengths,
-// targets and the payload are queued as given and handed to the runtime's
-// direct inputs at the next step, ahead of the bus's frames, in the values
-// the protocol's frames would carry, so they pass the same checks as frames
-// from a real bus; the runtime's own frames go to can_send, or nowhere.
+// The C API (cdcr/cdcr.h): the runtime behind the HAL of the caller's callbacks
+// (hal/callbacks), in the caller's storage. Cable lengths, targets, the payload
+// and homing are queued and handed to the runtime's direct inputs at the next
+// step, ahead of the bus's frames, in the values the protocol's frames would
+// carry (the same checks as from a bus); its own frames go to can_send.
 
 #include "cdcr/cdcr.h"
 
@@ -17,10 +16,9 @@
 namespace cdcr::firmware {
 namespace {
 
-// Inputs queued between two steps, counted in the frames that would carry
-// them: one cable frame per segment twice over, two targets (three frames
-// each) and a payload.
-constexpr int kInputQueueDepth = 2 * kMaxSegments + 6 + 1;
+// Inputs queued between two steps, in the frames that would carry them: a cable
+// frame per segment twice over, two targets (three frames each), payload, homing.
+constexpr int kInputQueueDepth = 2 * kMaxSegments + 6 + 2;
 constexpr std::uint32_t kInitializedMagic = 0x43444352u;  // "CDCR"
 
 double transmitted(const protocol::SignalSpec& signal, float value) { return protocol::as_transmitted(signal, value); }
@@ -45,6 +43,7 @@ class InputQueue final : public CycleInputs {
     for (int i = 0; i < 4; ++i) input.values[3 + i] = target.quaternion[i];
   }
   void push_payload(float payload_kg) { push(Kind::payload, 1).values[0] = payload_kg; }
+  void push_homing() { push(Kind::homing, 1); }
 
   int deliver(Runtime& runtime) override {
     for (int i = 0; i < count_; ++i) {
@@ -55,6 +54,8 @@ class InputQueue final : public CycleInputs {
         runtime.set_cable_lengths(input.segment, lengths_mm);
       } else if (input.kind == Kind::target) {
         runtime.set_target(target_request(input));
+      } else if (input.kind == Kind::homing) {
+        runtime.set_homed();
       } else {
         runtime.set_payload_kg(Scalar(transmitted(protocol::payload::kPayload, input.values[0])));
       }
@@ -65,7 +66,7 @@ class InputQueue final : public CycleInputs {
   }
 
  private:
-  enum class Kind : std::uint8_t { cables, target, payload };
+  enum class Kind : std::uint8_t { cables, target, payload, homing };
   enum Flags : std::uint8_t { kPose = 1, kTracking = 2, kRefuse = 4 };
   // Small: the queue lives in cdcr_runtime's storage. A target's values are
   // its position and quaternion, a cable input's the segment's four lengths.
@@ -77,9 +78,8 @@ class InputQueue final : public CycleInputs {
 
   Input& push(Kind kind, int frames) {
     frames_ += frames;
-    Input& input = inputs_[count_++];
-    input.kind = kind;
-    return input;
+    inputs_[count_].kind = kind;
+    return inputs_[count_++];
   }
 
   static TargetRequest target_request(const Input& in) {
@@ -141,8 +141,6 @@ cdcr_result check(const cdcr_runtime* runtime, CRuntime*& c) {
   return c != nullptr ? CDCR_OK : CDCR_ERROR_NOT_INITIALIZED;
 }
 
-bool finite(float value) { return std::isfinite(value); }
-
 bool geometry_from_config(const cdcr_geometry& in, Geometry& out) {
   if (in.segment_count == 0 && in.backbone_length_mm == 0 && in.anchor_radius_mm == 0 && in.theta_max_rad == 0) {
     out = Geometry::prototype();
@@ -160,11 +158,9 @@ namespace firmware = cdcr::firmware;
 namespace protocol = cdcr::firmware::protocol;
 
 static_assert(int(CDCR_STATE_FAULT) == int(firmware::RuntimeState::fault), "states as in fault.hpp");
-static_assert(int(CDCR_FAULT_PAYLOAD_INVALID) == int(firmware::FaultCode::payload_invalid),
-              "fault codes as in fault.hpp");
+static_assert(int(CDCR_FAULT_HOMING_MALFORMED) == int(firmware::FaultCode::homing_malformed), "faults as fault.hpp");
 static_assert(int(CDCR_IK_IN_PROGRESS) == int(protocol::IkOutcome::in_progress), "outcomes as in messages.hpp");
-static_assert(int(CDCR_IK_REFUSED_EXTRAPOLATING) == int(protocol::IkOutcome::refused_extrapolating),
-              "outcomes as in messages.hpp");
+static_assert(int(CDCR_IK_REFUSED_EXTRAPOLATING) == int(protocol::IkOutcome::refused_extrapolating), "outcomes");
 static_assert(int(CDCR_TARGET_POSE) == int(protocol::TargetMode::pose), "modes as in messages.hpp");
 static_assert(CDCR_MAX_SEGMENTS == firmware::kMaxSegments, "segment capacity as in capacity.hpp");
 
@@ -230,6 +226,12 @@ cdcr_result cdcr_set_payload(cdcr_runtime* runtime, float payload_kg) {
   return CDCR_OK;
 }
 
+cdcr_result cdcr_homing(cdcr_runtime* runtime) {
+  CRuntime* c = nullptr;
+  if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
+  return c->inputs.has_room(1) ? (c->inputs.push_homing(), CDCR_OK) : CDCR_ERROR_QUEUE_FULL;
+}
+
 cdcr_result cdcr_set_target(cdcr_runtime* runtime, const cdcr_target* target) {
   CRuntime* c = nullptr;
   if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
@@ -238,12 +240,12 @@ cdcr_result cdcr_set_target(cdcr_runtime* runtime, const cdcr_target* target) {
   const bool pose = target->mode == CDCR_TARGET_POSE;
   constexpr double kMaxPositionMm = 21474836.0;
   for (const float p : target->position_mm) {
-    if (!firmware::finite(p) || std::fabs(p) > kMaxPositionMm) return CDCR_ERROR_OUT_OF_RANGE;
+    if (!std::isfinite(p) || std::fabs(p) > kMaxPositionMm) return CDCR_ERROR_OUT_OF_RANGE;
   }
   if (pose) {
     double norm2 = 0;
     for (const float q : target->quaternion) {
-      if (!firmware::finite(q)) return CDCR_ERROR_OUT_OF_RANGE;
+      if (!std::isfinite(q)) return CDCR_ERROR_OUT_OF_RANGE;
       norm2 += double(q) * q;
     }
     if (std::fabs(std::sqrt(norm2) - 1.0) > protocol::kQuaternionNormTolerance) return CDCR_ERROR_INVALID_ARGUMENT;
@@ -324,6 +326,7 @@ cdcr_result cdcr_get_status(const cdcr_runtime* runtime, cdcr_status* status) {
   status->execution_max_ns = stats.execution_max_ns;
   status->execution_mean_ns = stats.execution_mean_ns();
   status->jitter_max_ns = stats.jitter_max_ns;
+  status->hysteresis_unknown = rt.hysteresis().known() ? 0 : 1;
   return CDCR_OK;
 }
 

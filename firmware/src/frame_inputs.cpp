@@ -31,6 +31,13 @@ bool FrameInputs::take(const hal::CanFrame& frame, Runtime& runtime) {
     } else {
       runtime.set_payload_kg(static_cast<Scalar>(payload.payload_kg));
     }
+  } else if (protocol::homing::kMessage.carries(frame.id)) {
+    protocol::Homing homing;
+    if (protocol::decode(frame, homing) != protocol::DecodeStatus::ok) {
+      runtime.reject_input(FaultCode::homing_malformed);
+    } else {
+      runtime.set_homed();
+    }
   } else {
     return false;
   }

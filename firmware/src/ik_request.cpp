@@ -259,6 +259,8 @@ void IkRequest::end(protocol::IkOutcome outcome) {
 bool IkRequest::set_setpoints(const Joints& joints) {
   Cables cables;
   if (model::cables_from_joints(joints, model_.geometry, cables) != model::Status::ok) return false;
+  // The joints are the effective lengths'; the drives are sent what makes them.
+  if (hysteresis_ != nullptr) hysteresis_->commanded_for(cables);
   hal::CanFrame frames[kMaxSegments];
   for (int s = 0; s < model_.geometry.segment_count; ++s) {
     const protocol::CableSetpoint setpoint{s, {cables[4 * s], cables[4 * s + 1], cables[4 * s + 2], cables[4 * s + 3]}};

@@ -57,9 +57,10 @@ RuntimeState Runtime::init() {
   }
   latest_cables_mm_.setZero(4 * model_.geometry.segment_count);
   ik_.configure();
+  hysteresis_.bind(model_);
   scheduler_.configure({model_.compensated, model_.uncertainty.has_variance(),
                         model_.correction.training_points() * model_.correction.mean_point_units(),
-                        model_.correction.smallest_gradient_slice_units()});
+                        model_.correction.smallest_gradient_slice_units(), hysteresis_units(hysteresis_)});
   enter(mode());
   if (boot_fault_ != FaultCode::none) {
     ConsoleLine line;
@@ -107,7 +108,10 @@ void Runtime::run_cycle(const hal::TimerTick& tick, CycleInputs* inputs) {
   if (state_ != RuntimeState::boot) update_pose();
   fresh_cables_ = false;
   const CyclePlan plan = scheduler_.plan(cycle_, variance_.running(), ik_.running(), update_.verifying());
-  if (plan.variance_slice && variance_.continue_slice(model_.uncertainty)) publish_uncertainty();
+  if (plan.variance_slice && variance_.continue_slice(model_.uncertainty)) {
+    hysteresis_.widen(model_, variance_.result());
+    publish_uncertainty();
+  }
   if (cycle_ % kStatusEveryCycles == 0) publish_status();
   scheduler_.charge_update(update_.step(cycle_, model_.geometry, plan.update_offer));
   if (update_.switch_pending()) reload_model();
@@ -209,7 +213,10 @@ void Runtime::update_pose() {
   }
   if (complete) {
     PoseEstimate estimate;
-    if (const model::Status s = estimate_pose(latest_cables_mm_, estimate); s == model::Status::ok) {
+    // The hysteresis state moves with every complete set; the pose is that
+    // of the effective lengths.
+    if (const model::Status s = estimate_pose(hysteresis_.track(latest_cables_mm_), estimate);
+        s == model::Status::ok) {
       latest_pose_ = estimate;
       has_pose_ = true;
       last_valid_cycle_ = cycle_;
@@ -217,6 +224,7 @@ void Runtime::update_pose() {
       publish_pose();
       if (!variance_.running() && latest_pose_.compensated && model_.uncertainty.has_variance()) {
         variance_.begin(model_.uncertainty, latest_pose_, static_cast<std::uint8_t>(cycle_ & 0xFF));
+        hysteresis_.begin_variance(model_, latest_pose_);
       }
     } else {
       statistics_.rejected_cable_sets += 1;
@@ -267,6 +275,7 @@ void Runtime::publish_status() {
   protocol::Status status;
   status.state = state_;
   status.extrapolating = extrapolating();
+  status.hysteresis_unknown = !hysteresis_.known();
   status.fault = fault;
   status.overruns = statistics_.overruns;
   status.exec_max_us = to_us(statistics_.execution_max_ns);

@@ -242,6 +242,54 @@ TEST_F(CApiRuntime, PayloadReachesThePoseAndBadOnesAreRefused) {
   EXPECT_STREQ(cdcr_fault_name(CDCR_FAULT_PAYLOAD_INVALID), "payload invalid");
 }
 
+// cdcr_homing with an image that models the cables' hysteresis: the state
+// is unknown from init (cdcr_status.hysteresis_unknown) until the call, and
+// the pose is then the runtime's on the effective lengths from home; without
+// a block the call is accepted and changes nothing.
+TEST_F(CApiRuntime, HomingMakesTheHysteresisStateKnown) {
+  test_support::SyntheticModelOptions options;
+  options.hysteresis_operators = 2;
+  training::TrainedModel m = test_support::synthetic_trained_model(options);
+  for (int k = 0; k < 6; ++k) {
+    m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
+    m.output_scale[k] *= k < 3 ? 0.1 : 0.001;
+  }
+  init(exporting::write_image(m));
+  QuietHal platform(image);
+  Runtime reference(platform.hal(), Geometry::prototype());
+  ASSERT_EQ(reference.init(), RuntimeState::run);
+  Cables approach, home;
+  ASSERT_EQ(model::homing_waypoints(reference.geometry(), approach, home), model::Status::ok);
+  const std::vector<float> at_home(home.data(), home.data() + home.size());
+  step_with(at_home, 2);
+  EXPECT_EQ(status().hysteresis_unknown, 1);
+  ASSERT_EQ(cdcr_homing(&runtime), CDCR_OK);
+  const std::vector<float> lengths = bent_cables(reference.geometry());
+  step_with(lengths);
+  EXPECT_EQ(status().hysteresis_unknown, 0);
+
+  // The reference: homed at home, then at the same lengths.
+  reference.set_homed();
+  const Cables cables = as_transmitted(lengths);
+  model::HysteresisState<float> state = reference.hysteresis().state();
+  model::update_hysteresis(state, reference.hysteresis().hysteresis_model(), cables);
+  Cables effective;
+  model::effective_lengths(state, reference.hysteresis().hysteresis_model(), effective);
+  PoseEstimate expected;
+  ASSERT_EQ(reference.estimate_pose(effective, expected), model::Status::ok);
+  cdcr_pose pose{};
+  ASSERT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_OK);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(pose.position_mm[i], expected.pose.position_mm[i]);
+  EXPECT_EQ(cdcr_homing(nullptr), CDCR_ERROR_NULL_ARGUMENT);
+
+  init(small_image());
+  step_with(lengths);
+  EXPECT_EQ(status().hysteresis_unknown, 0);
+  EXPECT_EQ(cdcr_homing(&runtime), CDCR_OK);
+  step_with(lengths);
+  EXPECT_EQ(status().fault, CDCR_FAULT_NONE);
+}
+
 // A pose target from the C API: solved over steps, setpoints out, and the
 // drives at the setpoints put the tip on the target.
 TEST_F(CApiRuntime, TargetIsSolvedToSetpoints) {

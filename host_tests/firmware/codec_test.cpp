@@ -326,7 +326,10 @@ TEST(Frames, ReservedBitsMakeAFrameMalformed) {
   PoseUncertainty uncertainty;
   EXPECT_EQ(decode(frame_of(0x133, {0, 0, 0, 0, 0, 0x04, 0}), uncertainty), DecodeStatus::reserved_bits_set);
   Status status;
-  EXPECT_EQ(decode(frame_of(0x150, {0x21, 0, 0, 0, 0, 0, 0, 0}), status), DecodeStatus::reserved_bits_set);
+  // Bit 5 is HYSTERESIS_UNKNOWN; 6 and 7 are reserved.
+  EXPECT_EQ(decode(frame_of(0x150, {0x41, 0, 0, 0, 0, 0, 0, 0}), status), DecodeStatus::reserved_bits_set);
+  ASSERT_EQ(decode(frame_of(0x150, {0x21, 0, 0, 0, 0, 0, 0, 0}), status), DecodeStatus::ok);
+  EXPECT_TRUE(status.hysteresis_unknown);
   ASSERT_EQ(decode(frame_of(0x150, {0x11, 0, 0, 0, 0, 0, 0, 0}), status), DecodeStatus::ok);
   EXPECT_EQ(status.state, RuntimeState::run);
   EXPECT_TRUE(status.extrapolating);

@@ -263,7 +263,8 @@ TEST(GoldenFrames, IkReport) {
   expect_physical(report.orientation_residual_rad, 0.01234);
 }
 
-// 0x150, DLC 8. STATE u4 at bit 0; EXTRAPOLATING bit 4 (5..7 reserved);
+// 0x150, DLC 8. STATE u4 at bit 0; EXTRAPOLATING bit 4; HYSTERESIS_UNKNOWN
+// bit 5 (6..7 reserved);
 // FAULT u8 at bit 8; OVERRUNS u16 at bit 16; EXEC_MAX u16 at bit 32, us;
 // EXEC_MEAN u16 at bit 48, us.
 TEST(GoldenFrames, Status) {
@@ -280,6 +281,21 @@ TEST(GoldenFrames, Status) {
   EXPECT_EQ(status.overruns, 513);
   EXPECT_EQ(status.exec_max_us, 1500);
   EXPECT_EQ(status.exec_mean_us, 750);
+  EXPECT_FALSE(status.hysteresis_unknown);
+
+  // STATE 1 RUN | HYSTERESIS_UNKNOWN 0x20; FAULT 0; 0 overruns; 7 us; 3 us.
+  const Bytes unknown{0x21, 0x00, 0x00, 0x00, 0x07, 0x00, 0x03, 0x00};
+  Status running{RuntimeState::run, FaultCode::none, 0, 7, 3};
+  running.hysteresis_unknown = true;
+  expect_encodes_to(running, 0x150, unknown);
+  const auto decoded_unknown = decoded<Status>(0x150, unknown);
+  EXPECT_TRUE(decoded_unknown.hysteresis_unknown);
+  EXPECT_FALSE(decoded_unknown.extrapolating);
+  EXPECT_EQ(decoded_unknown.state, RuntimeState::run);
+  // Bits 6 and 7 are still reserved.
+  Status reserved;
+  EXPECT_EQ(decode(frame_of(0x150, Bytes{0x61, 0x00, 0x00, 0x00, 0x07, 0x00, 0x03, 0x00}), reserved),
+            DecodeStatus::reserved_bits_set);
 }
 
 // 0x151, DLC 8. JITTER_MAX u16 at bit 0, us; REJECTED_FRAMES u16 at bit 16;
@@ -306,6 +322,16 @@ TEST(GoldenFrames, Payload) {
   expect_physical(decoded<Payload>(0x160, Bytes{0x39, 0x30}).payload_kg, 12.345);
   expect_encodes_to(Payload{0.75}, 0x160, Bytes{0xEE, 0x02});
   expect_physical(decoded<Payload>(0x160, Bytes{0xEE, 0x02}).payload_kg, 0.75);
+}
+
+// 0x161, DLC 1. AT_HOME bit 0, must be 1 (1..7 reserved).
+TEST(GoldenFrames, Homing) {
+  expect_encodes_to(Homing{}, 0x161, Bytes{0x01});
+  EXPECT_TRUE(decoded<Homing>(0x161, Bytes{0x01}).at_home);
+  Homing homing;
+  EXPECT_EQ(decode(frame_of(0x161, Bytes{0x00}), homing), DecodeStatus::out_of_range);
+  EXPECT_EQ(decode(frame_of(0x161, Bytes{0x03}), homing), DecodeStatus::reserved_bits_set);
+  EXPECT_EQ(decode(frame_of(0x161, Bytes{0x01, 0x00}), homing), DecodeStatus::wrong_dlc);
 }
 
 // 0x170, DLC 6. COMMAND u4 at bit 0 (4..7 reserved); TRANSFER_ID u16 at
@@ -381,7 +407,7 @@ TEST(GoldenFrames, UpdateReport) {
 // A message added to the table needs its golden frame above.
 TEST(GoldenFrames, EveryMessageOfTheTableHasOne) {
   constexpr std::uint32_t kGoldenIds[] = {0x102, 0x117, 0x120, 0x121, 0x122, 0x130, 0x131, 0x132, 0x133,
-                                          0x140, 0x150, 0x151, 0x160, 0x170, 0x171, 0x172, 0x173, 0x178};
+                                          0x140, 0x150, 0x151, 0x160, 0x161, 0x170, 0x171, 0x172, 0x173, 0x178};
   for (const MessageSpec* message : kMessages) {
     const bool covered = std::any_of(std::begin(kGoldenIds), std::end(kGoldenIds),
                                      [&](std::uint32_t id) { return message->carries(id); });

@@ -228,6 +228,97 @@ TEST(RuntimeReplay, ThePayloadColumnMustMatchTheImage) {
   EXPECT_EQ(run_replay(dir, "payload.img", "loaded.csv"), 0);
 }
 
+// A motion sequence of two sessions with a hysteresis image: the replay
+// carries the state from row to row, each session from home, and its poses
+// are the runtime's on the effective lengths of a float32 run of the
+// operator written out here.
+TEST(RuntimeReplay, AHysteresisImageCarriesTheStateOverTheSequence) {
+  test_support::SyntheticModelOptions options;
+  options.hysteresis_operators = 2;
+  const training::TrainedModel trained = test_support::synthetic_trained_model(options);
+  const std::vector<std::uint8_t> image = exporting::write_image(trained);
+  test_support::SimulatedPlatform platform(image);
+  Runtime runtime(platform.hal, Geometry::prototype());
+  ASSERT_EQ(runtime.init(), RuntimeState::run);
+  const model::HysteresisModel<float>& h = runtime.hysteresis().hysteresis_model();
+  ASSERT_EQ(h.cables, 8);
+
+  // 60 rows: a random walk of the bend, two sessions (a gap of a minute).
+  dataset::Dataset data;
+  data.segment_count = 2;
+  data.has_time = true;
+  data.cables_mm.resize(60, 8);
+  data.time_s.resize(60);
+  model::RobotGeometry<double> geometry = trained.geometry;
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> step(-0.03, 0.03);
+  model::JointVector<double> joints(4);
+  joints << 0.4, 0.1, -1.0, 0.12;
+  for (int i = 0; i < 60; ++i) {
+    for (int k = 0; k < 4; ++k) joints[k] += step(rng);
+    joints[1] = std::abs(joints[1]);
+    joints[3] = std::abs(joints[3]);
+    model::CableVector<double> cables;
+    ASSERT_EQ(model::cables_from_joints(joints, geometry, cables), model::Status::ok);
+    data.cables_mm.row(i) = cables.transpose();
+    data.time_s[i] = 0.1 * i + (i >= 35 ? 60.0 : 0.0);
+  }
+  data.session_starts = {0, 35};
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_sequence";
+  write_replay_inputs(dir, image, data);
+  ASSERT_EQ(run_replay(dir, "model.img", "cables.csv"), 0);
+  const dataset::Dataset written = dataset::read_dataset_csv((dir / "cables.csv").string());
+  ASSERT_TRUE(written.has_time);
+  ASSERT_EQ(written.session_starts, data.session_starts);
+
+  std::ifstream in(dir / "poses.csv");
+  std::string line;
+  ASSERT_TRUE(std::getline(in, line));
+  model::HysteresisState<float> state;
+  double largest_effect_mm = 0.0;
+  for (int i = 0; i < 60; ++i) {
+    ASSERT_TRUE(std::getline(in, line)) << i;
+    double x = 0, y = 0, z = 0;
+    ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf", &x, &y, &z), 3);
+    if (i == 0 || i == 35) ASSERT_EQ(model::start_at_home(state, h, runtime.geometry()), model::Status::ok);
+    const Cables commanded = written.cables_mm.row(i).transpose().cast<float>();
+    model::update_hysteresis(state, h, commanded);
+    Cables effective;
+    model::effective_lengths(state, h, effective);
+    PoseEstimate expected, joints_only;
+    ASSERT_EQ(runtime.estimate_pose(effective, expected), model::Status::ok);
+    ASSERT_EQ(runtime.estimate_pose(commanded, joints_only), model::Status::ok);
+    EXPECT_EQ(float(x), expected.pose.position_mm.x()) << i;
+    EXPECT_EQ(float(y), expected.pose.position_mm.y()) << i;
+    EXPECT_EQ(float(z), expected.pose.position_mm.z()) << i;
+    largest_effect_mm =
+        std::max(largest_effect_mm, double((expected.pose.position_mm - joints_only.pose.position_mm).norm()));
+  }
+  EXPECT_GT(largest_effect_mm, 0.1) << "the hysteresis must matter on these rows";
+}
+
+// An image that models the cables' hysteresis needs the rows as a motion
+// sequence (a t_s column): rows without time are refused in one line.
+TEST(RuntimeReplay, AHysteresisImageNeedsAMotionSequence) {
+  test_support::SyntheticModelOptions options;
+  options.hysteresis_operators = 2;
+  const std::vector<std::uint8_t> image = exporting::write_image(test_support::synthetic_trained_model(options));
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_hysteresis";
+  std::filesystem::create_directories(dir);
+  {
+    std::ofstream out(dir / "hysteresis.img", std::ios::binary);
+    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
+  }
+  { std::ofstream(dir / "plain.csv") << "l1_1,l1_2,l1_3,l1_4,l2_1,l2_2,l2_3,l2_4\n120,120,120,120,95.5,95.5,95.5,95.5\n"; }
+  const std::string err = (dir / "err.txt").string();
+  EXPECT_EQ(run_replay(dir, "hysteresis.img", "plain.csv", " 2>\"" + err + "\""), 1);
+  std::ifstream refused(err);
+  const std::string message((std::istreambuf_iterator<char>(refused)), std::istreambuf_iterator<char>());
+  EXPECT_NE(message.find("needs a motion sequence (a t_s column), but the rows have no time"), std::string::npos)
+      << message;
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+}
+
 TEST(RuntimeReplay, CorruptImageIsOneLineErrorWithExitOne) {
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_bad";
   std::filesystem::create_directories(dir);

@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
+#include <random>
 #include <string>
 #include <vector>
 
@@ -16,6 +17,7 @@
 #include "export/image_writer.hpp"
 #include "trained_model/trained_model.hpp"
 
+#include "../support/synthetic_trained_model.hpp"
 #include "../support/v1_image.hpp"
 
 namespace {
@@ -123,6 +125,13 @@ int main(int argc, char** argv) {
   sparse.fitted_rows = 40;
   write(root / "image" / "two_segments_sparse.bin", cdcr::exporting::write_image(sparse));
   // Format v1, which boards in the field still carry.
+  {
+    // v2.2: a hysteresis block (two play operators per cable).
+    TrainedModel with_hysteresis = small_model(1, 3, InputEncoding::bend_vector);
+    std::mt19937 rng(7);
+    with_hysteresis.hysteresis = cdcr::test_support::synthetic_hysteresis(with_hysteresis.geometry, 2, rng);
+    write(root / "image" / "one_segment_hysteresis.bin", cdcr::exporting::write_image(with_hysteresis));
+  }
   write(root / "image" / "one_segment_v1.bin",
         cdcr::test_support::v1_image(small_model(1, 3, InputEncoding::bend_vector)));
 

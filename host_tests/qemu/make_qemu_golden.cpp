@@ -2,6 +2,10 @@
 //
 //   cdcr_model_image.cpp          IMAGE as the exporter's C array, in .cdcr_model
 //   cdcr_model_image_flipped.cpp  the same image with one byte flipped
+//   cdcr_model_image_hysteresis.cpp  the same model with a hysteresis block
+//                                 (two play operators per cable, widths 0.25
+//                                 to 0.7 mm): the cycle budget with the
+//                                 cables' hysteresis
 //   qemu_golden.hpp               cable inputs as they travel on the bus, and
 //                                 the poses the host computes for them in
 //                                 double: compensated with the image, and
@@ -27,6 +31,7 @@
 #include "cdcr/model/compensated_kinematics.hpp"
 #include "export/binary_file.hpp"
 #include "export/c_source.hpp"
+#include "export/image_writer.hpp"
 
 namespace {
 
@@ -150,6 +155,27 @@ int main(int argc, char** argv) {
     cdcr::exporting::CSourceOptions c_options;
     c_options.description = std::string("model for the QEMU board programs, from ") + argv[1];
     write_text(dir + "/cdcr_model_image.cpp", cdcr::exporting::format_c_source(image.data(), image.size(), c_options));
+    // A hysteresis of the size the issue measured on a real robot (0.4 to
+    // 0.7 mm at most per cable), fixed values: the image is reproducible.
+    cdcr::model::HysteresisModel<double> hysteresis;
+    hysteresis.cables = 4 * segments;
+    hysteresis.operators = 2;
+    for (int c = 0; c < hysteresis.cables; ++c) {
+      hysteresis.widths_mm[c][0] = 0.25 + 0.01 * (c % 7);
+      hysteresis.widths_mm[c][1] = 0.6 + 0.01 * (c % 5);
+      hysteresis.weights[c][0] = 0.5;
+      hysteresis.weights[c][1] = 0.4;
+    }
+    cdcr::model::CableVector<double> approach_mm, home_mm;
+    if (cdcr::model::homing_waypoints(geometry, approach_mm, home_mm) != Status::ok) {
+      throw std::runtime_error("no homing move for the image's geometry");
+    }
+    cdcr::model::compute_homing_lags(hysteresis, approach_mm, home_mm);
+    const std::vector<std::uint8_t> with_hysteresis = cdcr::exporting::with_hysteresis_block(image, hysteresis);
+    c_options.description = "the same model with a hysteresis block of two play operators per cable";
+    write_text(dir + "/cdcr_model_image_hysteresis.cpp",
+               cdcr::exporting::format_c_source(with_hysteresis.data(), with_hysteresis.size(), c_options));
+
     // In the middle of the training data: only the CRC can tell.
     image[image.size() / 2] ^= 0xFF;
     c_options.description = "the same model with one byte flipped";

@@ -26,7 +26,34 @@ struct SyntheticModelOptions {
   // trained model's correction is millimetres and milliradians).
   double position_output_factor = 1.0;
   double rotation_output_factor = 1.0;
+  // Play operators per cable of a hysteresis model (0: none, a joints-only
+  // model): widths 0.2 to 0.7 mm, weights summing to 0.6 to 1 per cable,
+  // the homing lags the homing move leaves on this geometry.
+  int hysteresis_operators = 0;
 };
+
+// A hysteresis model for `geometry` with random but valid values (widths
+// 0.2 to 0.7 mm, the weights of each cable summing to 0.6 to 1), its homing
+// lags computed from the homing move.
+template <typename Rng>
+model::HysteresisModel<double> synthetic_hysteresis(const model::RobotGeometry<double>& geometry, int operators,
+                                                    Rng& rng) {
+  const auto uniform = [&rng](double low, double high) { return std::uniform_real_distribution<double>(low, high)(rng); };
+  model::HysteresisModel<double> h;
+  h.cables = 4 * geometry.segment_count;
+  h.operators = operators;
+  for (int c = 0; c < h.cables; ++c) {
+    const double total = uniform(0.6, 1.0);
+    for (int k = 0; k < operators; ++k) {
+      h.widths_mm[c][k] = uniform(0.2, 0.7);
+      h.weights[c][k] = total / operators;
+    }
+  }
+  model::CableVector<double> approach_mm, home_mm;
+  model::homing_waypoints(geometry, approach_mm, home_mm);
+  model::compute_homing_lags(h, approach_mm, home_mm);
+  return h;
+}
 
 inline training::TrainedModel synthetic_trained_model(const SyntheticModelOptions& options = {}) {
   std::mt19937 rng(options.seed);
@@ -77,6 +104,8 @@ inline training::TrainedModel synthetic_trained_model(const SyntheticModelOption
   for (int i = 0; i < n; ++i) {
     for (int k = 0; k < 6; ++k) m.alpha(i, k) = uniform(-1.0, 1.0);
   }
+
+  if (options.hysteresis_operators > 0) m.hysteresis = synthetic_hysteresis(m.geometry, options.hysteresis_operators, rng);
 
   m.dataset_hash = 0xcbf29ce484222325ull ^ options.seed;
   m.created_unix_s = 1700000000;  // 2023-11-14T22:13:20Z

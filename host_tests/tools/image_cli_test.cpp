@@ -15,13 +15,16 @@
 #include <iterator>
 #include <ostream>
 #include <limits>
+#include <random>
 #include <string>
 #include <vector>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "cdcr/model/compensated_kinematics.hpp"
 #include "cdcr/model/flash_image.hpp"
+#include "cdcr/model/gp_correction.hpp"
 #include "dataset/csv_dataset.hpp"
 #include "export/binary_file.hpp"
 #include "export/c_source.hpp"
@@ -456,6 +459,158 @@ TEST_F(ImageCli, InspectOfASparseModel) {
   const CliResult text = cdcr("inspect " + quoted(save("sparse.img", exporting::write_image(sparse))));
   EXPECT_NE(text.out.find("  inducing points     5\n  fitted rows         640\n"), std::string::npos) << text.out;
   EXPECT_NE(text.out.find("  model kind          2 (sparse-gp)\n"), std::string::npos) << text.out;
+}
+
+// A v2.2 image's hysteresis block: its counts in the header, its values
+// in the text and the JSON, and the check that passed on them.
+TEST_F(ImageCli, InspectShowsTheHysteresisBlock) {
+  test_support::SyntheticModelOptions options;
+  options.hysteresis_operators = 2;
+  const training::TrainedModel m = test_support::synthetic_trained_model(options);
+  const fs::path path = save("hysteresis.img", exporting::write_image(m));
+  const CliResult run = cdcr("inspect --json " + quoted(path));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["version"], "2.2");
+  EXPECT_EQ(j["header"]["hysteresis_cables"], 8);
+  EXPECT_EQ(j["header"]["hysteresis_operators"], 2);
+  ASSERT_TRUE(j["hysteresis"].is_object()) << run.out;
+  EXPECT_EQ(j["hysteresis"]["cables"], 8);
+  EXPECT_EQ(j["hysteresis"]["operators"], 2);
+  ASSERT_EQ(j["hysteresis"]["widths_mm"].size(), 16u);
+  EXPECT_EQ(j["hysteresis"]["widths_mm"][3].get<float>(), static_cast<float>(m.hysteresis.widths_mm[1][1]));
+  EXPECT_EQ(j["hysteresis"]["weights"][4].get<float>(), static_cast<float>(m.hysteresis.weights[2][0]));
+  EXPECT_EQ(j["hysteresis"]["homing_lags_mm"][15].get<float>(), static_cast<float>(m.hysteresis.homing_lag_mm[7][1]));
+  EXPECT_EQ(j["checks"]["hysteresis"]["passed"], true);
+  bool listed = false;
+  for (const json& block : j["blocks"]) listed = listed || block["name"] == "hysteresis";
+  EXPECT_TRUE(listed);
+
+  const CliResult text = cdcr("inspect " + quoted(path));
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("  hysteresis          8 cables, 2 operators each\n"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("cable hysteresis (2 play operators per cable"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("  hysteresis  pass"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("8 cables x 2 play operators: widths within [0, 2] mm"), std::string::npos) << text.out;
+
+  // A joints-only image says it has none.
+  const json plain = json::parse(cdcr("inspect --json " + quoted(save("model.img", image))).out);
+  EXPECT_TRUE(plain["hysteresis"].is_null());
+  EXPECT_EQ(plain["checks"]["hysteresis"]["detail"], "no hysteresis block");
+}
+
+// A bad value in the block, under a valid CRC: the check names it.
+TEST_F(ImageCli, InspectNamesABadHysteresisValue) {
+  test_support::SyntheticModelOptions options;
+  options.hysteresis_operators = 1;
+  Bytes bad = exporting::write_image(test_support::synthetic_trained_model(options));
+  const model::ImageLayout layout = model::image_layout(5, 4, 2, 2, 0, 0, model::image_hysteresis_floats(8, 1));
+  put<float>(bad, layout.hysteresis_offset + 4 * 2, 3.5f);  // cable 3's width
+  put<std::uint32_t>(bad, bad.size() - 4, model::crc32(bad.data(), bad.size() - 4));
+  const CliResult run = cdcr("inspect --json " + quoted(save("bad_hysteresis.img", bad)));
+  EXPECT_EQ(run.exit_code, 1);
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["status"], "invalid_parameters");
+  EXPECT_EQ(j["failed_check"], "hysteresis");
+  EXPECT_NE(j["checks"]["hysteresis"]["detail"].get<std::string>().find("hysteresis_width[2] 3.5, expected at most 2"),
+            std::string::npos)
+      << j["checks"]["hysteresis"]["detail"];
+}
+
+// An image with a hysteresis block evaluated on rows without time (not a
+// motion sequence): one line saying so, exit 1.
+TEST_F(ImageCli, EvalOfAHysteresisImageNeedsAMotionSequence) {
+  const fs::path data = dir / "data.csv";
+  ASSERT_EQ(cdcr("simulate --samples 12 --seed 4 --out " + quoted(data)).exit_code, 0);
+  test_support::SyntheticModelOptions options;
+  options.segments = dataset::read_dataset_csv(data.string()).segment_count;
+  options.hysteresis_operators = 1;
+  const fs::path path = save("hysteresis.img", exporting::write_image(test_support::synthetic_trained_model(options)));
+  const CliResult run = cdcr("eval --model " + quoted(path) + " --data " + quoted(data));
+  EXPECT_EQ(run.exit_code, 1);
+  EXPECT_TRUE(one_line(run.err)) << run.err;
+  EXPECT_NE(run.err.find("needs a motion sequence (a t_s column), but the rows have no time"), std::string::npos)
+      << run.err;
+  options.hysteresis_operators = 0;
+  const fs::path plain = save("plain.img", exporting::write_image(test_support::synthetic_trained_model(options)));
+  EXPECT_EQ(cdcr("eval --model " + quoted(plain) + " --data " + quoted(data)).exit_code, 0);
+}
+
+// cdcr eval on a motion sequence with a hysteresis image: the poses are
+// those of the effective lengths, the state carried from row to row and each
+// session from home. Measured poses made in double from the trained model's
+// own hysteresis and the image's GP are met to float32 rounding; the same
+// model without its block (joints-only) misses them by the lags.
+TEST_F(ImageCli, EvalOfASequenceCarriesTheHysteresisFromRowToRow) {
+  test_support::SyntheticModelOptions options;
+  options.hysteresis_operators = 2;
+  options.position_output_factor = 0.1;
+  options.rotation_output_factor = 0.001;
+  const training::TrainedModel m = test_support::synthetic_trained_model(options);
+  const Bytes with_block = exporting::write_image(m);
+  training::TrainedModel joints_only = m;
+  joints_only.hysteresis = model::HysteresisModel<double>{};
+  model::ImageView view{};
+  ASSERT_EQ(model::parse_image(with_block.data(), with_block.size(), view), model::ImageStatus::ok);
+  model::RobotGeometry<double> geometry;
+  ASSERT_EQ(model::geometry_from_image(view, geometry), model::Status::ok);
+  model::GpCorrection<double, double> correction;
+  ASSERT_EQ(correction.bind(view), model::Status::ok);
+
+  dataset::Dataset data;
+  data.segment_count = 2;
+  data.has_time = true;
+  data.has_poses = true;
+  const int rows = 80;
+  data.cables_mm.resize(rows, 8);
+  data.time_s.resize(rows);
+  data.session_starts = {0, 50};
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> step(-0.04, 0.04);
+  model::JointVector<double> joints(4);
+  joints << 0.3, 0.12, 2.0, 0.1;
+  model::HysteresisState<double> state;
+  for (int i = 0; i < rows; ++i) {
+    for (int k = 0; k < 4; ++k) joints[k] += step(rng);
+    joints[1] = std::abs(joints[1]);
+    joints[3] = std::abs(joints[3]);
+    model::CableVector<double> cables;
+    ASSERT_EQ(model::cables_from_joints(joints, geometry, cables), model::Status::ok);
+    // What the CSV carries: the reader's value of the written text.
+    data.cables_mm.row(i) = cables.transpose();
+    data.time_s[i] = 0.05 * i + (i >= 50 ? 100.0 : 0.0);
+    if (i == 0 || i == 50) ASSERT_EQ(model::start_at_home(state, m.hysteresis, geometry), model::Status::ok);
+    model::update_hysteresis(state, m.hysteresis, cables);
+    model::CableVector<double> effective;
+    model::effective_lengths(state, m.hysteresis, effective);
+    model::ForwardResult<double> truth;
+    ASSERT_EQ(model::compensated_forward(effective, geometry, correction, truth), model::Status::ok);
+    data.poses.push_back(truth.compensated);
+  }
+  const fs::path data_path = dir / "sequence.csv";
+  dataset::write_dataset_csv(data_path.string(), data);
+
+  const CliResult run = cdcr("eval --json --model " + quoted(save("hysteresis.img", with_block)) + " --data " +
+                             quoted(data_path));
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const json j = json::parse(run.out);
+  EXPECT_EQ(j["hysteresis"], "carried over the sequence");
+  EXPECT_LT(j["compensated"]["position_mm"].get<double>(), 0.002) << run.out;
+  EXPECT_LT(j["compensated"]["orientation_deg"].get<double>(), 0.001) << run.out;
+
+  const CliResult without = cdcr("eval --json --model " +
+                                 quoted(save("joints_only.img", exporting::write_image(joints_only))) + " --data " +
+                                 quoted(data_path));
+  ASSERT_EQ(without.exit_code, 0) << without.err;
+  const json k = json::parse(without.out);
+  EXPECT_EQ(k["hysteresis"], "none");
+  EXPECT_GT(k["compensated"]["position_mm"].get<double>(), 0.05) << without.out;
+
+  const CliResult text = cdcr("eval --model " + quoted(save("hysteresis.img", with_block)) + " --data " +
+                              quoted(data_path));
+  EXPECT_NE(text.out.find("hysteresis           carried from row to row over 2 session(s), each from home"),
+            std::string::npos)
+      << text.out;
 }
 
 // A v1 image, built from its specification, goes through every tool that

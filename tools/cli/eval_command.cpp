@@ -1,12 +1,16 @@
 #include "training_commands.hpp"
 
+#include <algorithm>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
 #include "cdcr/model/compensated_kinematics.hpp"
+#include "cdcr/model/hysteresis_sequence.hpp"
+#include "cdcr/model/image_hysteresis.hpp"
 #include "cdcr/model/units.hpp"
 #include "cli_errors.hpp"
 #include "export/binary_file.hpp"
@@ -45,6 +49,22 @@ void write_rows(const std::string& path, const training::TrainingSet& set,
   exporting::write_binary_file(path, text.data(), text.size());
 }
 
+// The effective cable lengths of the rows, a motion sequence, as the board
+// computes them: the image's hysteresis block in float32, each session
+// starting at home, the state carried from row to row.
+Eigen::MatrixXd effective_cables(const model::ImageView& image, const model::HysteresisModel<float>& hysteresis,
+                                 const Eigen::MatrixXd& cables_mm, const std::vector<int>& session_starts) {
+  model::RobotGeometry<float> geometry;
+  model::geometry_from_image(image, geometry);
+  Eigen::MatrixXf effective(cables_mm.rows(), cables_mm.cols());
+  if (const model::Status s = model::effective_lengths_over_sequence(
+          hysteresis, geometry, cables_mm, session_starts.data(), static_cast<int>(session_starts.size()), effective);
+      s != model::Status::ok) {
+    throw std::invalid_argument(std::string("hysteresis: ") + model::to_string(s));
+  }
+  return effective.cast<double>();
+}
+
 CommandOutput run_eval(const EvalCommandOptions& o) {
   const LoadedImage image = load_image(o.model_path);
   const dataset::Dataset data = load_dataset(o.data_path, true);
@@ -63,15 +83,27 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     throw InputError(fmt::format("{}: the model takes a payload input and the data have no payload_kg column",
                                  o.data_path));
   }
+  // A model of the cables' hysteresis needs the rows' order and sessions:
+  // rows without a time column are independent samples.
+  model::HysteresisModel<float> hysteresis;
+  const bool with_hysteresis = model::hysteresis_from_image(image.view, hysteresis);
+  if (with_hysteresis && !data.has_time) {
+    throw InputError(fmt::format("{}: the model compensates the cables' hysteresis and needs a motion sequence (a t_s "
+                                 "column), but the rows have no time",
+                                 o.data_path));
+  }
   const char* payload_use = payload_input ? "used" : (data.has_payload ? "ignored" : "none");
   training::TrainingSet set;
   std::vector<model::Pose<double>> compensated;
   std::vector<training::FirmwareEstimate> estimates;
   try {
     set = training::make_training_set(data, geometry, image.view.encoding, payload_input);
-    compensated = training::firmware_poses(image.view, set.cables_mm, training::FirmwareAccumulator::float64,
-                                           set.payload_kg);
-    estimates = training::firmware_estimates(image.view, set.cables_mm, set.payload_kg);
+    // The nominal (initial) error stays that of the commanded lengths.
+    const Eigen::MatrixXd cables_mm =
+        with_hysteresis ? effective_cables(image.view, hysteresis, set.cables_mm, data.session_starts) : set.cables_mm;
+    compensated =
+        training::firmware_poses(image.view, cables_mm, training::FirmwareAccumulator::float64, set.payload_kg);
+    estimates = training::firmware_estimates(image.view, cables_mm, set.payload_kg);
   } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
   }
@@ -91,6 +123,7 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     j["extrapolating"] = coverage.extrapolating;
     j["outside_range"] = coverage.outside_range;
     j["payload"] = payload_use;
+    j["hysteresis"] = with_hysteresis ? "carried over the sequence" : "none";
     if (has_variance) {
       j["coverage"] = {{"r95_mm", coverage.position_coverage},
                        {"r95_deg", coverage.orientation_coverage},
@@ -117,6 +150,10 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     }
     output.text += fmt::format("  extrapolating        {} of {} samples ({} outside the fitted input range)\n",
                                coverage.extrapolating, set.size(), coverage.outside_range);
+    if (with_hysteresis) {
+      output.text += fmt::format("  hysteresis           carried from row to row over {} session(s), each from home\n",
+                                 std::max<std::size_t>(1, data.session_starts.size()));
+    }
     if (data.has_payload && !payload_input) {
       output.text += "  payload              the payload_kg column is ignored: the model has no payload input\n";
     } else if (payload_input) {

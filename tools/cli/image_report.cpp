@@ -280,6 +280,16 @@ void describe_unfailed(ImageCheck& check, const Findings& findings, const ImageR
                : fmt::format("{} variance points, positive factor diagonals, one kernel for every output",
                              h.variance_rank));
       return;
+    case ImageCheckId::hysteresis:
+      if (!r.hysteresis) {
+        pass("no hysteresis block");
+      } else {
+        const ImageHysteresis& b = *r.hysteresis;
+        pass(fmt::format("{} cables x {} play operators: widths within [0, {}] mm, weights >= 0 summing to at most "
+                         "1 per cable, homing lags within +-width",
+                         b.cables, b.operators, model::kMaxHysteresisWidthMm));
+      }
+      return;
     case ImageCheckId::fitted_rows:
       if (r.fitted_rows && *r.fitted_rows == h.training_points) {
         pass(fmt::format("{} rows, the training points", *r.fitted_rows));
@@ -369,6 +379,10 @@ ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
     h.metadata_size = read<std::uint32_t>(bytes, metadata_size);
     h.variance_offset = read<std::uint32_t>(bytes, variance_offset);
     h.variance_rank = read<std::uint16_t>(bytes, variance_rank);
+    if (h.version_major >= 2 && h.version_minor >= model::kImageVersionMinorHysteresis) {
+      h.hysteresis_cables = bytes[hysteresis_cables];
+      h.hysteresis_operators = bytes[hysteresis_operators];
+    }
     r.header = h;
   }
   if (const ImageFinding* f = findings.find(ImageCheckId::size, "total_size"); f != nullptr && f->passed) {
@@ -401,6 +415,26 @@ ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
     r.blocks.push_back({"header", 0, model::kImageHeaderSize, true});
     for (int i = 0; i < 5; ++i) {
       r.blocks.push_back({block_names[i], offsets[i], block_sizes[i], inside(offsets[i], block_sizes[i])});
+    }
+    // The hysteresis block (v2.2) lies just before the metadata.
+    const std::uint64_t hysteresis_bytes =
+        4 * std::uint64_t{model::image_hysteresis_floats(h.hysteresis_cables, h.hysteresis_operators)};
+    const std::uint64_t hysteresis_span = (hysteresis_bytes + model::kImageBlockAlignment - 1) /
+                                          model::kImageBlockAlignment * model::kImageBlockAlignment;
+    if (hysteresis_bytes > 0 && h.metadata_offset >= hysteresis_span) {
+      const std::uint64_t at = h.metadata_offset - hysteresis_span;
+      const bool readable = inside(at, hysteresis_bytes);
+      r.blocks.insert(r.blocks.end() - 1, {"hysteresis", at, hysteresis_bytes, readable});
+      if (readable) {
+        const std::uint64_t count = std::uint64_t{h.hysteresis_cables} * h.hysteresis_operators;
+        ImageHysteresis block;
+        block.cables = h.hysteresis_cables;
+        block.operators = h.hysteresis_operators;
+        block.widths_mm = read_floats(bytes, at, count);
+        block.weights = read_floats(bytes, at + 4 * count, count);
+        block.homing_lags_mm = read_floats(bytes, at + 8 * count, count);
+        r.hysteresis = std::move(block);
+      }
     }
     if (h.total_size >= model::kImageTrailerSize) {
       r.blocks.push_back({"crc32", h.total_size - model::kImageTrailerSize, model::kImageTrailerSize,

@@ -28,7 +28,7 @@ enum class CheckResult { passed, failed, not_checked };
 struct ImageCheck {
   model::ImageCheckId id;
   const char* name;  // size, magic, version, header, alignment, checksum, kind, capacity, layout, finite, positive,
-                     // ranges, fitted_rows
+                     // ranges, fitted_rows, variance, hysteresis
   CheckResult result = CheckResult::not_checked;
   std::string detail;
 };
@@ -56,6 +56,8 @@ struct ImageHeaderFields {
   std::uint32_t metadata_size = 0;
   std::uint32_t variance_offset = 0;  // v2
   std::uint16_t variance_rank = 0;    // v2
+  std::uint8_t hysteresis_cables = 0;     // v2.2
+  std::uint8_t hysteresis_operators = 0;  // v2.2
 };
 
 // A block where the header says it is, with the size the dims imply.
@@ -72,6 +74,13 @@ struct ImageParameters {
   std::vector<float> signal_variance, noise_variance;              // 6 each
   std::vector<float> input_min, input_max;                         // D each, v2; empty for v1
   std::vector<float> extra_input_default;                          // extra_inputs: the default payload (kg)
+};
+
+// The hysteresis block (v2.2), cables x operators each, row-major per cable.
+struct ImageHysteresis {
+  int cables = 0;
+  int operators = 0;
+  std::vector<float> widths_mm, weights, homing_lags_mm;
 };
 
 struct ImageMetadata {
@@ -99,6 +108,7 @@ struct ImageReport {
   std::optional<ImageParameters> parameters;
   std::optional<float> max_abs_input;  // kernel coordinates
   std::optional<float> max_abs_alpha;
+  std::optional<ImageHysteresis> hysteresis;  // a v2.2 image's block, when it lies inside the file
   std::optional<ImageMetadata> metadata;
   // Data rows the model was fitted on: the metadata's for v2, the training
   // points for v1 (whose images carry exactly the rows they were fitted on).

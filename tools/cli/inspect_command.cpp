@@ -107,6 +107,9 @@ std::string format_text(const std::string& path, const ImageReport& r) {
       row("variance factor", h.variance_offset == 0 && h.variance_rank == 0
                                  ? std::string("none")
                                  : fmt::format("offset {}, rank {}", h.variance_offset, h.variance_rank));
+      if (h.hysteresis_cables != 0 || h.hysteresis_operators != 0) {
+        row("hysteresis", fmt::format("{} cables, {} operators each", h.hysteresis_cables, h.hysteresis_operators));
+      }
     }
 
     t += "dims\n";
@@ -167,6 +170,24 @@ std::string format_text(const std::string& path, const ImageReport& r) {
                        p.output_mean[k], p.output_scale[k], p.signal_variance[k], p.noise_variance[k]);
     }
   }
+  if (r.hysteresis) {
+    // effective length = commanded - sum_k weight_k lag_k, each lag within
+    // +-width (model/include/cdcr/model/hysteresis.hpp).
+    const ImageHysteresis& b = *r.hysteresis;
+    t += fmt::format("cable hysteresis ({} play operators per cable; lags at home after the homing move)\n",
+                     b.operators);
+    t += fmt::format("  {:<9}{:>4}{:>16}{:>12}{:>18}\n", "cable", "k", "width (mm)", "weight", "homing lag (mm)");
+    for (int c = 0; c < b.cables && c < static_cast<int>(kMaxListedRows); ++c) {
+      for (int k = 0; k < b.operators; ++k) {
+        const std::size_t i = static_cast<std::size_t>(c * b.operators + k);
+        t += fmt::format("  {:<9}{:>4}{:>16}{:>12}{:>18}\n", k == 0 ? fmt::format("{}", c + 1) : std::string(), k + 1,
+                         b.widths_mm[i], b.weights[i], b.homing_lags_mm[i]);
+      }
+    }
+    if (b.cables > static_cast<int>(kMaxListedRows)) {
+      t += fmt::format("  ({} more cables not listed)\n", b.cables - static_cast<int>(kMaxListedRows));
+    }
+  }
   if (r.max_abs_input || r.max_abs_alpha) {
     const bool sparse = r.header && is_sparse(*r.header);
     t += sparse ? "inducing points\n" : "training set\n";
@@ -207,6 +228,9 @@ std::string format_text(const std::string& path, const ImageReport& r) {
 
   t += "checks\n";
   for (const ImageCheck& c : r.checks) {
+    // An image without a hysteresis block reads as it did before v2.2.
+    const bool no_block = !r.header || (r.header->hysteresis_cables == 0 && r.header->hysteresis_operators == 0);
+    if (c.id == model::ImageCheckId::hysteresis && no_block && c.result != CheckResult::failed) continue;
     std::string line = fmt::format("  {:<12}{:<13}{}", c.name, result_text(c.result), c.detail);
     while (line.back() == ' ') line.pop_back();
     t += line + "\n";
@@ -261,6 +285,8 @@ Json format_json(const std::string& path, const ImageReport& r) {
     if (!is_v1(h)) {
       header["variance_offset"] = h.variance_offset;
       header["variance_rank"] = h.variance_rank;
+      header["hysteresis_cables"] = h.hysteresis_cables;
+      header["hysteresis_operators"] = h.hysteresis_operators;
     }
   }
   header["trailing_bytes"] = r.trailing_bytes ? Json(*r.trailing_bytes) : Json(nullptr);
@@ -322,6 +348,16 @@ Json format_json(const std::string& path, const ImageReport& r) {
     j["hyperparameters"] = nullptr;
     j["input_range"] = nullptr;
     j["default_payload_kg"] = nullptr;
+  }
+  if (r.hysteresis) {
+    const ImageHysteresis& b = *r.hysteresis;
+    j["hysteresis"] = {{"cables", b.cables},
+                       {"operators", b.operators},
+                       {"widths_mm", floats_json(b.widths_mm)},
+                       {"weights", floats_json(b.weights)},
+                       {"homing_lags_mm", floats_json(b.homing_lags_mm)}};
+  } else {
+    j["hysteresis"] = nullptr;
   }
   j["training_set"] = {{"max_abs_kernel_coordinate", r.max_abs_input ? float_json(*r.max_abs_input) : Json(nullptr)},
                        {"max_abs_alpha", r.max_abs_alpha ? float_json(*r.max_abs_alpha) : Json(nullptr)}};

@@ -36,6 +36,57 @@ class ImageBuffer {
   std::vector<std::uint8_t> bytes_;
 };
 
+// The counts a trained hysteresis model must have for a robot of
+// `segments` segments; parse_image() judges its values.
+void check_hysteresis_counts(const model::HysteresisModel<double>& hysteresis, int segments) {
+  if (hysteresis.empty()) return;
+  if (hysteresis.cables != 4 * segments || hysteresis.cables > model::kMaxCables || hysteresis.operators < 1 ||
+      hysteresis.operators > model::kMaxHysteresisOperators) {
+    throw std::invalid_argument("trained model's hysteresis has " + std::to_string(hysteresis.cables) +
+                                " cables and " + std::to_string(hysteresis.operators) +
+                                " operators per cable; a robot of " + std::to_string(segments) + " segments needs " +
+                                std::to_string(4 * segments) + " cables and 1 to " +
+                                std::to_string(model::kMaxHysteresisOperators) + " operators");
+  }
+}
+
+std::uint32_t hysteresis_floats(const model::HysteresisModel<double>& hysteresis) {
+  return hysteresis.empty() ? 0
+                            : model::image_hysteresis_floats(static_cast<std::uint32_t>(hysteresis.cables),
+                                                             static_cast<std::uint32_t>(hysteresis.operators));
+}
+
+// The header's counts and the block, for a model with a hysteresis model.
+void put_hysteresis(ImageBuffer& image, std::uint32_t block, const model::HysteresisModel<double>& hysteresis) {
+  if (hysteresis.empty()) return;
+  image.put<std::uint16_t>(model::image_field::version_minor, model::kImageVersionMinorHysteresis);
+  image.put<std::uint8_t>(model::image_field::hysteresis_cables, static_cast<std::uint8_t>(hysteresis.cables));
+  image.put<std::uint8_t>(model::image_field::hysteresis_operators, static_cast<std::uint8_t>(hysteresis.operators));
+  std::size_t at = block + 4 * model::image_hysteresis_field::widths;
+  for (const auto* values : {&hysteresis.widths_mm, &hysteresis.weights, &hysteresis.homing_lag_mm}) {
+    for (int c = 0; c < hysteresis.cables; ++c) {
+      for (int k = 0; k < hysteresis.operators; ++k) {
+        image.put_float(at, (*values)[c][k]);
+        at += 4;
+      }
+    }
+  }
+}
+
+// Whatever is written must parse (a non-positive scale, for one, is only
+// caught here). Capacity is a property of the firmware build, not of the
+// image, so none is imposed.
+void check_parses(ImageBuffer& image, std::uint32_t size) {
+  model::ImageView view{};
+  const model::ImageCapacity any_capacity{std::numeric_limits<std::uint32_t>::max(),
+                                          std::numeric_limits<std::uint16_t>::max(),
+                                          std::numeric_limits<std::uint16_t>::max()};
+  if (const model::ImageStatus status = model::parse_image(image.data(), size, view, any_capacity);
+      status != model::ImageStatus::ok) {
+    throw std::invalid_argument(std::string("trained model cannot be exported: ") + model::to_string(status));
+  }
+}
+
 }  // namespace
 
 std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
@@ -71,10 +122,12 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
     throw std::invalid_argument("trained model's variance factor has inconsistent dimensions");
   }
   if (rank > 0xFFFF) throw std::invalid_argument("trained model's variance factor is too large for a flash image");
+  check_hysteresis_counts(model.hysteresis, segments);
   const model::ImageLayout layout =
       model::image_layout(static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(d),
                           static_cast<std::uint32_t>(segments), model::kImageVersionMajor,
-                          static_cast<std::uint32_t>(rank), static_cast<std::uint32_t>(extra));
+                          static_cast<std::uint32_t>(rank), static_cast<std::uint32_t>(extra),
+                          hysteresis_floats(model.hysteresis));
   ImageBuffer image(layout.total_size);
 
   image.put<std::uint32_t>(magic, model::kImageMagic);
@@ -172,6 +225,9 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
     }
   }
 
+  // Without a hysteresis model the image is a 2.1 image, byte for byte.
+  put_hysteresis(image, layout.hysteresis_offset, model.hysteresis);
+
   using namespace model::image_metadata_field;
   const std::size_t meta = layout.metadata_offset;
   image.put<std::uint64_t>(meta + dataset_hash, model.dataset_hash);
@@ -184,18 +240,45 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   const std::uint32_t checksum = model::crc32(image.data(), layout.total_size - model::kImageTrailerSize);
   image.put<std::uint32_t>(layout.total_size - model::kImageTrailerSize, checksum);
 
-  // Whatever is written must parse (a non-positive scale, for one, is only
-  // caught here). Capacity is a property of the firmware build, not of the
-  // image, so none is imposed.
+  check_parses(image, layout.total_size);
+  return image.take();
+}
+
+std::vector<std::uint8_t> with_hysteresis_block(const std::vector<std::uint8_t>& image,
+                                                const model::HysteresisModel<double>& hysteresis) {
   model::ImageView view{};
   const model::ImageCapacity any_capacity{std::numeric_limits<std::uint32_t>::max(),
                                           std::numeric_limits<std::uint16_t>::max(),
                                           std::numeric_limits<std::uint16_t>::max()};
-  if (const model::ImageStatus status = model::parse_image(image.data(), layout.total_size, view, any_capacity);
+  if (const model::ImageStatus status = model::parse_image(image.data(), image.size(), view, any_capacity);
       status != model::ImageStatus::ok) {
-    throw std::invalid_argument(std::string("trained model cannot be exported: ") + model::to_string(status));
+    throw std::invalid_argument(std::string("image to add hysteresis to: ") + model::to_string(status));
   }
-  return image.take();
+  if (view.version_major != model::kImageVersionMajor || view.hysteresis_cables != 0) {
+    throw std::invalid_argument("only a v2 image without a hysteresis block can take one");
+  }
+  check_hysteresis_counts(hysteresis, view.segment_count);
+  const model::ImageLayout old_layout =
+      model::image_layout(view.training_points, static_cast<std::uint32_t>(view.input_dims),
+                          static_cast<std::uint32_t>(view.segment_count), view.version_major, view.variance_rank,
+                          static_cast<std::uint32_t>(view.extra_inputs));
+  const model::ImageLayout layout =
+      model::image_layout(view.training_points, static_cast<std::uint32_t>(view.input_dims),
+                          static_cast<std::uint32_t>(view.segment_count), view.version_major, view.variance_rank,
+                          static_cast<std::uint32_t>(view.extra_inputs), hysteresis_floats(hysteresis));
+  ImageBuffer out(layout.total_size);
+  // Everything before the metadata stays where it is; the block goes
+  // between it and the metadata, which moves.
+  std::memcpy(out.data(), image.data(), old_layout.metadata_offset);
+  std::memcpy(out.data() + layout.metadata_offset, image.data() + old_layout.metadata_offset,
+              model::kImageMetadataSize);
+  out.put<std::uint32_t>(model::image_field::total_size, layout.total_size);
+  out.put<std::uint32_t>(model::image_field::metadata_offset, layout.metadata_offset);
+  put_hysteresis(out, layout.hysteresis_offset, hysteresis);
+  const std::uint32_t checksum = model::crc32(out.data(), layout.total_size - model::kImageTrailerSize);
+  out.put<std::uint32_t>(layout.total_size - model::kImageTrailerSize, checksum);
+  check_parses(out, layout.total_size);
+  return out.take();
 }
 
 }  // namespace cdcr::exporting

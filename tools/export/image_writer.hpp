@@ -14,6 +14,14 @@ namespace cdcr::exporting {
 // dims, non-finite values after conversion to float32, or anything else
 // parse_image() would refuse, such as a non-positive scale, an inverted input
 // range, or an exact model whose fitted_rows is not its number of points).
+// A model with a hysteresis model (TrainedModel::hysteresis) is written as
+// a v2.2 image with the hysteresis block; one without, as a v2.1 image.
 std::vector<std::uint8_t> write_image(const training::TrainedModel& model);
+
+// `image` (a valid v2 image without a hysteresis block) with `hysteresis`
+// added: the same model, written as v2.2. Throws std::invalid_argument as
+// write_image does.
+std::vector<std::uint8_t> with_hysteresis_block(const std::vector<std::uint8_t>& image,
+                                                const model::HysteresisModel<double>& hysteresis);
 
 }  // namespace cdcr::exporting

@@ -1,4 +1,7 @@
-// cdcr-runtime --replay: the forward path over recorded cable lengths.
+// cdcr-runtime --replay: the forward path over recorded cable lengths. With
+// an image that models the cables' hysteresis the rows are a motion sequence
+// (the data's t_s column): the state is carried from row to row, each
+// session starting at home, and the pose is that of the effective lengths.
 
 #include <cstdio>
 #include <stdexcept>
@@ -7,6 +10,7 @@
 #include <Eigen/Geometry>
 
 #include <cdcr/firmware/runtime.hpp>
+#include <cdcr/model/hysteresis_sequence.hpp>
 
 #include "cli/cli_errors.hpp"
 #include "dataset/csv_dataset.hpp"
@@ -57,11 +61,24 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
     std::fprintf(stderr, "note: %s: the payload_kg column is ignored: the image has no payload input\n",
                  cables_path.c_str());
   }
+  const fw::HysteresisTracker& hysteresis = runtime.hysteresis();
+  if (hysteresis.active() && !data.has_time) {
+    throw InputError(cables_path + ": the image compensates the cables' hysteresis and needs a motion sequence (a t_s "
+                                   "column), but the rows have no time");
+  }
+  Eigen::MatrixXf effective_mm(data.cables_mm.rows(), data.cables_mm.cols());
+  if (hysteresis.active()) {
+    const model::Status s = model::effective_lengths_over_sequence(
+        hysteresis.hysteresis_model(), runtime.geometry(), data.cables_mm, data.session_starts.data(),
+        static_cast<int>(data.session_starts.size()), effective_mm);
+    if (s != model::Status::ok) throw InputError(cables_path + ": hysteresis: " + model::to_string(s));
+  }
   std::FILE* out = std::fopen(out_path.c_str(), "w");
   if (out == nullptr) throw InputError("cannot write " + out_path);
   std::fprintf(out, "x,y,z,qw,qx,qy,qz,r95_mm,r95_deg,extrapolating\n");
   for (Eigen::Index i = 0; i < data.cables_mm.rows(); ++i) {
-    const fw::Cables cables = data.cables_mm.row(i).transpose().cast<float>();
+    const fw::Cables cables = hysteresis.active() ? fw::Cables(effective_mm.row(i).transpose())
+                                                  : fw::Cables(data.cables_mm.row(i).transpose().cast<float>());
     if (payload_input && !runtime.set_payload_kg(static_cast<float>(data.payload_kg[i]))) {
       std::fclose(out);
       throw InputError(cables_path + ": sample " + std::to_string(i + 1) + ": payload " +

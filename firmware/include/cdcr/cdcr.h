@@ -49,7 +49,7 @@ extern "C" {
 /* Bytes of cdcr_runtime: enough for every supported target (host, Cortex-M7,
  * Cortex-M4F), checked when the library is compiled;
  * cdcr_runtime_storage_size() says how much this build uses. */
-#define CDCR_RUNTIME_STORAGE_BYTES 8192u
+#define CDCR_RUNTIME_STORAGE_BYTES 12288u
 
 /* Opaque: the caller provides the storage, typically as a static variable. */
 typedef struct cdcr_runtime {
@@ -92,7 +92,8 @@ typedef enum cdcr_fault {
   CDCR_FAULT_TARGET_UNREACHABLE = 8,     /* fault_detail: the model's status */
   CDCR_FAULT_CAN_TRANSMIT_FAILED = 9,    /* can_send returned non-zero */
   CDCR_FAULT_CAN_FILTERS_REFUSED = 10,   /* can_receive given without can_set_filters, or it refused */
-  CDCR_FAULT_PAYLOAD_INVALID = 11        /* a PAYLOAD frame beyond 0..50 kg: the previous payload stays */
+  CDCR_FAULT_PAYLOAD_INVALID = 11,       /* a PAYLOAD frame beyond 0..50 kg: the previous payload stays */
+  CDCR_FAULT_HOMING_MALFORMED = 12       /* a HOMING frame that does not decode: the hysteresis state stays */
 } cdcr_fault;
 
 /* How the last target ended (the IK_REPORT frame's OUTCOME). */
@@ -189,6 +190,10 @@ typedef struct cdcr_status {
   int64_t execution_max_ns;
   int64_t execution_mean_ns;
   int64_t jitter_max_ns;
+  /* 1: the model image has a hysteresis block and the cables' hysteresis
+   * state is not yet known (since init, until every cable has travelled far
+   * enough one way, or cdcr_homing()): r95 includes it. 0 without a block. */
+  int hysteresis_unknown;
 } cdcr_status;
 
 /* Bytes of cdcr_runtime this build uses (at most CDCR_RUNTIME_STORAGE_BYTES). */
@@ -216,6 +221,13 @@ cdcr_result cdcr_set_segment_cable_lengths(cdcr_runtime *runtime, int segment, c
  * value outside 0..50 kg, and nothing changes. A model without a payload
  * input ignores it. */
 cdcr_result cdcr_set_payload(cdcr_runtime *runtime, float payload_kg);
+
+/* The robot has just completed the homing move (every segment bent 0.1 rad
+ * towards alpha = 45 deg, then back straight) and is at home: from the next
+ * cdcr_step() the cables' hysteresis state is the image's homing state, and
+ * the cable lengths given next are its position (the HOMING frame's
+ * meaning). Changes nothing with an image without a hysteresis block. */
+cdcr_result cdcr_homing(cdcr_runtime *runtime);
 
 /* A target for the tip; the runtime solves it over the next steps and
  * publishes setpoints when it converges (see cdcr_status.ik_outcome). */

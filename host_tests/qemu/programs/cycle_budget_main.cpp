@@ -12,6 +12,12 @@
 // and the latency figures in cycles, and fails when a cycle exceeds the
 // board's budget (80,000 instructions on the Cortex-M7, 120,000 on the
 // Cortex-M4F).
+//
+// Built with CDCR_BUDGET_WITH_HYSTERESIS (cdcr_qemu_cycle_budget_hysteresis)
+// the image carries a hysteresis block: the runtime starts with the state
+// unknown (its r95 widening runs), the drives' moves make it known, and the
+// program also reports what the hysteresis itself costs: the tracking of a
+// cable set and the widening's Jacobian, at most, in instructions.
 
 #include <algorithm>
 #include <cmath>
@@ -245,6 +251,48 @@ void report_unit_costs() {
   console::console_write("\n");
 }
 
+#ifdef CDCR_BUDGET_WITH_HYSTERESIS
+firmware::HysteresisTracker probe_tracker;
+firmware::RobotModel probe_model;
+
+// The hysteresis' work in a cycle, measured on a tracker of its own bound to
+// the same image: a cable set's update and effective lengths (the state
+// unknown, then known), and the widening's nominal Jacobian.
+void report_hysteresis_costs(const model::ImageView& image) {
+  probe_model.geometry = runtime.geometry();
+  probe_model.image = image;
+  probe_model.compensated = true;
+  probe_tracker.bind(probe_model);
+  firmware::Cables cases[4];
+  for (int c = 0; c < 4; ++c) {
+    cases[c].resize(4 * segments);
+    for (int i = 0; i < 4 * segments; ++i) cases[c][i] = float(cdcr::qemu_golden::kCablesMm[c][i]);
+  }
+  std::uint32_t track_max = 0, widen_max = 0;
+  for (int round = 0; round < 12; ++round) {
+    const firmware::Cables& cables = cases[round % 4];
+    const bool unknown = !probe_tracker.known();
+    track_max = std::max(track_max, counter.instructions([&] { probe_tracker.track(cables); }));
+    if (unknown) {
+      firmware::PoseEstimate estimate;
+      runtime.estimate_pose(cables, estimate);
+      widen_max = std::max(widen_max, counter.instructions([&] { probe_tracker.begin_variance(probe_model, estimate); }));
+    }
+  }
+  console::console_write("hysteresis costs (instructions): ");
+  console::console_write_int(probe_tracker.hysteresis_model().cables);
+  console::console_write(" cables x ");
+  console::console_write_int(probe_tracker.hysteresis_model().operators);
+  console::console_write(" operators; track max ");
+  console::console_write_int(static_cast<std::int32_t>(track_max));
+  console::console_write(", widening max ");
+  console::console_write_int(static_cast<std::int32_t>(widen_max));
+  console::console_write("; charged ");
+  console::console_write_int(static_cast<std::int32_t>(firmware::hysteresis_units(runtime.hysteresis())));
+  console::console_write(" units a cycle\n");
+}
+#endif
+
 }  // namespace
 
 int main() {
@@ -258,6 +306,13 @@ int main() {
   console::console_write_int(static_cast<std::int32_t>(runtime.ik_units_per_cycle()));
   console::console_write(" units\n");
   report_unit_costs();
+#ifdef CDCR_BUDGET_WITH_HYSTERESIS
+  if (!runtime.hysteresis().active() || runtime.hysteresis().known()) {
+    console::console_write("FAIL: the image's hysteresis block is not tracked, or its state is known at power-up\n");
+    return 1;
+  }
+  report_hysteresis_costs(image);
+#endif
 
   // The drives start where golden case 0 has them.
   for (int s = 0; s < segments; ++s) {
@@ -389,6 +444,12 @@ int main() {
     console::console_write("FAIL: targets refusing extrapolation were all accepted or all refused\n");
     ok = false;
   }
+#ifdef CDCR_BUDGET_WITH_HYSTERESIS
+  if (!runtime.hysteresis().known()) {
+    console::console_write("FAIL: the drives' moves did not make the hysteresis state known\n");
+    ok = false;
+  }
+#endif
   if (cycles_run < 2000) {
     console::console_write("FAIL: fewer than 2,000 cycles\n");
     ok = false;

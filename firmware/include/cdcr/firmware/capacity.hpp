@@ -64,6 +64,19 @@ inline constexpr std::uint32_t kUncertaintyUnitsPerCycle = 192;
 inline constexpr int kUncertaintyEveryCyclesWhileSolving = 8;
 inline constexpr int kMaxVarianceRank = static_cast<int>(model::kMaxVarianceRank);
 
+// Work units the cables' hysteresis takes from a cycle, with an image that
+// has a hysteresis block (hysteresis_tracker.hpp), charged as part of the
+// forward path: per cable and play operator, the update of its lag interval
+// and the effective length; and, in a cycle that begins a pose variance while
+// the state is unknown, the nominal Jacobian that widens the radii. Measured
+// under QEMU by qemu.cycle_budget_hysteresis_<board> (16 cables x 2
+// operators: a cable set's tracking at most 2,162 instructions on the M7
+// and 2,210 on the M4F, the widening 2,951 and 4,818; the 142 units charged
+// are 6,674 and 7,668 instructions there). The widening is charged
+// in every cycle, though it runs only while the state is unknown.
+inline constexpr std::uint32_t kHysteresisUnitsPerOperator = 1;
+inline constexpr std::uint32_t kHysteresisWideningUnits = 110;
+
 // Bounds of one IK request: correction evaluations and nominal LM
 // iterations (see model::IkSolverOptions), and the cycles it may span
 // before it is reported unreachable.

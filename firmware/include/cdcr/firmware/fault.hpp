@@ -29,6 +29,8 @@ enum class FaultCode : std::uint8_t {
                                // foreign frames, but every frame on the bus now costs it a receive
   payload_invalid = 11,        // last payload refused (malformed PAYLOAD frame, beyond its range, NaN); the
                                // previous payload stays in use
+  homing_malformed = 12,       // last HOMING frame refused (wrong DLC, AT_HOME not 1): the hysteresis state
+                               // is unchanged
 };
 
 constexpr const char* to_string(RuntimeState state) {
@@ -55,6 +57,7 @@ constexpr const char* to_string(FaultCode code) {
     case FaultCode::can_transmit_failed: return "CAN transmit failed";
     case FaultCode::can_filters_refused: return "CAN acceptance filters refused";
     case FaultCode::payload_invalid: return "payload invalid";
+    case FaultCode::homing_malformed: return "homing frame malformed";
   }
   return "unknown fault";
 }

@@ -36,6 +36,7 @@ constexpr FaultDetailKind detail_kind(FaultCode code) {
     case FaultCode::can_transmit_failed:
     case FaultCode::can_filters_refused:
     case FaultCode::payload_invalid:
+    case FaultCode::homing_malformed:
       return FaultDetailKind::none;
   }
   return FaultDetailKind::none;

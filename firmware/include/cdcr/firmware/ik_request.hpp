@@ -9,6 +9,7 @@
 
 #include <cstdint>
 
+#include "cdcr/firmware/hysteresis_tracker.hpp"
 #include "cdcr/firmware/kinematics.hpp"
 #include "cdcr/firmware/outbox.hpp"
 #include "cdcr/firmware/protocol.hpp"
@@ -43,7 +44,11 @@ struct IkReport {
 
 class IkRequest {
  public:
-  IkRequest(const RobotModel& model, Outbox& outbox) : model_(model), outbox_(outbox) {}
+  // With `hysteresis` (an image with a hysteresis block) the solver finds
+  // the effective cable lengths that reach the target, and the setpoints are
+  // the commanded lengths that produce them from the cables' current state.
+  IkRequest(const RobotModel& model, Outbox& outbox, const HysteresisTracker* hysteresis = nullptr)
+      : model_(model), outbox_(outbox), hysteresis_(hysteresis) {}
   IkRequest(const IkRequest&) = delete;
   IkRequest& operator=(const IkRequest&) = delete;
 
@@ -86,6 +91,7 @@ class IkRequest {
 
   const RobotModel& model_;
   Outbox& outbox_;
+  const HysteresisTracker* hysteresis_;
   SolverCorrection solver_correction_{model_.correction};
   Solver solver_;
   IkReport report_;

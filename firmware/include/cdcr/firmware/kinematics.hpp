@@ -95,6 +95,8 @@ class PoseVariance {
 
   bool has_result() const { return has_result_; }
   const model::PoseUncertainty<Scalar>& result() const { return result_; }
+  // The same, for the caller that widens the radii (hysteresis_tracker.hpp).
+  model::PoseUncertainty<Scalar>& result() { return result_; }
   std::uint8_t result_sequence() const { return result_sequence_; }
 
  private:

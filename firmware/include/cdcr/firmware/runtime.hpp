@@ -13,14 +13,12 @@
 // targets; the drives keep the last setpoint they received (holding position
 // is the drives' own behaviour on a silent bus), and STATUS keeps coming.
 //
-// Per cycle: take the inputs (up to kMaxRxFramesPerCycle frames: cable
-// feedback, target frames, payload; or the same by direct call), estimate the
-// pose from the latest cable lengths, let the scheduler share out the rest of
-// the cycle (variance slice, model update, IK request: cycle_scheduler.hpp),
-// publish, and measure execution time and start jitter on the HAL clock.
-// Every frame goes through the codec in protocol.hpp. The parts: kinematics.hpp
-// (the model and the forward path), ik_request.hpp (a target over cycles),
-// cycle_scheduler.hpp, model_update.hpp, outbox.hpp (frames out, events).
+// Per cycle: take the inputs (up to kMaxRxFramesPerCycle frames, or by direct
+// call), move the hysteresis state and estimate the pose from the latest cable
+// lengths, let the scheduler share out the rest (variance slice, model update,
+// IK: cycle_scheduler.hpp), publish, and measure time and jitter on the HAL
+// clock. Frames go through protocol.hpp. The parts: kinematics.hpp,
+// hysteresis_tracker.hpp, ik_request.hpp, model_update.hpp, outbox.hpp.
 
 #include <cstdint>
 
@@ -30,6 +28,7 @@
 #include "cdcr/firmware/fault.hpp"
 #include "cdcr/firmware/fault_detail.hpp"
 #include "cdcr/firmware/frame_inputs.hpp"
+#include "cdcr/firmware/hysteresis_tracker.hpp"
 #include "cdcr/firmware/ik_request.hpp"
 #include "cdcr/firmware/kinematics.hpp"
 #include "cdcr/firmware/model_update.hpp"
@@ -85,6 +84,9 @@ class Runtime {
   // pose and the next IK evaluation use the new one. Without a payload input
   // a valid payload is accepted and changes nothing.
   bool set_payload_kg(Scalar payload_kg);
+  // HOMING: the homing move has just ended, the robot is at home
+  // (hysteresis_tracker.hpp); without a hysteresis block, nothing.
+  void set_homed() { hysteresis_.homed(model_.geometry); }
   // An input that could not be taken (a frame that does not decode):
   // counted in STATS, reported in STATUS.
   void reject_input(FaultCode code);
@@ -95,16 +97,14 @@ class Runtime {
   model::Status estimate_pose(const Cables& cables_mm, PoseEstimate& estimate) const {
     return firmware::estimate_pose(model_, cables_mm, estimate);
   }
-  // The radii and extrapolation flag of an estimate, in one go (a cycle
-  // spreads the same steps over a few cycles).
+  // The radii and extrapolation flag of an estimate in one go (cycles spread it).
   model::PoseUncertainty<Scalar> estimate_uncertainty(const PoseEstimate& estimate) const {
     return firmware::estimate_uncertainty(model_, estimate);
   }
 
   RuntimeState state() const { return state_; }
-  // What STATUS reports: stale input in FAULT, else the last rejection since
-  // the previous STATUS, else the boot fault (image), else refused filters,
-  // else none.
+  // What STATUS reports: stale input in FAULT, else the last rejection since the
+  // previous STATUS, else the boot fault (image), else refused filters, else none.
   FaultCode active_fault() const;
   // What STATS reports with it (fault_detail.hpp).
   FaultDetail active_fault_detail() const;
@@ -117,9 +117,8 @@ class Runtime {
   // The correction the image bound (unbound in DEGRADED).
   const Correction& correction() const { return model_.correction; }
   const IkReport& last_ik_report() const { return ik_.report(); }
-  // A target being solved, and the IK work units a cycle may spend on it
-  // (the last cycle's; after init, a cycle's that also runs a slice of the
-  // variance, the smaller).
+  // A target being solved, and the IK work units a cycle may spend on it (the last
+  // cycle's; after init, a cycle's that also runs a variance slice, the smaller).
   bool ik_running() const { return ik_.running(); }
   std::uint32_t ik_units_per_cycle() const { return scheduler_.ik_units(); }
   // Units the IK solver spent in the last cycle.
@@ -132,16 +131,16 @@ class Runtime {
   const Cables& setpoints_mm() const { return ik_.setpoints_mm(); }
   bool has_pose() const { return has_pose_; }
   const PoseEstimate& latest_pose() const { return latest_pose_; }
-  // The last radii sent (POSE_UNCERTAINTY), for the pose of cycle
-  // latest_uncertainty_sequence().
+  // The last radii sent (POSE_UNCERTAINTY), for latest_uncertainty_sequence()'s pose.
   bool has_uncertainty() const { return variance_.has_result(); }
   const model::PoseUncertainty<Scalar>& latest_uncertainty() const { return variance_.result(); }
   std::uint8_t latest_uncertainty_sequence() const { return variance_.result_sequence(); }
-  // Whether the latest pose extrapolates: outside the fitted range, or the
-  // last radii said so.
+  // Whether the latest pose extrapolates: outside the fitted range, or radii say so.
   bool extrapolating() const;
   // Model updates over CAN into the HAL's flash (model_update.hpp).
   const ModelUpdate& model_update() const { return update_; }
+  // The cables' hysteresis state (an image with a hysteresis block).
+  const HysteresisTracker& hysteresis() const { return hysteresis_; }
 
  private:
   // The switch to a newly committed image (model_loader.hpp).
@@ -176,9 +175,10 @@ class Runtime {
   Scalar payload_kg_ = 0;
   bool payload_received_ = false;
   PoseVariance variance_;
+  HysteresisTracker hysteresis_;
 
   FrameInputs frame_inputs_;
-  IkRequest ik_{model_, outbox_};
+  IkRequest ik_{model_, outbox_, &hysteresis_};
   CycleScheduler scheduler_;
   std::uint32_t ik_units_last_cycle_ = 0;
 

@@ -28,6 +28,9 @@ namespace cdcr::model {
 inline constexpr std::uint32_t kImageMagic = 0x50474443u;  // bytes "CDGP"
 inline constexpr std::uint16_t kImageVersionMajor = 2;      // what the exporter writes
 inline constexpr std::uint16_t kImageVersionMinor = 1;  // 2.1: the predictive-variance block
+// 2.2: the cables' hysteresis block. The exporter writes 2.2 only for a model
+// with one, so an image without it stays byte for byte a 2.1 image.
+inline constexpr std::uint16_t kImageVersionMinorHysteresis = 2;
 inline constexpr std::uint16_t kImageOldestVersionMajor = 1;  // still read: deployed boards carry v1 images
 inline constexpr std::uint32_t kImageHeaderSize = 64;
 inline constexpr std::uint32_t kImageBlockAlignment = 8;
@@ -111,6 +114,18 @@ inline constexpr std::uint32_t reserved = 3;                // f32, zero
 inline constexpr std::uint32_t points = 4;                  // R x D kernel coordinates, then the two factors
 }  // namespace image_variance_field
 
+// The hysteresis block (v2.2): per cable c and operator k, row-major
+// [c][k], float32: the play operators' widths (mm), their weights, then the
+// lags the homing move leaves (mm); see hysteresis.hpp. The counts are the
+// header's hysteresis_cables and hysteresis_operators.
+namespace image_hysteresis_field {
+inline constexpr std::uint32_t widths = 0;  // then weights, then homing lags, cables x operators each
+}  // namespace image_hysteresis_field
+
+constexpr std::uint32_t image_hysteresis_floats(std::uint32_t cables, std::uint32_t operators) {
+  return 3 * cables * operators;
+}
+
 constexpr std::uint32_t packed_triangle_floats(std::uint32_t rank) { return rank * (rank + 1) / 2; }
 
 // In 64 bits: a damaged header's rank (up to 65535) must not wrap the count.
@@ -144,7 +159,9 @@ inline constexpr std::size_t metadata_offset = 48;
 inline constexpr std::size_t metadata_size = 52;    // u32, kImageMetadataSize
 inline constexpr std::size_t variance_offset = 56;  // u32, the variance block; zero without one (v1: reserved)
 inline constexpr std::size_t variance_rank = 60;    // u16, R, the variance points; zero without (v1: reserved)
-inline constexpr std::size_t reserved_b = 62;       // 2 bytes, zero (v1: bytes 56..63)
+inline constexpr std::size_t reserved_b = 62;       // 2 bytes, zero before v2.2 (v1: bytes 56..63)
+inline constexpr std::size_t hysteresis_cables = 62;     // u8, v2.2: cables of the hysteresis block; zero without
+inline constexpr std::size_t hysteresis_operators = 63;  // u8, v2.2: play operators per cable; zero without
 }  // namespace image_field
 
 // Byte offsets inside the metadata block.
@@ -199,6 +216,14 @@ struct ImageView {
   const float* variance_points;               // R x D row-major, kernel coordinates
   const float* variance_inducing_factor;      // packed lower triangle L_u, R (R + 1) / 2: chol(K_uu / signal_variance)
   const float* variance_posterior_factor;     // packed lower triangle L_c: chol(I + L_u^-1 K_uf K_fu L_u^-T / (signal noise))
+  // The cables' hysteresis (v2.2; zero counts and null pointers without it),
+  // cables x operators each, row-major per cable (image_hysteresis.hpp
+  // makes a model::HysteresisModel of it).
+  int hysteresis_cables;
+  int hysteresis_operators;
+  const float* hysteresis_widths;      // mm, finite, in [0, kMaxHysteresisWidthMm]
+  const float* hysteresis_weights;     // finite, >= 0, summing to <= 1 per cable
+  const float* hysteresis_homing_lags; // mm, within +-width
   std::uint64_t dataset_hash;
   std::int64_t created_unix_s;
   std::uint32_t validation_samples;
@@ -213,6 +238,7 @@ struct ImageLayout {
   std::uint32_t inputs_offset;
   std::uint32_t alpha_offset;
   std::uint32_t variance_offset;  // 0 without a variance block
+  std::uint32_t hysteresis_offset;  // 0 without a hysteresis block
   std::uint32_t metadata_offset;
   std::uint32_t total_size;
 };
@@ -234,7 +260,8 @@ constexpr std::uint32_t image_parameter_floats(std::uint32_t input_dims,
 // Blocks follow the header in this order, each 8-byte aligned, then the CRC.
 constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t input_dims,
                                    std::uint32_t segment_count, std::uint16_t version_major = kImageVersionMajor,
-                                   std::uint32_t variance_rank = 0, std::uint32_t extra_inputs = 0) {
+                                   std::uint32_t variance_rank = 0, std::uint32_t extra_inputs = 0,
+                                   std::uint32_t hysteresis_floats = 0) {
   ImageLayout layout{};
   std::uint32_t at = kImageHeaderSize;
   layout.geometry_offset = at;
@@ -249,6 +276,10 @@ constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t 
     layout.variance_offset = at;
     at = align_up(at + 4 * static_cast<std::uint32_t>(image_variance_floats(variance_rank, input_dims)),
                   kImageBlockAlignment);
+  }
+  if (hysteresis_floats > 0) {
+    layout.hysteresis_offset = at;
+    at = align_up(at + 4 * hysteresis_floats, kImageBlockAlignment);
   }
   layout.metadata_offset = at;
   at = align_up(at + kImageMetadataSize, kImageBlockAlignment);
@@ -275,8 +306,9 @@ enum class ImageCheckId : std::uint8_t {
   ranges,       // invalid_parameters, v2: input_min <= input_max
   fitted_rows,  // invalid_parameters, v2: the metadata's fitted_rows
   variance,     // invalid_parameters, v2.1: what the variance block requires of the model
+  hysteresis,   // invalid_parameters, v2.2: the hysteresis block's widths, weights and homing lags
 };
-inline constexpr int kImageCheckCount = static_cast<int>(ImageCheckId::variance) + 1;
+inline constexpr int kImageCheckCount = static_cast<int>(ImageCheckId::hysteresis) + 1;
 
 constexpr const char* to_string(ImageCheckId check) {
   switch (check) {
@@ -294,6 +326,7 @@ constexpr const char* to_string(ImageCheckId check) {
     case ImageCheckId::ranges: return "ranges";
     case ImageCheckId::fitted_rows: return "fitted_rows";
     case ImageCheckId::variance: return "variance";
+    case ImageCheckId::hysteresis: return "hysteresis";
   }
   return "unknown";
 }
@@ -388,6 +421,62 @@ bool expect_each(Run& run, const float* values, std::uint32_t count, Good good, 
 
 inline bool is_finite(float value) { return std::isfinite(value); }
 inline bool is_positive(float value) { return value > 0.0f; }
+
+// The hysteresis block's values (hysteresis.hpp, check_hysteresis): widths
+// finite, non-negative and at most kMaxHysteresisWidthMm (the homing move
+// must take every cable twice as far), weights finite and non-negative with
+// a sum of at most 1 per cable (a float32 rounding's allowance, as
+// check_hysteresis makes), homing lags within +-width. A failure per bad
+// value, or one pass for the block. False where a stopping run must stop.
+template <typename Run>
+bool check_hysteresis_block(Run& run, const float* block, std::uint32_t cables, std::uint32_t operators) {
+  using Expect = ImageExpectation;
+  const std::uint32_t count = cables * operators;
+  const float* widths = block + image_hysteresis_field::widths;
+  const float* weights = widths + count;
+  const float* homing_lags = weights + count;
+  const float max_width = static_cast<float>(kMaxHysteresisWidthMm);
+  bool all_good = true;
+  const auto expect = [&](bool passed, const char* field, std::uint32_t index, double value, double expected,
+                          Expect expectation) {
+    if (passed) return true;
+    all_good = false;
+    return run.expect(false, ImageCheckId::hysteresis, ImageStatus::invalid_parameters, field,
+                      static_cast<std::int32_t>(index), value, expected, expectation);
+  };
+  for (std::uint32_t c = 0; c < cables; ++c) {
+    float weight_sum = 0.0f;
+    for (std::uint32_t k = 0; k < operators; ++k) {
+      const std::uint32_t i = c * operators + k;
+      const float width = widths[i];
+      const float weight = weights[i];
+      const float lag = homing_lags[i];
+      const bool width_finite = std::isfinite(width);
+      const bool weight_finite = std::isfinite(weight);
+      const bool lag_finite = std::isfinite(lag);
+      if (!expect(width_finite, "hysteresis_width", i, width, 0, Expect::finite) ||
+          !expect(!width_finite || width >= 0.0f, "hysteresis_width", i, width, 0, Expect::at_least) ||
+          !expect(!width_finite || width <= max_width, "hysteresis_width", i, width, max_width, Expect::at_most) ||
+          !expect(weight_finite, "hysteresis_weight", i, weight, 0, Expect::finite) ||
+          !expect(!weight_finite || weight >= 0.0f, "hysteresis_weight", i, weight, 0, Expect::at_least) ||
+          !expect(lag_finite, "hysteresis_homing_lag", i, lag, 0, Expect::finite) ||
+          !expect(!lag_finite || !width_finite || std::abs(lag) <= width, "hysteresis_homing_lag", i,
+                  std::abs(lag), width, Expect::at_most)) {
+        return false;
+      }
+      weight_sum += weight;
+    }
+    if (!expect(!std::isfinite(weight_sum) || weight_sum <= 1.0f + 8.0f * 1.1920929e-7f, "hysteresis_weight_sum", c,
+                weight_sum, 1.0, Expect::at_most)) {
+      return false;
+    }
+  }
+  if (all_good) {
+    run.expect(true, ImageCheckId::hysteresis, ImageStatus::invalid_parameters, Run::name("hysteresis"), -1, 0, 0,
+               Expect::finite, 3 * count);
+  }
+  return true;
+}
 }  // namespace detail
 
 // The checks of parse_image() that read every byte of an image (its CRC-32
@@ -568,7 +657,10 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
       return run.status;
     }
   }
-  for (std::size_t at = v1 ? variance_offset : reserved_b; at < kImageHeaderSize; ++at) {
+  // v2.2 gives bytes 62 and 63 the hysteresis block's counts.
+  const bool hysteresis_fields = !v1 && minor >= kImageVersionMinorHysteresis;
+  for (std::size_t at = v1 ? variance_offset : (hysteresis_fields ? kImageHeaderSize : reserved_b);
+       at < kImageHeaderSize; ++at) {
     if (!run.expect(bytes[at] == 0, Check::header, Status::bad_header, "reserved", static_cast<std::int32_t>(at),
                     bytes[at], 0, Expect::equal)) {
       return run.status;
@@ -612,6 +704,25 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
                   kImageOutputs, Expect::equal)) {
     return run.status;
   }
+  // v2.2: the hysteresis block's counts, both zero without one. The model
+  // library's storage (HysteresisModel) bounds them, not the build.
+  const std::uint32_t hysteresis_cable_count = hysteresis_fields ? bytes[hysteresis_cables] : 0;
+  const std::uint32_t hysteresis_operator_count = hysteresis_fields ? bytes[hysteresis_operators] : 0;
+  if (hysteresis_cable_count != 0 || hysteresis_operator_count != 0) {
+    if (!run.expect(hysteresis_cable_count == 4 * segments, Check::header, Status::bad_header, "hysteresis_cables", -1,
+                    hysteresis_cable_count, 4 * segments, Expect::equal) ||
+        !run.expect(hysteresis_operator_count >= 1, Check::header, Status::bad_header, "hysteresis_operators", -1,
+                    hysteresis_operator_count, 1, Expect::at_least) ||
+        !run.expect(hysteresis_cable_count <= static_cast<std::uint32_t>(kMaxCables), Check::capacity,
+                    Status::over_capacity, "hysteresis_cables", -1, hysteresis_cable_count, kMaxCables,
+                    Expect::at_most) ||
+        !run.expect(hysteresis_operator_count <= static_cast<std::uint32_t>(kMaxHysteresisOperators),
+                    Check::capacity, Status::over_capacity, "hysteresis_operators", -1, hysteresis_operator_count,
+                    kMaxHysteresisOperators, Expect::at_most)) {
+      return run.status;
+    }
+  }
+  const std::uint32_t hysteresis_floats = image_hysteresis_floats(hysteresis_cable_count, hysteresis_operator_count);
   if (!run.expect(n <= capacity.max_training_points, Check::capacity, Status::over_capacity, "training_points", -1, n,
                   capacity.max_training_points, Expect::at_most) ||
       !run.expect(segments <= capacity.max_segments, Check::capacity, Status::over_capacity, "segment_count", -1,
@@ -637,13 +748,13 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   // Under a generous capacity the 32-bit layout arithmetic below could wrap
   // into a size that matches; dims whose arrays alone exceed the image cannot.
   const std::uint64_t array_bytes =
-      (std::uint64_t{n} * (d + kImageOutputs) + std::uint64_t{image_variance_floats(rank, d)}) * 4;
+      (std::uint64_t{n} * (d + kImageOutputs) + std::uint64_t{image_variance_floats(rank, d)} + hysteresis_floats) * 4;
   if (!run.expect(array_bytes <= declared_total, Check::layout, Status::size_mismatch, "total_size", -1,
                   declared_total, static_cast<double>(array_bytes), Expect::at_least)) {
     return run.status;
   }
   if (array_bytes <= declared_total) {
-    const ImageLayout expected = image_layout(n, d, segments, major, rank, extra);
+    const ImageLayout expected = image_layout(n, d, segments, major, rank, extra, hysteresis_floats);
     const std::uint32_t expected_offsets[] = {expected.geometry_offset, expected.parameters_offset,
                                               expected.inputs_offset,   expected.alpha_offset,
                                               expected.metadata_offset, expected.variance_offset};
@@ -682,6 +793,12 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
       reinterpret_cast<const std::uint8_t*>(block(offsets[4], kImageMetadataSize / sizeof(float)));
   const std::uint64_t variance_floats = image_variance_floats(rank, d);
   const float* variance = rank > 0 ? block(offsets[5], variance_floats) : nullptr;
+  // The hysteresis block lies where the dims put it (no offset field).
+  const float* hysteresis =
+      hysteresis_floats > 0 && array_bytes <= declared_total
+          ? block(image_layout(n, d, segments, major, rank, extra, hysteresis_floats).hysteresis_offset,
+                  hysteresis_floats)
+          : nullptr;
 
   const struct {
     const char* name;
@@ -820,6 +937,14 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
       }
     }
   }
+  if (hysteresis == nullptr && Run::kEveryCheck) {
+    run.expect(true, Check::hysteresis, Status::invalid_parameters, "hysteresis_operators", -1,
+               hysteresis_operator_count, 0, Expect::at_least);
+  }
+  if (hysteresis != nullptr &&
+      !check_hysteresis_block(run, hysteresis, hysteresis_cable_count, hysteresis_operator_count)) {
+    return run.status;
+  }
   if (run.status != Status::ok) return run.status;
 
   ImageView v{};
@@ -851,6 +976,12 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   v.variance_points = variance_points;
   v.variance_inducing_factor = inducing_factor;
   v.variance_posterior_factor = posterior_factor;
+  v.hysteresis_cables = hysteresis != nullptr ? static_cast<int>(hysteresis_cable_count) : 0;
+  v.hysteresis_operators = hysteresis != nullptr ? static_cast<int>(hysteresis_operator_count) : 0;
+  const std::uint32_t hysteresis_values = hysteresis_cable_count * hysteresis_operator_count;
+  v.hysteresis_widths = hysteresis;
+  v.hysteresis_weights = hysteresis != nullptr ? hysteresis + hysteresis_values : nullptr;
+  v.hysteresis_homing_lags = hysteresis != nullptr ? hysteresis + 2 * hysteresis_values : nullptr;
   v.dataset_hash = read_u64(metadata + image_metadata_field::dataset_hash);
   v.created_unix_s = static_cast<std::int64_t>(read_u64(metadata + image_metadata_field::created_unix_s));
   v.validation_samples = read_u32(metadata + image_metadata_field::validation_samples);

@@ -41,6 +41,11 @@ struct CableSetpoint {
 };
 
 // PAYLOAD: kg.
+// The homing move has ended: the robot is at home (HOMING).
+struct Homing {
+  bool at_home = true;
+};
+
 struct Payload {
   double payload_kg = 0;
 };
@@ -96,6 +101,7 @@ struct Status {
   std::int64_t exec_max_us = 0;
   std::int64_t exec_mean_us = 0;
   bool extrapolating = false;  // the latest pose's (POSE_POSITION_Z FLAGS bit 1)
+  bool hysteresis_unknown = false;  // the cables' hysteresis state is not yet known
 };
 
 struct Stats {
@@ -270,6 +276,16 @@ inline DecodeStatus decode(const hal::CanFrame& frame, Payload& f) {
   return DecodeStatus::ok;
 }
 
+inline void encode(const Homing& f, hal::CanFrame& frame) {
+  frame = empty_frame(homing::kMessage);
+  set_data_word(frame, placed_integer(homing::kAtHome, f.at_home ? 1 : 0));
+}
+inline DecodeStatus decode(const hal::CanFrame& frame, Homing& f) {
+  if (const DecodeStatus s = check_frame(homing::kMessage, frame); s != DecodeStatus::ok) return s;
+  f.at_home = raw_in_word(data_word(frame), homing::kAtHome) != 0;
+  return DecodeStatus::ok;
+}
+
 // The SEQUENCE of a TARGET_POSITION_Z frame that did not decode, so that
 // the rejection can name its target; 0 when the frame is too short to hold one.
 inline std::uint8_t commit_sequence(const hal::CanFrame& frame) {
@@ -351,6 +367,7 @@ inline void encode(const Status& f, hal::CanFrame& frame) {
   frame = empty_frame(kMessage);
   set_data_word(frame, placed_integer(kState, static_cast<std::int64_t>(f.state)) |
                            placed_integer(kExtrapolating, f.extrapolating ? 1 : 0) |
+                           placed_integer(kHysteresisUnknown, f.hysteresis_unknown ? 1 : 0) |
                            placed_integer(kFault, static_cast<std::int64_t>(f.fault)) |
                            placed_integer(kOverruns, f.overruns) | placed_integer(kExecMax, f.exec_max_us) |
                            placed_integer(kExecMean, f.exec_mean_us));
@@ -361,6 +378,7 @@ inline DecodeStatus decode(const hal::CanFrame& frame, Status& f) {
   const std::uint64_t word = data_word(frame);
   f.state = static_cast<RuntimeState>(raw_in_word(word, kState));
   f.extrapolating = raw_in_word(word, kExtrapolating) != 0;
+  f.hysteresis_unknown = raw_in_word(word, kHysteresisUnknown) != 0;
   f.fault = static_cast<FaultCode>(raw_in_word(word, kFault));
   f.overruns = raw_in_word(word, kOverruns);
   f.exec_max_us = raw_in_word(word, kExecMax);

@@ -38,7 +38,7 @@ inline constexpr hal::CanFilter kTargetFrames{0x120, 0x7FC};         // TARGET_O
 inline constexpr hal::CanFilter kPoseFrames{0x130, 0x7FC};           // POSE_POSITION_XY, _POSITION_Z, POSE_ORIENTATION
 inline constexpr hal::CanFilter kIkReportFrames{0x140, 0x7FF};       // IK_REPORT
 inline constexpr hal::CanFilter kStatusFrames{0x150, 0x7FE};         // STATUS, STATS
-inline constexpr hal::CanFilter kPayloadFrames{0x160, 0x7FF};        // PAYLOAD
+inline constexpr hal::CanFilter kPayloadFrames{0x160, 0x7FE};        // PAYLOAD, HOMING
 
 enum class TargetMode : std::uint8_t { position = 0, pose = 1 };
 
@@ -87,6 +87,7 @@ inline constexpr ValueName kFaultCode[] = {
     {9, "can_transmit_failed"},
     {10, "can_filters_refused"},
     {11, "payload_invalid"},
+    {12, "homing_malformed"},
 };
 }  // namespace values
 
@@ -269,20 +270,30 @@ inline constexpr MessageNotes kNotes{&kMessage, "HOST",
 // 0x150: heartbeat, every kStatusEveryCycles cycles.
 namespace status {
 inline constexpr SignalSpec kState{"STATE", 0, 4, false, 1, 0, 0, 3, "", value_table(values::kRuntimeState)};
-// 1: the latest pose extrapolates (POSE_POSITION_Z FLAGS bit 1). Bits 5..7
+// 1: the latest pose extrapolates (POSE_POSITION_Z FLAGS bit 1). Bits 6..7
 // are reserved (0).
 inline constexpr SignalSpec kExtrapolating{"EXTRAPOLATING", 4, 1, false, 1, 0, 0, 1, ""};
+// 1: the image models the cables' hysteresis and its state is not yet known
+// (since power-up, before enough travel or a HOMING frame): poses are less
+// certain and POSE_UNCERTAINTY's radii say by how much. Always 0 without a
+// hysteresis block.
+inline constexpr SignalSpec kHysteresisUnknown{"HYSTERESIS_UNKNOWN", 5, 1, false, 1, 0, 0, 1, ""};
 inline constexpr SignalSpec kFault{"FAULT", 8, 8, false, 1, 0, 0, 255, "", value_table(values::kFaultCode)};
 inline constexpr SignalSpec kOverruns{"OVERRUNS", 16, 16, false, 1, 0, 0, 65535, ""};
 inline constexpr SignalSpec kExecMax{"EXEC_MAX", 32, 16, false, 1, 0, 0, 65535, "us"};
 inline constexpr SignalSpec kExecMean{"EXEC_MEAN", 48, 16, false, 1, 0, 0, 65535, "us"};
-inline constexpr const SignalSpec* kSignals[] = {&kState, &kExtrapolating, &kFault, &kOverruns, &kExecMax, &kExecMean};
+inline constexpr const SignalSpec* kSignals[] = {&kState,    &kExtrapolating, &kHysteresisUnknown, &kFault,
+                                                 &kOverruns, &kExecMax,       &kExecMean};
 inline constexpr MessageSpec kMessage{"STATUS", 0x150, 1, 8, "RUNTIME", signal_list(kSignals), kStatusFrames};
 inline constexpr SignalNote kSignalNotes[] = {
     {&kExtrapolating, "1: the latest pose extrapolates (POSE_POSITION_Z FLAGS bit 1)."},
+    {&kHysteresisUnknown,
+     "1: the model image has a hysteresis block and the cables' hysteresis state is not yet known (after power-up, "
+     "until every cable has travelled twice its widest play operator one way, or a HOMING frame): the radii of "
+     "POSE_UNCERTAINTY include it. Always 0 without a hysteresis block."},
     {&kFault, "firmware::FaultCode of the active fault."},
 };
-inline constexpr MessageNotes kNotes{&kMessage, "HOST", "Heartbeat, every 10 cycles. Bits 5 to 7 are reserved (0).",
+inline constexpr MessageNotes kNotes{&kMessage, "HOST", "Heartbeat, every 10 cycles. Bits 6 to 7 are reserved (0).",
                                      signal_notes(kSignalNotes)};
 }  // namespace status
 
@@ -323,6 +334,22 @@ inline constexpr MessageNotes kNotes{
     "uses the image's default. A frame beyond [0, 50] kg is refused (FAULT 11 payload_invalid) and the previous "
     "payload stays in use."};
 }  // namespace payload
+
+// 0x161: the robot has just completed the homing move (model/hysteresis.hpp:
+// every segment bent 0.1 rad towards alpha = 45 deg, then straight) and is
+// at home: the cables' hysteresis state is the image's homing state from
+// now on, and the next cable feedback is its position. Bits 1..7 reserved.
+namespace homing {
+inline constexpr SignalSpec kAtHome{"AT_HOME", 0, 1, false, 1, 0, 1, 1, ""};
+inline constexpr const SignalSpec* kSignals[] = {&kAtHome};
+inline constexpr MessageSpec kMessage{"HOMING", 0x161, 1, 1, "HOST", signal_list(kSignals), kPayloadFrames};
+inline constexpr MessageNotes kNotes{
+    &kMessage, "RUNTIME",
+    "The robot has just completed the homing move (every segment bent 0.1 rad towards alpha = 45 deg, then back "
+    "straight) and is at home: the runtime takes the cables' hysteresis state as the image's homing state. AT_HOME "
+    "must be 1; a frame that does not decode is refused (FAULT 12 homing_malformed). Without a hysteresis block in "
+    "the image it changes nothing. Bits 1 to 7 are reserved (0)."};
+}  // namespace homing
 
 // Model updates (0x170..0x17F; firmware/model_update.hpp): the host writes a
 // new model image into the inactive flash slot, in blocks of up to
@@ -473,7 +500,7 @@ inline constexpr const MessageNotes* kMessageNotes[] = {
     &target_position_xy::kNotes, &target_position_z::kNotes, &pose_position_xy::kNotes,
     &pose_position_z::kNotes,    &pose_orientation::kNotes, &pose_uncertainty::kNotes,
     &ik_report::kNotes,          &status::kNotes,           &stats::kNotes,
-    &payload::kNotes,
+    &payload::kNotes,            &homing::kNotes,
     &update_command::kNotes,     &update_digest::kNotes,    &update_block::kNotes,
     &update_data::kNotes,        &update_report::kNotes,
 };

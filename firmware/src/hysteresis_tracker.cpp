@@ -1,0 +1,144 @@
+#include "cdcr/firmware/hysteresis_tracker.hpp"
+
+#include <cmath>
+
+#include "cdcr/model/chain.hpp"
+#include "cdcr/model/image_hysteresis.hpp"
+#include "cdcr/model/series.hpp"
+#include "cdcr/model/units.hpp"
+
+namespace cdcr::firmware {
+
+namespace {
+
+// tr S and tr S^2 of the symmetric 3 x 3 S = a + b, each given as xx, yy,
+// zz, xy, xz, yz.
+void traces(const Scalar (&a)[6], const Scalar (&b)[6], Scalar& trace, Scalar& trace_of_square) {
+  Scalar s[6];
+  for (int i = 0; i < 6; ++i) s[i] = a[i] + b[i];
+  trace = s[0] + s[1] + s[2];
+  trace_of_square = s[0] * s[0] + s[1] * s[1] + s[2] * s[2] + Scalar(2) * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]);
+}
+
+void add_outer(Scalar (&covariance)[6], const model::Vec3<Scalar>& v, Scalar variance) {
+  covariance[0] += variance * v.x() * v.x();
+  covariance[1] += variance * v.y() * v.y();
+  covariance[2] += variance * v.z() * v.z();
+  covariance[3] += variance * v.x() * v.y();
+  covariance[4] += variance * v.x() * v.z();
+  covariance[5] += variance * v.y() * v.z();
+}
+
+}  // namespace
+
+void HysteresisTracker::bind(const RobotModel& model) {
+  active_ = model.compensated && model::hysteresis_from_image(model.image, model_) &&
+            model_.cables == 4 * model.geometry.segment_count;
+  if (!active_) model_ = model::HysteresisModel<Scalar>{};
+  // l3 - l1 and l2 - l4 span a chord of at most 4 r sin(theta_max / 2)
+  // (segment.hpp), a little less here so the kinematics' rounding allowance
+  // is not needed.
+  segments_ = model.geometry.segment_count;
+  for (int s = 0; s < segments_; ++s) {
+    chord_limit_mm_[s] = Scalar(4) * model.geometry.segments[s].anchor_radius_mm *
+                         std::sin(Scalar(0.5) * model.geometry.segments[s].theta_max_rad) * Scalar(0.999999);
+  }
+  model::reset_unknown(state_, model_);
+  known_ = state_.known();
+  widening_ = false;
+  uncertainty_mm_.setZero(model_.cables);
+}
+
+const Cables& HysteresisTracker::track(const Cables& commanded_mm) {
+  if (!active_ || !commanded_mm.allFinite()) return commanded_mm;
+  model::update_hysteresis(state_, model_, commanded_mm);
+  // The lag intervals only shrink: once known, the state stays known.
+  if (!known_) known_ = state_.known();
+  model::effective_lengths(state_, model_, effective_mm_, &uncertainty_mm_);
+  for (int s = 0; s < segments_; ++s) {
+    // The means of the two pairs stay.
+    Scalar* e = effective_mm_.data() + 4 * s;
+    const Scalar limit = chord_limit_mm_[s];
+    const Scalar chord = std::hypot(e[2] - e[0], e[1] - e[3]);
+    if (!(chord > limit)) continue;
+    const Scalar scale = limit / chord;
+    const Scalar mean_13 = Scalar(0.5) * (e[0] + e[2]), half_31 = Scalar(0.5) * scale * (e[2] - e[0]);
+    const Scalar mean_24 = Scalar(0.5) * (e[1] + e[3]), half_24 = Scalar(0.5) * scale * (e[1] - e[3]);
+    e[0] = mean_13 - half_31;
+    e[2] = mean_13 + half_31;
+    e[1] = mean_24 + half_24;
+    e[3] = mean_24 - half_24;
+  }
+  return effective_mm_;
+}
+
+void HysteresisTracker::homed(const Geometry& geometry) {
+  if (!active_ || model::start_at_home(state_, model_, geometry) != model::Status::ok) return;
+  known_ = state_.known();
+  uncertainty_mm_.setZero(model_.cables);
+}
+
+void HysteresisTracker::commanded_for(Cables& cables_mm) const {
+  if (!active_ || !state_.has_position) return;
+  for (int c = 0; c < model_.cables; ++c) cables_mm[c] = model::commanded_for_effective(state_, model_, c, cables_mm[c]);
+}
+
+// The bend of segment i follows its cables as u = (l3 - l1) / (2 r s),
+// w = (l2 - l4) / (2 r s) with s = sinc(theta / 2) (segment.hpp), so each
+// bend coordinate's variance is that of two cables over (2 r s)^2; the
+// spatial Jacobian in the bend moves the tip position p by v + omega x p.
+void HysteresisTracker::begin_variance(const RobotModel& model, const PoseEstimate& estimate) {
+  widening_ = active_ && !known_;
+  if (!widening_) return;
+  const Geometry& geometry = model.geometry;
+  const Joints bend = model::bend_from_joints(estimate.joints);
+  model::Pose<Scalar> tip;
+  model::Jacobian<Scalar, kMaxSegments> jacobian;
+  model::tip_jacobian_bend(bend, geometry, tip, jacobian);
+  for (int i = 0; i < 6; ++i) position_covariance_[i] = orientation_covariance_[i] = Scalar(0);
+  for (int s = 0; s < geometry.segment_count; ++s) {
+    const Scalar lever = Scalar(2) * geometry.segments[s].anchor_radius_mm *
+                         model::series::sinc(Scalar(0.5) * estimate.joints[2 * s + 1]);
+    const Scalar* u = uncertainty_mm_.data() + 4 * s;
+    const Scalar bend_variance[2] = {(u[0] * u[0] + u[2] * u[2]) / (Scalar(3) * lever * lever),
+                                     (u[1] * u[1] + u[3] * u[3]) / (Scalar(3) * lever * lever)};
+    for (int k = 0; k < 2; ++k) {
+      const model::Vec3<Scalar> v = jacobian.col(2 * s + k).head<3>();
+      const model::Vec3<Scalar> omega = jacobian.col(2 * s + k).tail<3>();
+      add_outer(position_covariance_, v + omega.cross(tip.position_mm), bend_variance[k]);
+      add_outer(orientation_covariance_, omega, bend_variance[k]);
+    }
+  }
+  tip_mm_ = estimate.pose.position_mm;
+}
+
+// The GP's covariance as model::GpUncertainty forms it (from its latent
+// share and the image's scales and calibration), plus the one kept.
+void HysteresisTracker::widen(const RobotModel& model, model::PoseUncertainty<Scalar>& radii) const {
+  const model::ImageView& image = model.image;
+  if (!widening_ || image.variance_calibration == nullptr) return;
+  const Scalar normalised = Scalar(image.signal_variance[0]) * radii.latent_share + Scalar(image.noise_variance[0]);
+  Scalar v[6];
+  for (int k = 0; k < 6; ++k) v[k] = Scalar(image.output_scale[k]) * Scalar(image.output_scale[k]) * normalised;
+  const Scalar ps = Scalar(image.variance_calibration[model::image_variance_field::position_scale]);
+  const Scalar os = Scalar(image.variance_calibration[model::image_variance_field::orientation_scale]);
+  const Scalar ps2 = ps * ps;
+  const Scalar os2 = os * os;
+  // S_p = diag(v) + [p]x diag(w) [p]x^T, as gaussian_radii_95.
+  const Scalar* w = v + 3;
+  const Scalar px = tip_mm_.x(), py = tip_mm_.y(), pz = tip_mm_.z();
+  const Scalar gp_position[6] = {ps2 * (v[0] + w[1] * pz * pz + w[2] * py * py),
+                                 ps2 * (v[1] + w[0] * pz * pz + w[2] * px * px),
+                                 ps2 * (v[2] + w[0] * py * py + w[1] * px * px),
+                                 -ps2 * w[2] * px * py,
+                                 -ps2 * w[1] * px * pz,
+                                 -ps2 * w[0] * py * pz};
+  const Scalar gp_orientation[6] = {os2 * w[0], os2 * w[1], os2 * w[2], Scalar(0), Scalar(0), Scalar(0)};
+  Scalar trace = 0, trace_of_square = 0;
+  traces(gp_position, position_covariance_, trace, trace_of_square);
+  radii.r95_mm = model::gaussian_radius_95(trace, trace_of_square);
+  traces(gp_orientation, orientation_covariance_, trace, trace_of_square);
+  radii.r95_deg = model::gaussian_radius_95(trace, trace_of_square) * Scalar(model::kDegreesPerRadian);
+}
+
+}  // namespace cdcr::firmware

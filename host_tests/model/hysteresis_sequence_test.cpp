@@ -1,0 +1,83 @@
+// The effective lengths over a motion sequence (hysteresis_sequence.hpp),
+// as replay and eval run them: each session starts at home, whatever the
+// session before it did, and within a session the state is carried from row
+// to row, as a hand-written run of the operator gives.
+
+#include <random>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cdcr/model/hysteresis_sequence.hpp"
+
+namespace cdcr::model {
+namespace {
+
+HysteresisModel<float> two_operator_model(const RobotGeometry<float>& geometry) {
+  HysteresisModel<float> h;
+  h.cables = 4 * geometry.segment_count;
+  h.operators = 2;
+  for (int c = 0; c < h.cables; ++c) {
+    h.widths_mm[c][0] = 0.3f + 0.02f * c;
+    h.widths_mm[c][1] = 0.7f;
+    h.weights[c][0] = 0.5f;
+    h.weights[c][1] = 0.4f;
+  }
+  CableVector<float> approach, home;
+  homing_waypoints(geometry, approach, home);
+  compute_homing_lags(h, approach, home);
+  return h;
+}
+
+TEST(HysteresisSequence, EachSessionStartsAtHomeAndCarriesItsStateFromRowToRow) {
+  const RobotGeometry<float> geometry = RobotGeometry<float>::uniform(2, 120.0f, 67.0f);
+  const HysteresisModel<float> h = two_operator_model(geometry);
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> step(-0.8, 0.8);
+  Eigen::MatrixXd commanded(30, 8);
+  CableVector<float> approach, home;
+  homing_waypoints(geometry, approach, home);
+  for (int i = 0; i < commanded.rows(); ++i) {
+    for (int c = 0; c < 8; ++c) commanded(i, c) = home[c] + (i == 0 ? 0.0 : commanded(i - 1, c) - home[c]) + step(rng);
+  }
+  const std::vector<int> sessions = {0, 12, 20};
+  Eigen::MatrixXf effective(30, 8);
+  ASSERT_EQ(effective_lengths_over_sequence(h, geometry, commanded, sessions.data(), 3, effective), Status::ok);
+
+  // By hand.
+  HysteresisState<float> state;
+  for (int i = 0; i < commanded.rows(); ++i) {
+    if (i == 0 || i == 12 || i == 20) ASSERT_EQ(start_at_home(state, h, geometry), Status::ok);
+    const CableVector<float> row = commanded.row(i).transpose().cast<float>();
+    update_hysteresis(state, h, row);
+    CableVector<float> expected;
+    effective_lengths(state, h, expected);
+    for (int c = 0; c < 8; ++c) ASSERT_EQ(effective(i, c), expected[c]) << "row " << i << " cable " << c;
+  }
+
+  // A session does not depend on the one before it.
+  Eigen::MatrixXd changed = commanded;
+  changed.topRows(12).array() += 1.5;
+  Eigen::MatrixXf effective_changed(30, 8);
+  ASSERT_EQ(effective_lengths_over_sequence(h, geometry, changed, sessions.data(), 3, effective_changed), Status::ok);
+  EXPECT_TRUE(effective_changed.bottomRows(18) == effective.bottomRows(18));
+  // Without sessions the whole sequence is one, and it does.
+  Eigen::MatrixXf one_session(30, 8), one_session_changed(30, 8);
+  effective_lengths_over_sequence(h, geometry, commanded, nullptr, 0, one_session);
+  effective_lengths_over_sequence(h, geometry, changed, nullptr, 0, one_session_changed);
+  EXPECT_TRUE(one_session.topRows(12) == effective.topRows(12));
+  EXPECT_FALSE(one_session.row(12) == effective.row(12));
+  // The lags matter: the effective lengths are not the commanded ones.
+  EXPECT_GT((effective.cast<double>() - commanded).cwiseAbs().maxCoeff(), 0.3);
+}
+
+TEST(HysteresisSequence, RefusesRowsOfAnotherCableCount) {
+  const RobotGeometry<float> geometry = RobotGeometry<float>::uniform(2, 120.0f, 67.0f);
+  const HysteresisModel<float> h = two_operator_model(geometry);
+  Eigen::MatrixXd commanded = Eigen::MatrixXd::Constant(3, 4, 120.0);
+  Eigen::MatrixXf effective(3, 4);
+  EXPECT_NE(effective_lengths_over_sequence(h, geometry, commanded, nullptr, 0, effective), Status::ok);
+}
+
+}  // namespace
+}  // namespace cdcr::model
