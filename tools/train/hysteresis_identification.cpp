@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "cdcr/model/hysteresis_sequence.hpp"
 #include "cdcr/model/limits.hpp"
 #include "gaussian_process.hpp"
 #include "hyperparameter_search.hpp"
@@ -33,21 +34,11 @@ Eigen::MatrixXd effective_cables(const Eigen::MatrixXd& commanded_mm, const std:
                                   " starts at row " + std::to_string(session_starts[i] + 1) + ")");
     }
   }
+  // The same sequence code the replay and the evaluation run in float32.
   Eigen::MatrixXd effective(commanded_mm.rows(), commanded_mm.cols());
-  model::HysteresisState<double> state;
-  model::CableVector<double> row_effective;
-  std::size_t next_session = 0;
-  for (int i = 0; i < rows; ++i) {
-    if (next_session < session_starts.size() && session_starts[next_session] == i) {
-      if (const model::Status s = model::start_at_home(state, hysteresis, geometry); s != model::Status::ok) {
-        throw std::invalid_argument(std::string("homing move: ") + model::to_string(s));
-      }
-      ++next_session;
-    }
-    model::update_hysteresis(state, hysteresis, commanded_mm.row(i).transpose());
-    model::effective_lengths(state, hysteresis, row_effective);
-    effective.row(i) = row_effective.transpose();
-  }
+  const model::Status status = model::effective_lengths_over_sequence(
+      hysteresis, geometry, commanded_mm, session_starts.data(), static_cast<int>(session_starts.size()), effective);
+  if (status != model::Status::ok) throw std::invalid_argument(std::string("homing move: ") + model::to_string(status));
   return effective;
 }
 
