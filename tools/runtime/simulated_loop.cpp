@@ -356,6 +356,7 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, cons
       two_sided ? long(legs.size()) * cycles_per_target + 1 : std::lround(seconds * rate_hz);
   std::size_t next_leg = 0;
   ErrorTally side_error[2];
+  double first_arrival_mm = 0;  // the first target after homing: where a wrong homing state shows most
   long side_checked[2] = {0, 0};
 
   ErrorTally estimate_error;
@@ -391,6 +392,7 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, cons
         target_error.add(error_mm);
         ++targets_checked;
         if (previous_leg != nullptr) {
+          if (targets_checked == 1) first_arrival_mm = error_mm;
           side_error[previous_leg->side].add(error_mm);
           ++side_checked[previous_leg->side];
         }
@@ -482,6 +484,7 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, cons
                 "tip vs target mean %.3f mm (max %.3f) from the first side, %.3f mm (max %.3f) from the second\n",
                 side_checked[0] > 0 ? side_error[0].sum_mm / double(side_checked[0]) : 0.0, side_error[0].max_mm,
                 side_checked[1] > 0 ? side_error[1].sum_mm / double(side_checked[1]) : 0.0, side_error[1].max_mm);
+    std::printf("first arrival after the homing move: tip vs target %.3f mm\n", first_arrival_mm);
   }
   std::printf("accuracy, nominal model only -> %s runtime:\n",
               runtime.latest_pose().compensated ? "compensated" : "uncompensated");
