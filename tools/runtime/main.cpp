@@ -48,7 +48,8 @@ int main(int argc, char** argv) {
   bool hysteresis = false;
   app.add_flag("--hysteresis", hysteresis,
                "--sim with the cables' friction hysteresis (as cdcr simulate --hysteresis): the tip depends on the "
-               "path of the drives");
+               "path of the drives. The robot first homes (then HOMING is sent), and each target is approached from "
+               "two sides (four half-second legs per target)");
   app.add_flag("--circle", circle,
                "--sim following a streamed circle (a TRACKING pose target every cycle), once round");
   app.add_option("--circle-radius", circle_radius_mm, "--circle radius, mm")->capture_default_str();

@@ -16,14 +16,16 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
 // --hysteresis turns the cables' friction hysteresis on (source 7 of
 // tools/sim/simulator_config.hpp, as `cdcr simulate --hysteresis`): the
 // friction follows every change of the drives' lengths, so the tip depends
-// on the path.
+// on the path. With it the loop starts as a real robot does: the homing move
+// (model::homing_waypoints), then a HOMING frame.
 struct SimulatedRobotChoice {
   bool ideal_robot = false;
   bool hysteresis = false;
 };
 
 // --sim: the closed loop with simulated drives and robot over the virtual
-// bus, at a fixed rate in lockstep simulated time; the six demo targets.
+// bus, at a fixed rate in lockstep simulated time; the six demo targets
+// (--seconds 3), with --hysteresis each approached from two sides.
 int simulate(const std::string& image_path, double rate_hz, double seconds, const SimulatedRobotChoice& robot);
 // --sim --circle: the same loop following a streamed circle.
 int follow_circle(const std::string& image_path, double rate_hz, double radius_mm, double speed_mm_s,

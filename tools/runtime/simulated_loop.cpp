@@ -13,6 +13,7 @@
 
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/model/compensation.hpp>
+#include <cdcr/model/hysteresis.hpp>
 #include <cdcr/sim/lockstep_timer.hpp>
 #include <cdcr/sim/virtual_can.hpp>
 
@@ -84,6 +85,51 @@ void send_pose_target(cdcr::hal::CanBus& host, const model::Pose<double>& target
   for (const cdcr::hal::CanFrame& frame : sim::target_frames(target, protocol::TargetMode::pose, tracking, sequence)) {
     host.send(frame);
   }
+}
+
+// The start-up of a robot whose cables have friction, as a real robot's:
+// the drives take the cables through the homing move (model::
+// homing_waypoints: the approach, every segment bent towards alpha = 45 deg,
+// then home, straight), each leg a straight line in cable space streamed as
+// CABLE_SETPOINT frames a little slower than the drives can follow, and the
+// robot settles at each stop. At home the host sends HOMING: from there the
+// runtime knows the cables' hysteresis state (the image's homing state).
+// `cycle` runs one cycle of the loop (drives, friction, runtime).
+template <typename Cycle>
+void run_homing_move(const model::RobotGeometry<double>& geometry, const sim::SimulatedCableDrives& drives,
+                     cdcr::hal::CanBus& host, double rate_hz, Cycle&& cycle) {
+  model::CableVector<double> approach_mm, home_mm;
+  if (const model::Status status = model::homing_waypoints(geometry, approach_mm, home_mm);
+      status != model::Status::ok) {
+    throw std::runtime_error(std::string("the homing move: ") + model::to_string(status));
+  }
+  constexpr double kLineSpeedMmPerS = 40.0;  // the drives' 50 mm/s, with a margin
+  const long settle_cycles = std::max(1L, std::lround(0.1 * rate_hz));
+  const auto send_setpoints = [&](const model::CableVector<double>& cables_mm) {
+    for (int s = 0; s < geometry.segment_count; ++s) {
+      const protocol::CableSetpoint setpoint{
+          s, {cables_mm[4 * s], cables_mm[4 * s + 1], cables_mm[4 * s + 2], cables_mm[4 * s + 3]}};
+      cdcr::hal::CanFrame frame;
+      if (!protocol::encode(setpoint, frame)) {
+        throw std::runtime_error("the homing move: a cable length the CABLE_SETPOINT frame cannot carry");
+      }
+      host.send(frame);
+    }
+  };
+  for (const model::CableVector<double>* stop : {&approach_mm, &home_mm}) {
+    const model::CableVector<double> from_mm = drives.cables_mm();
+    const double longest_mm = (*stop - from_mm).cwiseAbs().maxCoeff();
+    const long line_cycles = std::max(1L, static_cast<long>(std::ceil(longest_mm / kLineSpeedMmPerS * rate_hz)));
+    for (long k = 1; k <= line_cycles; ++k) {
+      send_setpoints(from_mm + (*stop - from_mm) * (double(k) / double(line_cycles)));
+      cycle();
+    }
+    for (long k = 0; k < settle_cycles; ++k) cycle();
+  }
+  cdcr::hal::CanFrame frame;
+  protocol::encode(protocol::Homing{true}, frame);
+  host.send(frame);
+  cycle();
 }
 
 // The closed loop following a streamed circle: the robot first goes to the
@@ -178,11 +224,14 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   // from half the bend can end `unreachable` a few hundredths of a
   // millimetre off: near the straight robot the roll about the backbone is
   // weakly actuated; see the README's open points.)
+  // With the friction the robot first homes, and the ramp starts from home.
+  if (robot_choice.hysteresis) run_homing_move(geometry, drives, host, rate_hz, cycle);
+  const double ramp_from = robot_choice.hysteresis ? 0.0 : 0.5;
   std::uint8_t sequence = 0;
   const long ramp_cycles = std::lround(0.5 * rate_hz);
   for (long k = 1; k <= 2 * ramp_cycles; ++k) {
     const double ramp = std::min(1.0, double(k) / double(ramp_cycles));
-    send_pose_target(host, target_at_bend((0.5 + 0.5 * ramp) * bend_rad, 0.0), ++sequence, true);
+    send_pose_target(host, target_at_bend((ramp_from + (1.0 - ramp_from) * ramp) * bend_rad, 0.0), ++sequence, true);
     cycle();
   }
   if (const double off_mm = setpoints_to_target_mm(target_at(0.0)); !(off_mm < 1.0)) {
@@ -257,9 +306,58 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, cons
 
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
   const double dt_s = double(period_ns) * 1e-9;
-  const long cycles = std::lround(seconds * rate_hz);
   const long cycles_per_target = std::max(1L, std::lround(0.5 * rate_hz));
   platform.timer.start(period_ns);
+
+  // With the friction the robot first homes, as a real one starts up, and
+  // each target (one per half second of --seconds, as without it) is then
+  // approached from two sides, each side a leg of its own: first from a
+  // via point where every segment's bend direction is turned +45 degrees
+  // (same bend), then from one turned -45 degrees. The cables across the
+  // bend plane reach the target once lengthening and once shortening, so
+  // the tip's error shows whether the runtime knows which way each cable
+  // came. Every arrival at a target is checked, the last one included.
+  const bool two_sided = robot_choice.hysteresis;
+  struct Leg {
+    model::Vec3<double> position_mm;
+    bool via;  // a via point: not checked
+    int side;  // 0: from the +45 degree side, 1: from the -45 degree side
+  };
+  std::vector<Leg> legs;
+  if (two_sided) {
+    const auto plain_cycle = [&] {
+      const cdcr::hal::TimerTick tick = platform.timer.wait_next();
+      drives.step(dt_s);
+      effective_cables = robot.move_cables(drives.cables_mm());
+      runtime.run_cycle(tick);
+      cdcr::hal::CanFrame frame;
+      while (host.receive(frame) == cdcr::hal::CanStatus::ok) {
+      }
+    };
+    run_homing_move(geometry, drives, host, rate_hz, plain_cycle);
+    const auto reachable_position = [&](const model::JointVector<double>& joints) {
+      model::CableVector<double> cables;
+      model::cables_from_joints(joints, geometry, cables);
+      return robot.true_pose(cables).position_mm;
+    };
+    const long target_count = std::max(1L, std::lround(seconds * rate_hz) / cycles_per_target);
+    for (long t = 0; t < target_count; ++t) {
+      const model::JointVector<double> joints = random_joints();
+      const model::Vec3<double> target_mm = reachable_position(joints);
+      for (int side = 0; side < 2; ++side) {
+        model::JointVector<double> turned = joints;
+        for (int s = 0; s < geometry.segment_count; ++s) turned[2 * s] += (side == 0 ? 0.25 : -0.25) * M_PI;
+        legs.push_back({reachable_position(turned), true, side});
+        legs.push_back({target_mm, false, side});
+      }
+    }
+  }
+  const long cycles =
+      two_sided ? long(legs.size()) * cycles_per_target + 1 : std::lround(seconds * rate_hz);
+  std::size_t next_leg = 0;
+  ErrorTally side_error[2];
+  double first_arrival_mm = 0;  // the first target after homing: where a wrong homing state shows most
+  long side_checked[2] = {0, 0};
 
   ErrorTally estimate_error;
   long estimate_samples = 0;
@@ -288,26 +386,44 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, cons
     drives.step(dt_s);
     effective_cables = robot.move_cables(drives.cables_mm());
     if (k % cycles_per_target == 0) {
-      if (targets_sent > 0) {
+      const Leg* previous_leg = two_sided && next_leg > 0 ? &legs[next_leg - 1] : nullptr;
+      if (targets_sent > 0 && !(previous_leg != nullptr && previous_leg->via)) {
         const double error_mm = (robot.true_pose(effective_cables).position_mm - target_mm).norm();
         target_error.add(error_mm);
         ++targets_checked;
+        if (previous_leg != nullptr) {
+          if (targets_checked == 1) first_arrival_mm = error_mm;
+          side_error[previous_leg->side].add(error_mm);
+          ++side_checked[previous_leg->side];
+        }
         // The request spans cycles: its setpoints are checked when the next
-        // target is due.
-        if (runtime.has_setpoints() && runtime.last_ik_report().outcome == protocol::IkOutcome::converged) {
+        // target is due. (Not with the friction: the setpoints are then
+        // commanded lengths, which the frictionless true pose misreads.)
+        if (!two_sided && runtime.has_setpoints() &&
+            runtime.last_ik_report().outcome == protocol::IkOutcome::converged) {
           const model::CableVector<double> setpoints_mm = runtime.setpoints_mm().cast<double>();
           const double setpoint_error_mm = (robot.true_pose(setpoints_mm).position_mm - target_mm).norm();
           setpoint_target_error.add(setpoint_error_mm);
           ++setpoints_checked;
         }
       }
-      // Targets the real robot can reach: where it goes for random cables.
-      model::CableVector<double> target_cables;
-      model::cables_from_joints(random_joints(), geometry, target_cables);
-      target_mm = robot.true_pose(target_cables).position_mm;
-      send_target(host, target_mm, static_cast<std::uint8_t>(targets_sent++));
-      const model::IkResult<double> nominal_ik = model::solve_ik_position(target_mm, geometry, nominal_ik_joints);
-      if (nominal_ik.converged()) {
+      bool is_target = true;
+      if (two_sided) {
+        is_target = next_leg < legs.size() && !legs[next_leg].via;
+        if (next_leg < legs.size()) {
+          target_mm = legs[next_leg++].position_mm;
+          send_target(host, target_mm, static_cast<std::uint8_t>(targets_sent++));
+        }
+      } else {
+        // Targets the real robot can reach: where it goes for random cables.
+        model::CableVector<double> target_cables;
+        model::cables_from_joints(random_joints(), geometry, target_cables);
+        target_mm = robot.true_pose(target_cables).position_mm;
+        send_target(host, target_mm, static_cast<std::uint8_t>(targets_sent++));
+      }
+      const model::IkResult<double> nominal_ik =
+          is_target ? model::solve_ik_position(target_mm, geometry, nominal_ik_joints) : model::IkResult<double>{};
+      if (is_target && nominal_ik.converged()) {
         nominal_ik_joints = nominal_ik.joints;
         const double error_mm = (robot.true_pose(nominal_ik.cables_mm).position_mm - target_mm).norm();
         nominal_target_error.add(error_mm);
@@ -363,18 +479,27 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, cons
               targets_sent, targets_converged, double(cycles_per_target) / rate_hz,
               targets_checked > 0 ? target_error.sum_mm / double(targets_checked) : 0.0, target_error.max_mm,
               targets_checked);
+  if (two_sided) {
+    std::printf("each target approached from two sides (every bend direction turned +45 deg, then -45 deg): "
+                "tip vs target mean %.3f mm (max %.3f) from the first side, %.3f mm (max %.3f) from the second\n",
+                side_checked[0] > 0 ? side_error[0].sum_mm / double(side_checked[0]) : 0.0, side_error[0].max_mm,
+                side_checked[1] > 0 ? side_error[1].sum_mm / double(side_checked[1]) : 0.0, side_error[1].max_mm);
+    std::printf("first arrival after the homing move: tip vs target %.3f mm\n", first_arrival_mm);
+  }
   std::printf("accuracy, nominal model only -> %s runtime:\n",
               runtime.latest_pose().compensated ? "compensated" : "uncompensated");
   std::printf("  pose estimate vs robot: mean %.3f -> %.3f mm, max %.3f -> %.3f mm\n",
               estimate_samples > 0 ? nominal_estimate_error.sum_mm / double(estimate_samples) : 0.0,
               estimate_samples > 0 ? estimate_error.sum_mm / double(estimate_samples) : 0.0,
               nominal_estimate_error.max_mm, estimate_error.max_mm);
-  std::printf("  tip vs target at the commanded cables (%ld and %ld of %ld solved): mean %.3f -> %.3f mm, "
-              "max %.3f -> %.3f mm\n",
-              nominal_targets_reached, setpoints_checked, targets_sent,
-              nominal_targets_reached > 0 ? nominal_target_error.sum_mm / double(nominal_targets_reached) : 0.0,
-              setpoints_checked > 0 ? setpoint_target_error.sum_mm / double(setpoints_checked) : 0.0,
-              nominal_target_error.max_mm, setpoint_target_error.max_mm);
+  if (!two_sided) {
+    std::printf("  tip vs target at the commanded cables (%ld and %ld of %ld solved): mean %.3f -> %.3f mm, "
+                "max %.3f -> %.3f mm\n",
+                nominal_targets_reached, setpoints_checked, targets_sent,
+                nominal_targets_reached > 0 ? nominal_target_error.sum_mm / double(nominal_targets_reached) : 0.0,
+                setpoints_checked > 0 ? setpoint_target_error.sum_mm / double(setpoints_checked) : 0.0,
+                nominal_target_error.max_mm, setpoint_target_error.max_mm);
+  }
   return 0;
 }
 
