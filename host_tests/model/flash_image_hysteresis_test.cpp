@@ -26,11 +26,7 @@
 namespace cdcr::model {
 namespace {
 
-using test_support::Bytes;
-using test_support::Findings;
-using test_support::get;
-using test_support::put;
-using test_support::reseal;
+using namespace test_support;  // the image edits of image_edits.hpp
 
 // The verdict of all three modes, which must agree; the first failed
 // finding of the reporting one in `first` (empty field when none failed).

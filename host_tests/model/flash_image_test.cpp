@@ -34,12 +34,7 @@
 namespace cdcr::model {
 namespace {
 
-using test_support::Bytes;
-using test_support::Findings;
-using test_support::get;
-using test_support::put;
-using test_support::reference_crc32;
-using test_support::reseal;
+using namespace test_support;  // the image edits of image_edits.hpp
 
 // The reporting parse of the same bytes.
 ImageStatus parse_reporting(const Bytes& image, Findings& findings, const ImageCapacity& capacity = {}) {

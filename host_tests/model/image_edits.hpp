@@ -12,20 +12,11 @@
 
 #include "cdcr/model/flash_image.hpp"
 
+#include "../support/reference_crc32.hpp"
+
 namespace cdcr::test_support {
 
 using Bytes = std::vector<std::uint8_t>;
-
-// CRC-32 computed one bit at a time straight from the polynomial, to check
-// the table-driven implementation against something that shares no code.
-inline std::uint32_t reference_crc32(const std::uint8_t* data, std::size_t size) {
-  std::uint32_t crc = 0xFFFFFFFFu;
-  for (std::size_t i = 0; i < size; ++i) {
-    crc ^= data[i];
-    for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ ((crc & 1u) != 0 ? 0xEDB88320u : 0u);
-  }
-  return ~crc;
-}
 
 template <typename T>
 T get(const Bytes& image, std::size_t offset) {
