@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -85,25 +86,35 @@ std::vector<float> bent_cables(const Geometry& geometry, double theta_rad = 0.15
   return out;
 }
 
-TEST(CApi, PoseFromCableLengthsIsTheRuntimes) {
-  const std::vector<std::uint8_t> image = small_image();
-  QuietHal platform(image);
-  Runtime runtime(platform.hal(), Geometry::prototype());
-  ASSERT_EQ(runtime.init(), RuntimeState::run);
-  const std::vector<float> lengths = bent_cables(runtime.geometry());
+// The C API's pose after `cycles` cycles on a bent robot's lengths, and the
+// C++ runtime's estimate of the same lengths on the same image beside it.
+class CApiPose : public ::testing::Test {
+ protected:
+  void run_both(const std::vector<std::uint8_t>& image_bytes, int cycles) {
+    image = image_bytes;
+    platform = std::make_unique<QuietHal>(image);
+    runtime = std::make_unique<Runtime>(platform->hal(), Geometry::prototype());
+    ASSERT_EQ(runtime->init(), RuntimeState::run);
+    const std::vector<float> lengths = bent_cables(runtime->geometry());
+    ASSERT_EQ(c_api_check_pose(image.data(), std::uint32_t(image.size()), nullptr, lengths.data(), lengths.size(),
+                               std::uint32_t(cycles), &pose, &status),
+              0);
+    ASSERT_EQ(runtime->estimate_pose(as_transmitted(lengths), expected), model::Status::ok);
+  }
 
+  std::vector<std::uint8_t> image;
+  std::unique_ptr<QuietHal> platform;
+  std::unique_ptr<Runtime> runtime;
   cdcr_pose pose{};
   cdcr_status status{};
-  ASSERT_EQ(c_api_check_pose(image.data(), std::uint32_t(image.size()), nullptr, lengths.data(), lengths.size(), 3,
-                             &pose, &status),
-            0);
+  PoseEstimate expected;
+};
+
+TEST_F(CApiPose, PoseFromCableLengthsIsTheRuntimes) {
+  ASSERT_NO_FATAL_FAILURE(run_both(small_image(), 3));
   EXPECT_EQ(status.state, CDCR_STATE_RUN);
   EXPECT_EQ(status.fault, CDCR_FAULT_NONE);
   EXPECT_EQ(status.cycles, 3u);
-
-  const Cables cables = as_transmitted(lengths);
-  PoseEstimate expected;
-  ASSERT_EQ(runtime.estimate_pose(cables, expected), model::Status::ok);
   ASSERT_TRUE(expected.compensated);
   EXPECT_EQ(pose.compensated, 1);
   EXPECT_EQ(pose.segment_count, 2);
@@ -121,7 +132,7 @@ TEST(CApi, PoseFromCableLengthsIsTheRuntimes) {
 
 // The radii the runtime computes over a few cycles reach the C side: those
 // of the pose, as the same code gives them in one go.
-TEST(CApi, PoseCarriesTheRadiiOfTheImagesVariance) {
+TEST_F(CApiPose, PoseCarriesTheRadiiOfTheImagesVariance) {
   test_support::SyntheticModelOptions options;
   options.segments = 2;
   options.training_points = 40;
@@ -129,21 +140,8 @@ TEST(CApi, PoseCarriesTheRadiiOfTheImagesVariance) {
   m.signal_variance.setConstant(m.signal_variance[0]);
   m.noise_variance.setConstant(m.noise_variance[0]);
   m.variance = training::fit_variance_factor(m, m.inputs, training::variance_points(m, m.inputs, 12, 1));
-  const std::vector<std::uint8_t> image = exporting::write_image(m);
-  QuietHal platform(image);
-  Runtime runtime(platform.hal(), Geometry::prototype());
-  ASSERT_EQ(runtime.init(), RuntimeState::run);
-  const std::vector<float> lengths = bent_cables(runtime.geometry());
-
-  cdcr_pose pose{};
-  cdcr_status status{};
-  ASSERT_EQ(c_api_check_pose(image.data(), std::uint32_t(image.size()), nullptr, lengths.data(), lengths.size(), 12,
-                             &pose, &status),
-            0);
-  const Cables cables = as_transmitted(lengths);
-  PoseEstimate expected;
-  ASSERT_EQ(runtime.estimate_pose(cables, expected), model::Status::ok);
-  const model::PoseUncertainty<Scalar> radii = runtime.estimate_uncertainty(expected);
+  ASSERT_NO_FATAL_FAILURE(run_both(exporting::write_image(m), 12));
+  const model::PoseUncertainty<Scalar> radii = runtime->estimate_uncertainty(expected);
   ASSERT_GT(radii.r95_mm, 0.0f);
   EXPECT_EQ(pose.r95_mm, radii.r95_mm);
   EXPECT_EQ(pose.r95_deg, radii.r95_deg);
