@@ -6,6 +6,7 @@
 #include <cmath>
 #include <cstdint>
 #include <cstring>
+#include <memory>
 #include <vector>
 
 #include <gtest/gtest.h>
@@ -23,18 +24,23 @@ namespace cdcr::firmware {
 namespace {
 
 // Corrections of a few tenths of a millimetre, as a trained model makes.
-// With fitted_range_offset, the image's fitted input range is moved that
+// small_image: with fitted_range_offset, the image's fitted input range is moved that
 // far (in every input) from where its points are, so every query is outside.
 // With payload_input, the model has the payload as an input.
-std::vector<std::uint8_t> small_image(int segments = 2, double fitted_range_offset = 0.0, bool payload_input = false) {
-  test_support::SyntheticModelOptions options;
-  options.segments = segments;
-  options.payload_input = payload_input;
+training::TrainedModel small_model(const test_support::SyntheticModelOptions& options) {
   training::TrainedModel m = test_support::synthetic_trained_model(options);
   for (int k = 0; k < 6; ++k) {
     m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
     m.output_scale[k] *= k < 3 ? 0.1 : 0.001;
   }
+  return m;
+}
+
+std::vector<std::uint8_t> small_image(int segments = 2, double fitted_range_offset = 0.0, bool payload_input = false) {
+  test_support::SyntheticModelOptions options;
+  options.segments = segments;
+  options.payload_input = payload_input;
+  training::TrainedModel m = small_model(options);
   if (fitted_range_offset != 0.0) {
     m.set_input_range(m.inputs);
     m.input_min.array() += fitted_range_offset;
@@ -85,25 +91,35 @@ std::vector<float> bent_cables(const Geometry& geometry, double theta_rad = 0.15
   return out;
 }
 
-TEST(CApi, PoseFromCableLengthsIsTheRuntimes) {
-  const std::vector<std::uint8_t> image = small_image();
-  QuietHal platform(image);
-  Runtime runtime(platform.hal(), Geometry::prototype());
-  ASSERT_EQ(runtime.init(), RuntimeState::run);
-  const std::vector<float> lengths = bent_cables(runtime.geometry());
+// The C API's pose after `cycles` cycles on a bent robot's lengths, and the
+// C++ runtime's estimate of the same lengths on the same image beside it.
+class CApiPose : public ::testing::Test {
+ protected:
+  void run_both(const std::vector<std::uint8_t>& image_bytes, int cycles) {
+    image = image_bytes;
+    platform = std::make_unique<QuietHal>(image);
+    runtime = std::make_unique<Runtime>(platform->hal(), Geometry::prototype());
+    ASSERT_EQ(runtime->init(), RuntimeState::run);
+    const std::vector<float> lengths = bent_cables(runtime->geometry());
+    ASSERT_EQ(c_api_check_pose(image.data(), std::uint32_t(image.size()), nullptr, lengths.data(), lengths.size(),
+                               cycles, &pose, &status),
+              0);
+    ASSERT_EQ(runtime->estimate_pose(as_transmitted(lengths), expected), model::Status::ok);
+  }
 
+  std::vector<std::uint8_t> image;
+  std::unique_ptr<QuietHal> platform;
+  std::unique_ptr<Runtime> runtime;
   cdcr_pose pose{};
   cdcr_status status{};
-  ASSERT_EQ(c_api_check_pose(image.data(), std::uint32_t(image.size()), nullptr, lengths.data(), lengths.size(), 3,
-                             &pose, &status),
-            0);
+  PoseEstimate expected;
+};
+
+TEST_F(CApiPose, PoseFromCableLengthsIsTheRuntimes) {
+  ASSERT_NO_FATAL_FAILURE(run_both(small_image(), 3));
   EXPECT_EQ(status.state, CDCR_STATE_RUN);
   EXPECT_EQ(status.fault, CDCR_FAULT_NONE);
   EXPECT_EQ(status.cycles, 3u);
-
-  const Cables cables = as_transmitted(lengths);
-  PoseEstimate expected;
-  ASSERT_EQ(runtime.estimate_pose(cables, expected), model::Status::ok);
   ASSERT_TRUE(expected.compensated);
   EXPECT_EQ(pose.compensated, 1);
   EXPECT_EQ(pose.segment_count, 2);
@@ -121,7 +137,7 @@ TEST(CApi, PoseFromCableLengthsIsTheRuntimes) {
 
 // The radii the runtime computes over a few cycles reach the C side: those
 // of the pose, as the same code gives them in one go.
-TEST(CApi, PoseCarriesTheRadiiOfTheImagesVariance) {
+TEST_F(CApiPose, PoseCarriesTheRadiiOfTheImagesVariance) {
   test_support::SyntheticModelOptions options;
   options.segments = 2;
   options.training_points = 40;
@@ -129,21 +145,8 @@ TEST(CApi, PoseCarriesTheRadiiOfTheImagesVariance) {
   m.signal_variance.setConstant(m.signal_variance[0]);
   m.noise_variance.setConstant(m.noise_variance[0]);
   m.variance = training::fit_variance_factor(m, m.inputs, training::variance_points(m, m.inputs, 12, 1));
-  const std::vector<std::uint8_t> image = exporting::write_image(m);
-  QuietHal platform(image);
-  Runtime runtime(platform.hal(), Geometry::prototype());
-  ASSERT_EQ(runtime.init(), RuntimeState::run);
-  const std::vector<float> lengths = bent_cables(runtime.geometry());
-
-  cdcr_pose pose{};
-  cdcr_status status{};
-  ASSERT_EQ(c_api_check_pose(image.data(), std::uint32_t(image.size()), nullptr, lengths.data(), lengths.size(), 12,
-                             &pose, &status),
-            0);
-  const Cables cables = as_transmitted(lengths);
-  PoseEstimate expected;
-  ASSERT_EQ(runtime.estimate_pose(cables, expected), model::Status::ok);
-  const model::PoseUncertainty<Scalar> radii = runtime.estimate_uncertainty(expected);
+  ASSERT_NO_FATAL_FAILURE(run_both(exporting::write_image(m), 12));
+  const model::PoseUncertainty<Scalar> radii = runtime->estimate_uncertainty(expected);
   ASSERT_GT(radii.r95_mm, 0.0f);
   EXPECT_EQ(pose.r95_mm, radii.r95_mm);
   EXPECT_EQ(pose.r95_deg, radii.r95_deg);
@@ -191,9 +194,37 @@ class CApiRuntime : public ::testing::Test {
     return s;
   }
 
+  // A position target a few millimetres from `start`.
+  static cdcr_target position_target_near(const cdcr_pose& start, std::uint8_t sequence) {
+    cdcr_target target{};
+    target.position_mm[0] = start.position_mm[0] + 4.0f;
+    target.position_mm[1] = start.position_mm[1] - 3.0f;
+    target.position_mm[2] = start.position_mm[2] - 1.0f;
+    target.mode = CDCR_TARGET_POSITION;
+    target.sequence = sequence;
+    return target;
+  }
+  // Steps at `lengths` while the solver runs, 300 steps at most.
+  void step_while_solving(const std::vector<float>& lengths) {
+    int steps = 0;
+    do {
+      step_with(lengths);
+    } while (status().ik_running && ++steps < 300);
+  }
+
+  // init, and the C++ runtime on the same image beside the C one.
+  void init_with_reference(const std::vector<std::uint8_t>& image_bytes) {
+    ASSERT_NO_FATAL_FAILURE(init(image_bytes));
+    reference_platform = std::make_unique<QuietHal>(image);
+    reference = std::make_unique<Runtime>(reference_platform->hal(), Geometry::prototype());
+    ASSERT_EQ(reference->init(), RuntimeState::run);
+  }
+
   std::vector<std::uint8_t> image;
   cdcr_config config{};
   cdcr_runtime runtime{};
+  std::unique_ptr<QuietHal> reference_platform;
+  std::unique_ptr<Runtime> reference;
 };
 
 // cdcr_set_payload: a payload model's pose is the runtime's at that payload
@@ -202,21 +233,13 @@ class CApiRuntime : public ::testing::Test {
 TEST_F(CApiRuntime, PayloadReachesThePoseAndBadOnesAreRefused) {
   test_support::SyntheticModelOptions options;
   options.payload_input = true;
-  training::TrainedModel m = test_support::synthetic_trained_model(options);
-  for (int k = 0; k < 6; ++k) {
-    m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
-    m.output_scale[k] *= k < 3 ? 0.1 : 0.001;
-  }
-  init(exporting::write_image(m));
-  QuietHal platform(image);
-  Runtime reference(platform.hal(), Geometry::prototype());
-  ASSERT_EQ(reference.init(), RuntimeState::run);
-  const std::vector<float> lengths = bent_cables(reference.geometry());
+  ASSERT_NO_FATAL_FAILURE(init_with_reference(exporting::write_image(small_model(options))));
+  const std::vector<float> lengths = bent_cables(reference->geometry());
   const Cables cables = as_transmitted(lengths);
   const auto pose_at = [&](float payload_kg) {
-    EXPECT_TRUE(reference.set_payload_kg(payload_kg));
+    EXPECT_TRUE(reference->set_payload_kg(payload_kg));
     PoseEstimate e;
-    EXPECT_EQ(reference.estimate_pose(cables, e), model::Status::ok);
+    EXPECT_EQ(reference->estimate_pose(cables, e), model::Status::ok);
     return e.pose.position_mm;
   };
   step_with(lengths, 2);
@@ -249,34 +272,26 @@ TEST_F(CApiRuntime, PayloadReachesThePoseAndBadOnesAreRefused) {
 TEST_F(CApiRuntime, HomingMakesTheHysteresisStateKnown) {
   test_support::SyntheticModelOptions options;
   options.hysteresis_operators = 2;
-  training::TrainedModel m = test_support::synthetic_trained_model(options);
-  for (int k = 0; k < 6; ++k) {
-    m.output_mean[k] *= k < 3 ? 0.1 : 0.001;
-    m.output_scale[k] *= k < 3 ? 0.1 : 0.001;
-  }
-  init(exporting::write_image(m));
-  QuietHal platform(image);
-  Runtime reference(platform.hal(), Geometry::prototype());
-  ASSERT_EQ(reference.init(), RuntimeState::run);
+  ASSERT_NO_FATAL_FAILURE(init_with_reference(exporting::write_image(small_model(options))));
   Cables approach, home;
-  ASSERT_EQ(model::homing_waypoints(reference.geometry(), approach, home), model::Status::ok);
+  ASSERT_EQ(model::homing_waypoints(reference->geometry(), approach, home), model::Status::ok);
   const std::vector<float> at_home(home.data(), home.data() + home.size());
   step_with(at_home, 2);
   EXPECT_EQ(status().hysteresis_unknown, 1);
   ASSERT_EQ(cdcr_homing(&runtime), CDCR_OK);
-  const std::vector<float> lengths = bent_cables(reference.geometry());
+  const std::vector<float> lengths = bent_cables(reference->geometry());
   step_with(lengths);
   EXPECT_EQ(status().hysteresis_unknown, 0);
 
   // The reference: homed at home, then at the same lengths.
-  reference.set_homed();
+  reference->set_homed();
   const Cables cables = as_transmitted(lengths);
-  model::HysteresisState<float> state = reference.hysteresis().state();
-  model::update_hysteresis(state, reference.hysteresis().hysteresis_model(), cables);
+  model::HysteresisState<float> state = reference->hysteresis().state();
+  model::update_hysteresis(state, reference->hysteresis().hysteresis_model(), cables);
   Cables effective;
-  model::effective_lengths(state, reference.hysteresis().hysteresis_model(), effective);
+  model::effective_lengths(state, reference->hysteresis().hysteresis_model(), effective);
   PoseEstimate expected;
-  ASSERT_EQ(reference.estimate_pose(effective, expected), model::Status::ok);
+  ASSERT_EQ(reference->estimate_pose(effective, expected), model::Status::ok);
   cdcr_pose pose{};
   ASSERT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_OK);
   for (int i = 0; i < 3; ++i) EXPECT_EQ(pose.position_mm[i], expected.pose.position_mm[i]);
@@ -302,17 +317,9 @@ TEST_F(CApiRuntime, TargetIsSolvedToSetpoints) {
   EXPECT_EQ(cdcr_get_setpoints(&runtime, &setpoints), CDCR_ERROR_NO_DATA);
   EXPECT_EQ(status().ik_outcome, CDCR_IK_NONE);
 
-  cdcr_target target{};
-  target.position_mm[0] = start.position_mm[0] + 4.0f;
-  target.position_mm[1] = start.position_mm[1] - 3.0f;
-  target.position_mm[2] = start.position_mm[2] - 1.0f;
-  target.mode = CDCR_TARGET_POSITION;
-  target.sequence = 42;
+  const cdcr_target target = position_target_near(start, 42);
   ASSERT_EQ(cdcr_set_target(&runtime, &target), CDCR_OK);
-  int steps = 0;
-  do {
-    step_with(lengths);
-  } while (status().ik_running && ++steps < 300);
+  step_while_solving(lengths);
   const cdcr_status done = status();
   EXPECT_EQ(done.ik_outcome, CDCR_IK_CONVERGED);
   EXPECT_EQ(done.ik_sequence, 42);
@@ -344,18 +351,10 @@ TEST_F(CApiRuntime, ATargetRefusingExtrapolationIsRefusedOutsideTheFittedRange) 
     cdcr_pose start{};
     ASSERT_EQ(cdcr_get_pose(&runtime, &start), CDCR_OK);
     EXPECT_EQ(start.extrapolating, 1);
-    cdcr_target target{};
-    target.position_mm[0] = start.position_mm[0] + 4.0f;
-    target.position_mm[1] = start.position_mm[1] - 3.0f;
-    target.position_mm[2] = start.position_mm[2] - 1.0f;
-    target.mode = CDCR_TARGET_POSITION;
-    target.sequence = 7;
+    cdcr_target target = position_target_near(start, 7);
     target.refuse_extrapolating = refuse;
     ASSERT_EQ(cdcr_set_target(&runtime, &target), CDCR_OK);
-    int steps = 0;
-    do {
-      step_with(lengths);
-    } while (status().ik_running && ++steps < 300);
+    step_while_solving(lengths);
     cdcr_setpoints setpoints{};
     if (refuse) {
       EXPECT_EQ(status().ik_outcome, CDCR_IK_REFUSED_EXTRAPOLATING);

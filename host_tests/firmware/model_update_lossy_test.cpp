@@ -156,6 +156,11 @@ class LostFrameTest : public ::testing::Test {
     board->cycle();
   }
   std::vector<UpdateReason> reasons() { return test_support::report_reasons(board->take_reports()); }
+  UpdateState update_state() const { return board->runtime->model_update().state(); }
+  // Cycles (100 at most) until the board receives the transfer's blocks.
+  void cycle_until_receiving() {
+    for (int i = 0; i < 100 && update_state() != UpdateState::receiving; ++i) board->cycle();
+  }
   sim::SimFlash flash{1024, 64, 256};
   std::unique_ptr<UpdateBoard> board;
   SentImage sent{update_test_image(60, 2)};
@@ -168,14 +173,14 @@ TEST_F(LostFrameTest, ANewTransferAsksForTheDigestAgain) {
   board->cycle(out.take());
   const std::vector<hal::CanFrame> reports = board->reports;
   EXPECT_EQ(reasons(), std::vector<UpdateReason>{UpdateReason::no_transfer});
-  EXPECT_EQ(board->runtime->model_update().state(), UpdateState::idle);
+  EXPECT_EQ(update_state(), UpdateState::idle);
   // The sender answers with the digest and START again, and the transfer
   // begins.
   for (const hal::CanFrame& report : reports) sent.sender.on_report(report, board->now_ms(), out);
   EXPECT_EQ(sent.sender.restarts(), 1u);
   board->cycle(out.take());
   EXPECT_EQ(reasons(), std::vector<UpdateReason>{UpdateReason::none});
-  EXPECT_EQ(board->runtime->model_update().state(), UpdateState::preparing);
+  EXPECT_EQ(update_state(), UpdateState::preparing);
 }
 
 TEST_F(LostFrameTest, ARepeatedStartGoesOnWithTheTransfer) {
@@ -184,15 +189,15 @@ TEST_F(LostFrameTest, ARepeatedStartGoesOnWithTheTransfer) {
   out.frames.push_back(out.frames.back());  // START twice
   board->cycle(out.take());
   EXPECT_EQ(reasons(), (std::vector<UpdateReason>{UpdateReason::none, UpdateReason::none}));
-  for (int i = 0; i < 100 && board->runtime->model_update().state() != UpdateState::receiving; ++i) board->cycle();
-  EXPECT_EQ(board->runtime->model_update().state(), UpdateState::receiving);
+  cycle_until_receiving();
+  EXPECT_EQ(update_state(), UpdateState::receiving);
   // START again later with a digest frame lost: the transfer goes on.
   sent.sender.start(out, board->now_ms());
   out.frames.erase(out.frames.begin());
   board->take_reports();
   board->cycle(out.take());
   EXPECT_EQ(reasons(), std::vector<UpdateReason>{UpdateReason::none});
-  EXPECT_EQ(board->runtime->model_update().state(), UpdateState::receiving);
+  EXPECT_EQ(update_state(), UpdateState::receiving);
 }
 
 // A block header repeated before its data: the block is taken once, and
@@ -201,8 +206,8 @@ TEST_F(LostFrameTest, ARepeatedBlockHeaderIsNotAMissingBlock) {
   FrameQueue out;
   sent.sender.start(out, board->now_ms());
   board->cycle(out.take());
-  for (int i = 0; i < 100 && board->runtime->model_update().state() != UpdateState::receiving; ++i) board->cycle();
-  ASSERT_EQ(board->runtime->model_update().state(), UpdateState::receiving);
+  cycle_until_receiving();
+  ASSERT_EQ(update_state(), UpdateState::receiving);
   board->take_reports();
   sent.sender.send_block(0, out);
   out.frames.insert(out.frames.begin() + 1, out.frames.front());

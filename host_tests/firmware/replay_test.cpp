@@ -54,15 +54,22 @@ void random_cables(const model::RobotGeometry<double>& geometry, int samples, un
   }
 }
 
+void write_bytes(const std::filesystem::path& path, const std::vector<std::uint8_t>& bytes) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+std::string read_text(const std::filesystem::path& path) {
+  std::ifstream in(path);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
 // The image and the cables, as the replay reads them, in `dir`: model.img
 // and cables.csv.
 void write_replay_inputs(const std::filesystem::path& dir, const std::vector<std::uint8_t>& image,
                          const dataset::Dataset& data) {
   std::filesystem::create_directories(dir);
-  {
-    std::ofstream out(dir / "model.img", std::ios::binary);
-    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
-  }
+  write_bytes(dir / "model.img", image);
   dataset::write_dataset_csv((dir / "cables.csv").string(), data);
 }
 
@@ -73,6 +80,20 @@ int run_replay(const std::filesystem::path& dir, const std::string& image, const
                               (dir / "poses.csv").string() + "\"" + extra;
   const int status = std::system(command.c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+}
+
+// run_replay with its standard error in `errors`.
+int run_replay_capturing_errors(const std::filesystem::path& dir, const std::string& image, const std::string& cables,
+                                std::string& errors) {
+  const std::filesystem::path err = dir / "err.txt";
+  const int exit_code = run_replay(dir, image, cables, " 2>\"" + err.string() + "\"");
+  errors = read_text(err);
+  return exit_code;
+}
+
+void expect_one_line_naming(const std::string& message, const std::string& cause) {
+  EXPECT_NE(message.find(cause), std::string::npos) << message;
+  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
 }
 
 TEST(RuntimeReplay, MatchesTheEvaluationsFirmwarePoses) {
@@ -204,26 +225,19 @@ TEST(RuntimeReplay, ThePayloadColumnMustMatchTheImage) {
   const std::vector<std::uint8_t> plain_image = exporting::write_image(test_support::synthetic_trained_model());
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_column";
   std::filesystem::create_directories(dir);
-  for (const auto& [name, bytes] : {std::pair{"payload.img", &payload_image}, std::pair{"plain.img", &plain_image}}) {
-    std::ofstream out(dir / name, std::ios::binary);
-    out.write(reinterpret_cast<const char*>(bytes->data()), static_cast<std::streamsize>(bytes->size()));
-  }
+  write_bytes(dir / "payload.img", payload_image);
+  write_bytes(dir / "plain.img", plain_image);
   { std::ofstream(dir / "plain.csv") << "l1_1,l1_2,l1_3,l1_4,l2_1,l2_2,l2_3,l2_4\n120,120,120,120,95.5,95.5,95.5,95.5\n"; }
   {
     std::ofstream(dir / "loaded.csv")
         << "l1_1,l1_2,l1_3,l1_4,l2_1,l2_2,l2_3,l2_4,payload_kg\n120,120,120,120,95.5,95.5,95.5,95.5,0.5\n";
   }
-  const std::string err = (dir / "err.txt").string();
-  EXPECT_EQ(run_replay(dir, "payload.img", "plain.csv", " 2>\"" + err + "\""), 1);
-  std::ifstream refused(err);
-  const std::string message((std::istreambuf_iterator<char>(refused)), std::istreambuf_iterator<char>());
-  EXPECT_NE(message.find("the image takes a payload input and the data have no payload_kg column"), std::string::npos)
-      << message;
-  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+  std::string message;
+  EXPECT_EQ(run_replay_capturing_errors(dir, "payload.img", "plain.csv", message), 1);
+  expect_one_line_naming(message, "the image takes a payload input and the data have no payload_kg column");
 
-  EXPECT_EQ(run_replay(dir, "plain.img", "loaded.csv", " 2>\"" + err + "\""), 0);
-  std::ifstream noted(err);
-  const std::string note((std::istreambuf_iterator<char>(noted)), std::istreambuf_iterator<char>());
+  std::string note;
+  EXPECT_EQ(run_replay_capturing_errors(dir, "plain.img", "loaded.csv", note), 0);
   EXPECT_NE(note.find("the payload_kg column is ignored"), std::string::npos) << note;
   EXPECT_EQ(run_replay(dir, "payload.img", "loaded.csv"), 0);
 }
@@ -255,11 +269,8 @@ TEST(RuntimeReplay, AHysteresisImageCarriesTheStateOverTheSequence) {
   model::JointVector<double> joints(4);
   joints << 0.4, 0.1, -1.0, 0.12;
   for (int i = 0; i < 60; ++i) {
-    for (int k = 0; k < 4; ++k) joints[k] += step(rng);
-    joints[1] = std::abs(joints[1]);
-    joints[3] = std::abs(joints[3]);
     model::CableVector<double> cables;
-    ASSERT_EQ(model::cables_from_joints(joints, geometry, cables), model::Status::ok);
+    ASSERT_EQ(test_support::random_walk_step(joints, rng, step, geometry, cables), model::Status::ok);
     data.cables_mm.row(i) = cables.transpose();
     data.time_s[i] = 0.1 * i + (i >= 35 ? 60.0 : 0.0);
   }
@@ -305,18 +316,11 @@ TEST(RuntimeReplay, AHysteresisImageNeedsAMotionSequence) {
   const std::vector<std::uint8_t> image = exporting::write_image(test_support::synthetic_trained_model(options));
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_hysteresis";
   std::filesystem::create_directories(dir);
-  {
-    std::ofstream out(dir / "hysteresis.img", std::ios::binary);
-    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
-  }
+  write_bytes(dir / "hysteresis.img", image);
   { std::ofstream(dir / "plain.csv") << "l1_1,l1_2,l1_3,l1_4,l2_1,l2_2,l2_3,l2_4\n120,120,120,120,95.5,95.5,95.5,95.5\n"; }
-  const std::string err = (dir / "err.txt").string();
-  EXPECT_EQ(run_replay(dir, "hysteresis.img", "plain.csv", " 2>\"" + err + "\""), 1);
-  std::ifstream refused(err);
-  const std::string message((std::istreambuf_iterator<char>(refused)), std::istreambuf_iterator<char>());
-  EXPECT_NE(message.find("needs a motion sequence (a t_s column), but the rows have no time"), std::string::npos)
-      << message;
-  EXPECT_EQ(std::count(message.begin(), message.end(), '\n'), 1) << message;
+  std::string message;
+  EXPECT_EQ(run_replay_capturing_errors(dir, "hysteresis.img", "plain.csv", message), 1);
+  expect_one_line_naming(message, "needs a motion sequence (a t_s column), but the rows have no time");
 }
 
 TEST(RuntimeReplay, CorruptImageIsOneLineErrorWithExitOne) {
@@ -352,16 +356,12 @@ TEST(RuntimeClosedLoop, FollowsAStreamedCircle) {
   const std::vector<std::uint8_t> image = exporting::write_image(m);
   const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_circle";
   std::filesystem::create_directories(dir);
-  {
-    std::ofstream out(dir / "model.img", std::ios::binary);
-    out.write(reinterpret_cast<const char*>(image.data()), static_cast<std::streamsize>(image.size()));
-  }
+  write_bytes(dir / "model.img", image);
   const std::string command = std::string("\"") + CDCR_RUNTIME_EXE + "\" --image \"" + (dir / "model.img").string() +
                               "\" --sim --ideal-robot --circle --circle-radius 30 --circle-speed 100 > \"" +
                               (dir / "out.txt").string() + "\"";
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
-  std::ifstream in(dir / "out.txt");
-  const std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string text = read_text(dir / "out.txt");
   double tip_mean = -1, tip_max = -1, following_mean = -1, following_max = -1;
   long sent = -1, streamed = -1, cycles = -1, missing = -1;
   unsigned overruns = 1;

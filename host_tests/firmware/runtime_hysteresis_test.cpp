@@ -20,6 +20,8 @@
 #include "runtime_test_fixture.hpp"
 #include "train/predictive_variance.hpp"
 
+#include "../support/image_in_double.hpp"
+
 namespace cdcr::firmware {
 namespace {
 
@@ -212,12 +214,9 @@ TEST_F(RuntimeHysteresisTest, WithoutAHysteresisBlockNothingChanges) {
 TEST_F(RuntimeHysteresisTest, Float32FidelityOverTwoHundredRowsAgainstDouble) {
   const training::TrainedModel m = hysteresis_model();
   boot_with(m);
-  model::ImageView view{};
-  ASSERT_EQ(model::parse_image(image.data(), image.size(), view), model::ImageStatus::ok);
-  model::RobotGeometry<double> geometry;
-  ASSERT_EQ(model::geometry_from_image(view, geometry), model::Status::ok);
-  model::GpCorrection<double, double> correction;
-  ASSERT_EQ(correction.bind(view), model::Status::ok);
+  test_support::ImageInDouble reference;
+  ASSERT_TRUE(test_support::read_image_in_double(image, reference));
+  const model::RobotGeometry<double>& geometry = reference.geometry;
   model::HysteresisState<double> state;
   ASSERT_EQ(model::start_at_home(state, m.hysteresis, geometry), model::Status::ok);
   send_frame(protocol::Homing{});
@@ -240,7 +239,7 @@ TEST_F(RuntimeHysteresisTest, Float32FidelityOverTwoHundredRowsAgainstDouble) {
     model::effective_lengths(state, m.hysteresis, effective);
     largest_lag_effect_mm = std::max(largest_lag_effect_mm, (effective - commanded).cwiseAbs().maxCoeff());
     model::ForwardResult<double> expected;
-    ASSERT_EQ(model::compensated_forward(effective, geometry, correction, expected), model::Status::ok);
+    ASSERT_EQ(model::compensated_forward(effective, geometry, reference.correction, expected), model::Status::ok);
     const model::Pose<double> board = runtime->latest_pose().pose.cast<double>();
     const model::PoseError<double> e = model::pose_error(expected.compensated, board);
     worst_mm = std::max(worst_mm, e.position_mm);

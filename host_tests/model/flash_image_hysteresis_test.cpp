@@ -21,40 +21,12 @@
 #include "export/image_writer.hpp"
 
 #include "../support/synthetic_trained_model.hpp"
+#include "image_edits.hpp"
 
 namespace cdcr::model {
 namespace {
 
-using Bytes = std::vector<std::uint8_t>;
-
-template <typename T>
-T get(const Bytes& image, std::size_t offset) {
-  T value;
-  std::memcpy(&value, image.data() + offset, sizeof(T));
-  return value;
-}
-
-template <typename T>
-void put(Bytes& image, std::size_t offset, T value) {
-  std::memcpy(image.data() + offset, &value, sizeof(T));
-}
-
-void reseal(Bytes& image) {
-  const auto total = get<std::uint32_t>(image, image_field::total_size);
-  put<std::uint32_t>(image, total - kImageTrailerSize, crc32(image.data(), total - kImageTrailerSize));
-}
-
-class Findings : public ImageCheckSink {
- public:
-  void on_finding(const ImageFinding& finding) override { all.push_back(finding); }
-  const ImageFinding* first_failure() const {
-    for (const ImageFinding& f : all) {
-      if (!f.passed) return &f;
-    }
-    return nullptr;
-  }
-  std::vector<ImageFinding> all;
-};
+using namespace test_support;  // the image edits of image_edits.hpp
 
 // The verdict of all three modes, which must agree; the first failed
 // finding of the reporting one in `first` (empty field when none failed).

@@ -29,65 +29,12 @@
 
 #include "../support/synthetic_trained_model.hpp"
 #include "../support/v1_image.hpp"
+#include "image_edits.hpp"
 
 namespace cdcr::model {
 namespace {
 
-using Bytes = std::vector<std::uint8_t>;
-
-// CRC-32 computed one bit at a time straight from the polynomial, to check
-// the table-driven implementation against something that shares no code.
-std::uint32_t reference_crc32(const std::uint8_t* data, std::size_t size) {
-  std::uint32_t crc = 0xFFFFFFFFu;
-  for (std::size_t i = 0; i < size; ++i) {
-    crc ^= data[i];
-    for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ ((crc & 1u) != 0 ? 0xEDB88320u : 0u);
-  }
-  return ~crc;
-}
-
-template <typename T>
-T get(const Bytes& image, std::size_t offset) {
-  T value;
-  std::memcpy(&value, image.data() + offset, sizeof(T));
-  return value;
-}
-
-template <typename T>
-void put(Bytes& image, std::size_t offset, T value) {
-  std::memcpy(image.data() + offset, &value, sizeof(T));
-}
-
-// Recomputes the trailer for the total_size the header declares.
-void reseal(Bytes& image) {
-  const auto total = get<std::uint32_t>(image, image_field::total_size);
-  put<std::uint32_t>(image, total - kImageTrailerSize, reference_crc32(image.data(), total - kImageTrailerSize));
-}
-
-// Every finding of a reporting parse.
-class Findings : public ImageCheckSink {
- public:
-  void on_finding(const ImageFinding& finding) override { all.push_back(finding); }
-
-  const ImageFinding* first_failure() const {
-    for (const ImageFinding& f : all) {
-      if (!f.passed) return &f;
-    }
-    return nullptr;
-  }
-  bool failed(ImageCheckId check) const {
-    return std::any_of(all.begin(), all.end(),
-                       [check](const ImageFinding& f) { return f.check == check && !f.passed; });
-  }
-  const ImageFinding* failure_of(const char* field) const {
-    for (const ImageFinding& f : all) {
-      if (!f.passed && std::string(f.field) == field) return &f;
-    }
-    return nullptr;
-  }
-
-  std::vector<ImageFinding> all;
-};
+using namespace test_support;  // the image edits of image_edits.hpp
 
 // The reporting parse of the same bytes.
 ImageStatus parse_reporting(const Bytes& image, Findings& findings, const ImageCapacity& capacity = {}) {

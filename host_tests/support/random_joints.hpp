@@ -3,8 +3,10 @@
 // robot: per segment alpha, then theta, from the caller's generator and
 // ranges, so the same seed gives the same robot poses in every test.
 
+#include <cmath>
 #include <random>
 
+#include "cdcr/model/chain.hpp"
 #include "cdcr/model/types.hpp"
 
 namespace cdcr::test_support {
@@ -18,6 +20,19 @@ model::JointVector<double> random_joints(int segment_count, Rng& rng, std::unifo
     joints[2 * s + 1] = theta_rad(rng);
   }
   return joints;
+}
+
+// One step of a random walk through joint space, for motion sequences: every
+// joint moves by step(rng), each theta folded back to >= 0 (a bend that
+// crosses straight continues as the opposite alpha's); `cables` are those of
+// the new joints through `geometry`.
+template <typename Rng>
+model::Status random_walk_step(model::JointVector<double>& joints, Rng& rng,
+                               std::uniform_real_distribution<double>& step,
+                               const model::RobotGeometry<double>& geometry, model::CableVector<double>& cables) {
+  for (int k = 0; k < joints.size(); ++k) joints[k] += step(rng);
+  for (int k = 1; k < joints.size(); k += 2) joints[k] = std::abs(joints[k]);
+  return model::cables_from_joints(joints, geometry, cables);
 }
 
 }  // namespace cdcr::test_support

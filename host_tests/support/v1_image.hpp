@@ -12,20 +12,12 @@
 
 #include <Eigen/Core>
 
+#include "reference_crc32.hpp"
 #include "trained_model/trained_model.hpp"
 
 namespace cdcr::test_support {
 
 namespace v1_detail {
-
-inline std::uint32_t bitwise_crc32(const std::uint8_t* data, std::size_t size) {
-  std::uint32_t crc = 0xFFFFFFFFu;
-  for (std::size_t i = 0; i < size; ++i) {
-    crc ^= data[i];
-    for (int bit = 0; bit < 8; ++bit) crc = (crc >> 1) ^ ((crc & 1u) != 0 ? 0xEDB88320u : 0u);
-  }
-  return ~crc;
-}
 
 inline std::uint32_t next_multiple_of_8(std::uint32_t at) { return (at + 7) / 8 * 8; }
 
@@ -111,14 +103,14 @@ inline std::vector<std::uint8_t> v1_image(const training::TrainedModel& m) {
   // 20: reserved, zero
   put(l.metadata + 24, m.metrics);
   std::memcpy(image.data() + l.metadata + 56, m.trainer.data(), std::min<std::size_t>(m.trainer.size(), 32));
-  put(l.total - 4, v1_detail::bitwise_crc32(image.data(), l.total - 4));
+  put(l.total - 4, reference_crc32(image.data(), l.total - 4));
   return image;
 }
 
 inline void reseal_v1_image(std::vector<std::uint8_t>& image) {
   std::uint32_t total = 0;
   std::memcpy(&total, image.data() + 12, 4);
-  const std::uint32_t crc = v1_detail::bitwise_crc32(image.data(), total - 4);
+  const std::uint32_t crc = reference_crc32(image.data(), total - 4);
   std::memcpy(image.data() + total - 4, &crc, 4);
 }
 

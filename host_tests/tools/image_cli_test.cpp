@@ -32,6 +32,8 @@
 #include "image_report.hpp"
 #include "test_work_dir.hpp"
 
+#include "../support/image_in_double.hpp"
+#include "../support/random_joints.hpp"
 #include "../support/run_cdcr.hpp"
 #include "../support/synthetic_trained_model.hpp"
 #include "../support/v1_image.hpp"
@@ -550,12 +552,9 @@ TEST_F(ImageCli, EvalOfASequenceCarriesTheHysteresisFromRowToRow) {
   const Bytes with_block = exporting::write_image(m);
   training::TrainedModel joints_only = m;
   joints_only.hysteresis = model::HysteresisModel<double>{};
-  model::ImageView view{};
-  ASSERT_EQ(model::parse_image(with_block.data(), with_block.size(), view), model::ImageStatus::ok);
-  model::RobotGeometry<double> geometry;
-  ASSERT_EQ(model::geometry_from_image(view, geometry), model::Status::ok);
-  model::GpCorrection<double, double> correction;
-  ASSERT_EQ(correction.bind(view), model::Status::ok);
+  test_support::ImageInDouble reference;
+  ASSERT_TRUE(test_support::read_image_in_double(with_block, reference));
+  const model::RobotGeometry<double>& geometry = reference.geometry;
 
   dataset::Dataset data;
   data.segment_count = 2;
@@ -571,11 +570,8 @@ TEST_F(ImageCli, EvalOfASequenceCarriesTheHysteresisFromRowToRow) {
   joints << 0.3, 0.12, 2.0, 0.1;
   model::HysteresisState<double> state;
   for (int i = 0; i < rows; ++i) {
-    for (int k = 0; k < 4; ++k) joints[k] += step(rng);
-    joints[1] = std::abs(joints[1]);
-    joints[3] = std::abs(joints[3]);
     model::CableVector<double> cables;
-    ASSERT_EQ(model::cables_from_joints(joints, geometry, cables), model::Status::ok);
+    ASSERT_EQ(test_support::random_walk_step(joints, rng, step, geometry, cables), model::Status::ok);
     // What the CSV carries: the reader's value of the written text.
     data.cables_mm.row(i) = cables.transpose();
     data.time_s[i] = 0.05 * i + (i >= 50 ? 100.0 : 0.0);
@@ -584,7 +580,7 @@ TEST_F(ImageCli, EvalOfASequenceCarriesTheHysteresisFromRowToRow) {
     model::CableVector<double> effective;
     model::effective_lengths(state, m.hysteresis, effective);
     model::ForwardResult<double> truth;
-    ASSERT_EQ(model::compensated_forward(effective, geometry, correction, truth), model::Status::ok);
+    ASSERT_EQ(model::compensated_forward(effective, geometry, reference.correction, truth), model::Status::ok);
     data.poses.push_back(truth.compensated);
   }
   const fs::path data_path = dir / "sequence.csv";

@@ -27,6 +27,25 @@ bench_build() {
   fi
 }
 
+# bench_work NAME DEPS CMAKE_OPTIONS TARGET...
+# What every bench starts with: bench_build (DEPS, CMAKE_OPTIONS, TARGET... as
+# there), then its output folder $build_dir/NAME made; sets work_dir to it
+# and cdcr to the built command line tool.
+bench_work() {
+  local name=$1
+  shift
+  bench_build "$@"
+  work_dir=$build_dir/$name
+  mkdir -p "$work_dir"
+  cdcr=$build_dir/bin/cdcr
+}
+
+# seed_option DEFAULT [--seed S]
+# Prints the seed of a bench's optional --seed S argument, DEFAULT without it.
+seed_option() {
+  if [[ ${2:-} == --seed ]]; then echo "$3"; else echo "$1"; fi
+}
+
 # noise_floor SIMULATE_JSON
 # Prints the noise floor of a `cdcr simulate --json` report as --noise-floor
 # takes it: position_mm,orientation_deg.

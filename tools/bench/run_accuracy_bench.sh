@@ -9,13 +9,8 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 source tools/bench/bench_build.sh
 
-seed=1
-if [[ ${1:-} == --seed ]]; then seed=$2; fi
-
-work_dir=$build_dir/accuracy_bench
-bench_build base "" cdcr
-mkdir -p "$work_dir"
-cdcr=$build_dir/bin/cdcr
+seed=$(seed_option 1 "$@")
+bench_work accuracy_bench base "" cdcr
 
 "$cdcr" simulate --samples 750 --seed "$seed" --out "$work_dir/data.csv" --json >"$work_dir/simulate.json"
 floor=$(noise_floor "$work_dir/simulate.json")

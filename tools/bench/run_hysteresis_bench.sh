@@ -19,13 +19,8 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 source tools/bench/bench_build.sh
 
-seed=7
-if [[ ${1:-} == --seed ]]; then seed=$2; fi
-
-work_dir=$build_dir/hysteresis_bench
-bench_build "base sklearn" "" cdcr
-mkdir -p "$work_dir"
-cdcr=$build_dir/bin/cdcr
+seed=$(seed_option 7 "$@")
+bench_work hysteresis_bench "base sklearn" "" cdcr
 python=/usr/bin/python3
 # The robot's nominal geometry, as independent_robot.py states it.
 geometry=(--segments 4 --length 110 --radius 60)

@@ -13,10 +13,7 @@ set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 source tools/bench/bench_build.sh
 
-work_dir=$build_dir/learning_curve_bench
-bench_build base "" cdcr
-mkdir -p "$work_dir"
-cdcr=$build_dir/bin/cdcr
+bench_work learning_curve_bench base "" cdcr
 
 "$cdcr" simulate --samples 4000 --seed 1 --workspace-theta-max 0.7 --out "$work_dir/train.csv" >/dev/null
 "$cdcr" simulate --samples 200 --seed 1 --session 1 --workspace-theta-max 0.7 --out "$work_dir/test.csv" --json \

@@ -26,9 +26,7 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 
-work_dir=$build_dir/training_bench
-bench_build --show-build "base sklearn" "-DCDCR_BUILD_TOOLS=ON -DCDCR_BUILD_BENCHMARKS=ON" cdcr cdcr-bench-training
-mkdir -p "$work_dir"
+bench_work training_bench --show-build "base sklearn" "-DCDCR_BUILD_TOOLS=ON -DCDCR_BUILD_BENCHMARKS=ON" cdcr cdcr-bench-training
 
 # Both sides' BLAS on one thread per call: the trainer's default (its
 # search uses the cores by running starts side by side), and scikit-learn's

@@ -32,10 +32,7 @@ while [[ $# -gt 0 ]]; do
   esac
 done
 
-work_dir=$build_dir/workspace_bench
-bench_build "base sklearn" "-DCDCR_BUILD_TOOLS=ON -DCDCR_BUILD_BENCHMARKS=ON" cdcr cdcr-bench-training
-mkdir -p "$work_dir"
-cdcr=$build_dir/bin/cdcr
+bench_work workspace_bench "base sklearn" "-DCDCR_BUILD_TOOLS=ON -DCDCR_BUILD_BENCHMARKS=ON" cdcr cdcr-bench-training
 
 simulate_case() {  # name, training rows, test rows, simulate options...
   local name=$1 rows=$2 test_rows=$3

@@ -23,23 +23,10 @@
 #include "cdcr/model/geometry.hpp"
 #include "dataset/csv_dataset.hpp"
 #include "train/hyperparameter_search.hpp"
+#include "train/json_rows.hpp"
 #include "train/lapack.hpp"
 #include "train/trainer.hpp"
 #include "train/training_set.hpp"
-
-namespace {
-
-nlohmann::json rows(const Eigen::MatrixXd& m) {
-  nlohmann::json j = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < m.rows(); ++i) {
-    std::vector<double> row(static_cast<std::size_t>(m.cols()));
-    for (Eigen::Index k = 0; k < m.cols(); ++k) row[static_cast<std::size_t>(k)] = m(i, k);
-    j.push_back(row);
-  }
-  return j;
-}
-
-}  // namespace
 
 int main(int argc, char** argv) {
   using namespace cdcr;
@@ -74,8 +61,8 @@ int main(int argc, char** argv) {
     if (!export_path.empty()) {
       const training::SearchBounds& b = options.bounds;
       nlohmann::json j;
-      j["x"] = rows(x);
-      j["y"] = rows(y);
+      j["x"] = training::json_rows(x);
+      j["y"] = training::json_rows(y);
       j["bounds"] = {{"length_scale", {b.length_scale_min, b.length_scale_max}},
                      {"signal_variance", {b.signal_variance_min, b.signal_variance_max}},
                      {"noise_variance", {b.noise_variance_min, b.noise_variance_max}}};

@@ -126,14 +126,6 @@ std::vector<int> likelihood_rows(const std::vector<int>& train_rows, int count, 
   return rows;
 }
 
-KernelHyperparameters hyperparameters_of(const TrainedModel& m) {
-  KernelHyperparameters h;
-  h.length_scales = m.length_scales;
-  h.signal_variance = m.signal_variance[0];
-  h.noise_variance = m.noise_variance[0];
-  return h;
-}
-
 // The GP's likelihood on the identification rows for one hysteresis model.
 // Inputs and outputs are normalised once, by the commanded rows, for every
 // candidate: the likelihood of outputs scaled differently would not compare.
@@ -333,7 +325,7 @@ HysteresisIdentification identify_hysteresis(const dataset::Dataset& data, const
   const TrainingSet commanded_train =
       make_training_set(data, geometry, training_options.encoding, with_payload).subset(train_rows);
   result.joints_only = train(commanded_train, geometry, training_options, &result.joints_only_report);
-  const KernelHyperparameters joints_only_h = hyperparameters_of(result.joints_only);
+  const KernelHyperparameters joints_only_h = shared_hyperparameters(result.joints_only);
 
   Likelihood likelihood(data, likelihood_rows(train_rows, options.max_rows, training_options.search.seed), geometry,
                         training_options.encoding, with_payload);

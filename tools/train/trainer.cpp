@@ -52,8 +52,6 @@ Eigen::MatrixXd normalise(const Eigen::MatrixXd& m, const Eigen::VectorXd& mean,
   return (m.rowwise() - mean.transpose()).array().rowwise() / scale.transpose().array();
 }
 
-namespace {
-
 KernelHyperparameters shared_hyperparameters(const TrainedModel& model) {
   KernelHyperparameters h;
   h.length_scales = model.length_scales;
@@ -61,6 +59,8 @@ KernelHyperparameters shared_hyperparameters(const TrainedModel& model) {
   h.noise_variance = model.noise_variance[0];
   return h;
 }
+
+namespace {
 
 // Normalised rows back to the model's input units, the way the image
 // stores its points.

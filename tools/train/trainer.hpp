@@ -61,6 +61,9 @@ struct Normalisation {
 Normalisation normalisation_of(const TrainingSet& set);
 Eigen::MatrixXd normalise(const Eigen::MatrixXd& m, const Eigen::VectorXd& mean, const Eigen::VectorXd& scale);
 
+// A shared-hyperparameter model's kernel (the first output's variances).
+KernelHyperparameters shared_hyperparameters(const TrainedModel& model);
+
 // Shared hyperparameters only (throws std::invalid_argument otherwise). The
 // model's kind and points follow select_model() for the rows of `set`.
 TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& geometry,

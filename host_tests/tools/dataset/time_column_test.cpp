@@ -1,7 +1,7 @@
 // The dataset CSV's time column: a file that starts with t_s is a motion
 // sequence (rows in the order the robot moved through them), split into
-// sessions at pauses longer than kSessionGapSeconds; what the reader refuses,
-// and that the writer writes the time back.
+// sessions at pauses longer than kSessionGapSeconds, and that the writer
+// writes the time back. The reader's refusals are in csv_dataset_test.cpp.
 
 #include <string>
 #include <vector>
@@ -9,12 +9,10 @@
 #include <gtest/gtest.h>
 
 #include "dataset/csv_dataset.hpp"
-#include "rejection_case.hpp"
 
 namespace {
 
 using namespace cdcr::dataset;  // the reader and writer under test
-using BadCsv = cdcr::test_support::RejectionCase;
 
 const std::string kTimeCables = "t_s,l1_1,l1_2,l1_3,l1_4\n";
 const std::string kTimePoses = "t_s,l1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy,qz\n";
@@ -55,44 +53,6 @@ TEST(DatasetTimeColumn, AGapLongerThanTheThresholdStartsASession) {
   EXPECT_EQ(data.session_starts, (std::vector<int>{0, 3, 5}));
   EXPECT_EQ(session_starts_from_times(data.time_s), data.session_starts);
 }
-
-class DatasetTimeRejects : public testing::TestWithParam<BadCsv> {};
-
-TEST_P(DatasetTimeRejects, WithOneLineNamingTheLine) {
-  const BadCsv& c = GetParam();
-  const DatasetError e = cdcr::test_support::refusal([&] { parse_dataset_csv(c.text); }, c.text);
-  cdcr::test_support::expect_refusal_matches(e, c);
-  EXPECT_EQ(std::string(e.what()).find_first_of("\r\n"), std::string::npos);
-}
-
-INSTANTIATE_TEST_SUITE_P(
-    Time, DatasetTimeRejects,
-    testing::Values(
-        BadCsv{"going_back", kTimeCables + "1,1,2,3,4\n# a comment\n2,1,2,3,4\n1.5,1,2,3,4\n", 5,
-               "line 5: column t_s: '1.5' is not after the previous row's '2'; the time of a motion sequence must "
-               "strictly increase"},
-        BadCsv{"repeated", kTimeCables + "1,1,2,3,4\n1.0,1,2,3,4\n", 3,
-               "line 3: column t_s: '1.0' is not after the previous row's '1'; the time of a motion sequence must "
-               "strictly increase"},
-        BadCsv{"nan", kTimeCables + "nan,1,2,3,4\n", 2, "line 2: column t_s: 'nan' is NaN or Inf"},
-        BadCsv{"empty", kTimeCables + ",1,2,3,4\n", 2, "line 2: column t_s: empty field"},
-        BadCsv{"missing_field", kTimeCables + "1,2,3,4\n", 2, "line 2: expected 5 fields, found 4"},
-        BadCsv{"with_payload", "t_s,l1_1,l1_2,l1_3,l1_4,payload_kg\n1,1,2,3,4,0.5\n", 1,
-               "line 1: a time column (t_s) together with a payload column (payload_kg) is not supported: record a "
-               "motion sequence without payload, or payload samples without time"},
-        BadCsv{"with_payload_and_poses", "t_s,l1_1,l1_2,l1_3,l1_4,payload_kg,x,y,z,qw,qx,qy,qz\n", 1,
-               "line 1: a time column (t_s) together with a payload column (payload_kg) is not supported: record a "
-               "motion sequence without payload, or payload samples without time"},
-        BadCsv{"after_the_cables", "l1_1,l1_2,l1_3,l1_4,t_s\n1,2,3,4,5\n", 1,
-               "line 1: header column 5 is 't_s', which belongs first, before the cable columns"},
-        BadCsv{"after_the_poses", "l1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy,qz,t_s\n", 1,
-               "line 1: header column 12 is 't_s', which belongs first, before the cable columns"},
-        BadCsv{"twice", "t_s,t_s,l1_1,l1_2,l1_3,l1_4\n", 1,
-               "line 1: header column 2 is 't_s', which belongs first, before the cable columns"},
-        BadCsv{"alone", "t_s\n1\n", 1,
-               "line 1: header must start with t_s, then cable columns l1_1,l1_2,l1_3,l1_4,... (a multiple of 4), "
-               "found 0"}),
-    cdcr::test_support::rejection_case_name);
 
 Dataset sequence(const std::vector<double>& times) {
   Dataset data;

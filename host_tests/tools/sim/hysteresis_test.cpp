@@ -15,6 +15,7 @@
 #include <cdcr/model/hysteresis.hpp>
 
 #include "sim/data_collection.hpp"
+#include "mean_error_bounds.hpp"
 #include "sim_test_types.hpp"
 
 namespace cdcr::sim {
@@ -274,10 +275,7 @@ TEST(SimulatorHysteresis, AnotherSessionIsTheSameRobotFromAnotherState) {
 TEST(SimulatorHysteresis, TheSessionNoiseFloorIsBelowAMillimetre) {
   SimulatedRobot robot(kPrototype, hysteresis_config(1, 0));
   const CollectionSummary summary = summarize(collect(robot, 700));
-  EXPECT_GT(summary.noise_floor.position_mm, 0.6);
-  EXPECT_LT(summary.noise_floor.position_mm, 0.8);
-  EXPECT_GT(summary.noise_floor.orientation_deg, 0.05);
-  EXPECT_LT(summary.noise_floor.orientation_deg, 0.25);
+  test_types::expect_mean_error_between(summary.noise_floor, 0.6, 0.8, 0.05, 0.25);
 }
 
 // Off (the default), the robot has no state and a session is what it was:

@@ -11,6 +11,8 @@
 
 #include "sim/data_collection.hpp"
 
+#include "mean_error_bounds.hpp"
+
 namespace cdcr::sim {
 namespace {
 
@@ -78,10 +80,7 @@ TEST(SimulatorNoise, NoNoiseNoFloor) {
 TEST(SimulatorNoise, DefaultFloorIsAFewMillimetres) {
   SimulatedRobot robot(kPrototype, SimulatorConfig{});
   const CollectionSummary summary = summarize(collect(robot, 750));
-  EXPECT_GT(summary.noise_floor.position_mm, 1.0);
-  EXPECT_LT(summary.noise_floor.position_mm, 4.0);
-  EXPECT_GT(summary.noise_floor.orientation_deg, 0.2);
-  EXPECT_LT(summary.noise_floor.orientation_deg, 1.0);
+  test_types::expect_mean_error_between(summary.noise_floor, 1.0, 4.0, 0.2, 1.0);
 }
 
 }  // namespace

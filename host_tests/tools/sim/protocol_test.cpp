@@ -14,6 +14,8 @@
 
 #include "sim/data_collection.hpp"
 
+#include "mean_error_bounds.hpp"
+
 namespace cdcr::sim {
 namespace {
 
@@ -29,10 +31,7 @@ TEST(SimulatorProtocol, DefaultRobotsShowTable2sInitialError) {
     SCOPED_TRACE(testing::Message() << "seed " << seed << ": " << summary.initial.position_mm << " mm, "
                                     << summary.initial.orientation_deg << " deg");
     EXPECT_EQ(summary.samples, 750);
-    EXPECT_GT(summary.initial.position_mm, 35.0);
-    EXPECT_LT(summary.initial.position_mm, 70.0);
-    EXPECT_GT(summary.initial.orientation_deg, 7.0);
-    EXPECT_LT(summary.initial.orientation_deg, 15.0);
+    test_types::expect_mean_error_between(summary.initial, 35.0, 70.0, 7.0, 15.0);
   }
 }
 

@@ -24,6 +24,17 @@ std::string text_of(const std::string& path) {
   return std::string(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
 }
 
+// The message the command refuses `options` with; fails the test if it runs.
+std::string refusal(const SimulateCommandOptions& options) {
+  try {
+    run_simulate(options);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "accepted";
+  return "";
+}
+
 TEST(SimulateHysteresis, WritesAMotionSequence) {
   SimulateCommandOptions options;
   options.samples = 25;
@@ -46,14 +57,9 @@ TEST(SimulateHysteresis, RefusesAPayloadWithTheSequence) {
   options.samples = 5;
   options.hysteresis = true;
   options.payload_range_kg = "0,1";
-  try {
-    run_simulate(options);
-    FAIL() << "accepted";
-  } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(),
-                 "--hysteresis records a motion sequence (a t_s column), which cannot carry a payload column: drop "
-                 "--payload-range");
-  }
+  EXPECT_EQ(refusal(options),
+            "--hysteresis records a motion sequence (a t_s column), which cannot carry a payload column: drop "
+            "--payload-range");
 }
 
 TEST(SimulateHysteresis, TheLagRangeNeedsTheHysteresisAndAnOrderedRange) {
@@ -63,12 +69,7 @@ TEST(SimulateHysteresis, TheLagRangeNeedsTheHysteresisAndAnOrderedRange) {
   EXPECT_THROW(run_simulate(options), InputError);
   options.hysteresis = true;
   options.hysteresis_lag_mm = "0.7,0.4";
-  try {
-    run_simulate(options);
-    FAIL() << "accepted";
-  } catch (const InputError& e) {
-    EXPECT_STREQ(e.what(), "--hysteresis-lag must satisfy 0 <= LO <= HI (got 0.7, 0.4 mm)");
-  }
+  EXPECT_EQ(refusal(options), "--hysteresis-lag must satisfy 0 <= LO <= HI (got 0.7, 0.4 mm)");
   // No friction, no memory: the tip is where the same commands put it without it.
   options.hysteresis_lag_mm = "0,0";
   options.json = true;

@@ -15,6 +15,7 @@
 
 #include "train/gaussian_process.hpp"
 #include "train/hyperparameter_search.hpp"
+#include "train/json_rows.hpp"
 
 namespace cdcr::training {
 namespace {
@@ -47,21 +48,11 @@ Problem make_problem() {
   return p;
 }
 
-nlohmann::json rows(const Eigen::MatrixXd& m) {
-  nlohmann::json j = nlohmann::json::array();
-  for (Eigen::Index i = 0; i < m.rows(); ++i) {
-    std::vector<double> row(static_cast<std::size_t>(m.cols()));
-    for (Eigen::Index k = 0; k < m.cols(); ++k) row[static_cast<std::size_t>(k)] = m(i, k);
-    j.push_back(row);
-  }
-  return j;
-}
-
 nlohmann::json run_sklearn(const Problem& p) {
   nlohmann::json request;
-  request["x"] = rows(p.x);
-  request["y"] = rows(p.y);
-  request["queries"] = rows(p.queries);
+  request["x"] = json_rows(p.x);
+  request["y"] = json_rows(p.y);
+  request["queries"] = json_rows(p.queries);
   request["length_scales"] = std::vector<double>(p.h.length_scales.data(), p.h.length_scales.data() + 3);
   request["signal_variance"] = p.h.signal_variance;
   request["noise_variance"] = p.h.noise_variance;

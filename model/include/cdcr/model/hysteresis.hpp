@@ -124,35 +124,36 @@ struct HysteresisState {
   }
 };
 
-// Power-up: nothing known; each lag anywhere within its width.
-template <typename S>
-void reset_unknown(HysteresisState<S>& state, const HysteresisModel<S>& model) {
+// What both resets share: the model's dimensions, no position yet, and each
+// operator's lag interval set to lag_interval(c, k, low, high).
+template <typename S, typename LagInterval>
+void reset_hysteresis_state(HysteresisState<S>& state, const HysteresisModel<S>& model, LagInterval lag_interval) {
   state.cables = model.cables;
   state.operators = model.operators;
   state.has_position = false;
   for (int c = 0; c < model.cables; ++c) {
     state.commanded_mm[c] = S(0);
-    for (int k = 0; k < model.operators; ++k) {
-      state.lag_low_mm[c][k] = -model.widths_mm[c][k];
-      state.lag_high_mm[c][k] = model.widths_mm[c][k];
-    }
+    for (int k = 0; k < model.operators; ++k) lag_interval(c, k, state.lag_low_mm[c][k], state.lag_high_mm[c][k]);
   }
+}
+
+// Power-up: nothing known; each lag anywhere within its width.
+template <typename S>
+void reset_unknown(HysteresisState<S>& state, const HysteresisModel<S>& model) {
+  reset_hysteresis_state(state, model, [&model](int c, int k, S& low, S& high) {
+    low = -model.widths_mm[c][k];
+    high = model.widths_mm[c][k];
+  });
 }
 
 // The robot has just completed the homing move: every lag is the model's
 // homing lag. The next commanded lengths (update) set the position.
 template <typename S>
 void reset_to_homing(HysteresisState<S>& state, const HysteresisModel<S>& model) {
-  state.cables = model.cables;
-  state.operators = model.operators;
-  state.has_position = false;
-  for (int c = 0; c < model.cables; ++c) {
-    state.commanded_mm[c] = S(0);
-    for (int k = 0; k < model.operators; ++k) {
-      state.lag_low_mm[c][k] = model.homing_lag_mm[c][k];
-      state.lag_high_mm[c][k] = model.homing_lag_mm[c][k];
-    }
-  }
+  reset_hysteresis_state(state, model, [&model](int c, int k, S& low, S& high) {
+    low = model.homing_lag_mm[c][k];
+    high = model.homing_lag_mm[c][k];
+  });
 }
 
 // Moves every cable to `commanded_mm` (the drives' lengths, one per cable) in
