@@ -70,6 +70,11 @@ SESSION_ROWS = (700, 200)
 BOUC_WEN_STEP_MM = 0.05
 CABLE_SPEED_MM_PER_S = 15.0
 DWELL_S = 0.4
+GRAVITY_M_PER_S2 = 9.81
+# Newton millimetres per radian per segment: the first kilogram at the tip
+# sags the straight robot's tip by 55 to 75 mm (the simulator's 75 mm).
+PAYLOAD_STIFFNESS_N_MM_PER_RAD = (35000.0, 48000.0)
+PAYLOAD_ITERATIONS = 100
 
 
 # --- constant-curvature kinematics (shared/notes/kinematics-conventions.md) ---
@@ -232,6 +237,11 @@ class Robot:
         a = (1.0 - reversal_slope) / (2.0 * beta_share)
         beta_plus_gamma = a / max_lag ** n
         self.friction_parameters = (a, beta_share * beta_plus_gamma, (1.0 - beta_share) * beta_plus_gamma, n)
+        # The segments' bending stiffness under a payload, from a stream of its
+        # own so the robot without payload stays the one it always was.
+        stiffness_rng = np.random.default_rng([seed, 1001])
+        stiffness = stiffness_rng.uniform(*PAYLOAD_STIFFNESS_N_MM_PER_RAD, SEGMENTS)
+        self.compliance_rad_per_n_mm = scale / stiffness
 
     def new_friction(self, rng):
         """The friction state at power-up: anywhere within each cable's range."""
@@ -239,9 +249,11 @@ class Robot:
         friction.z = rng.uniform(-1.0, 1.0, friction.a.shape) * friction.max_lag_mm()
         return friction
 
-    def true_pose(self, effective_mm, bend_noise):
-        """The platform's pose in the motion-capture base frame for the lengths that bend the segments."""
+    def _end_disk(self, effective_mm, bend_noise, payload_bends=None):
+        """The end disk's pose, each segment's base frame and commanded bend angle; payload_bends (rad, per
+        segment) are added to the achieved bends when given."""
         pose = self.base.copy()
+        bases, thetas = [], []
         for i in range(SEGMENTS):
             alpha, theta = joints_from_cables(effective_mm[4 * i:4 * i + 4], self.radius_mm[i])
             bend = theta * np.array([math.cos(alpha + self.anchor_offset_rad[i]),
@@ -252,9 +264,52 @@ class Robot:
             carried = (SEGMENTS - i) / SEGMENTS
             bend = bend + self.sag_rad[i] * carried * (1.0 + 1.5 * theta / WORKSPACE_THETA_MAX_RAD) * local_gravity[:2]
             bend = bend + bend_noise[i]
+            if payload_bends is not None:
+                bend = bend + payload_bends[i]
+            bases.append(pose)
+            thetas.append(theta)
             pose = pose @ segment_transform(math.atan2(bend[1], bend[0]), float(np.hypot(*bend)), self.length_mm[i])
             pose = pose @ transform(rotation(np.array([0.0, 0.0, 1.0]), self.twist_rad[i]), np.zeros(3))
+        return pose, bases, thetas
+
+    def payload_bends(self, end_disk, bases, thetas, payload_kg):
+        """Each segment's further bend under the payload hanging at the end disk: the weight's moment about the
+        segment's base over its bending compliance, which grows by half from straight to the workspace's
+        largest bend (the same softening as the sag of its own weight, milder)."""
+        force_n = payload_kg * GRAVITY_M_PER_S2 * self.gravity
+        bends = np.zeros((SEGMENTS, 2))
+        for i in range(SEGMENTS):
+            moment = np.cross(end_disk[:3, 3] - bases[i][:3, 3], force_n)
+            local = bases[i][:3, :3].T @ moment
+            # A rotation vector (kx, ky, 0) is the bend (theta cos a, theta sin a) = (ky, -kx).
+            softening = 1.0 + 0.5 * thetas[i] / WORKSPACE_THETA_MAX_RAD
+            bends[i] = np.array([local[1], -local[0]]) * self.compliance_rad_per_n_mm[i] * softening
+        return bends
+
+    def true_pose(self, effective_mm, bend_noise, payload_kg=0.0):
+        """The platform's pose in the motion-capture base frame for the lengths that bend the segments, carrying
+        payload_kg at the end disk. The payload's sag moves its own lever arms: a fixed-point iteration."""
+        if not (math.isfinite(payload_kg) and payload_kg >= 0.0):
+            raise ValueError("payload must be finite and not negative (got {} kg)".format(payload_kg))
+        pose, bases, thetas = self._end_disk(effective_mm, bend_noise)
+        if payload_kg > 0.0:
+            extra = np.zeros((SEGMENTS, 2))
+            for _ in range(PAYLOAD_ITERATIONS):
+                following = self.payload_bends(pose, bases, thetas, payload_kg)
+                change = np.abs(following - extra).max()
+                extra = following
+                pose, bases, thetas = self._end_disk(effective_mm, bend_noise, extra)
+                if change < 1e-12:
+                    break
+            else:
+                raise RuntimeError("payload sag does not converge: {} kg is too heavy for this robot".format(payload_kg))
         return pose @ self.marker
+
+    def straight_sag_mm(self, payload_kg=1.0):
+        """How far payload_kg moves the tip of the straight robot (no noise): its first kilogram's sag."""
+        home = np.full(4 * SEGMENTS, NOMINAL_LENGTH_MM)
+        still = np.zeros((SEGMENTS, 2))
+        return float(np.linalg.norm(self.true_pose(home, still, payload_kg)[:3, 3] - self.true_pose(home, still)[:3, 3]))
 
 
 def random_configuration(rng):
@@ -263,9 +318,13 @@ def random_configuration(rng):
     return np.concatenate([cable_lengths(a, t, NOMINAL_LENGTH_MM, NOMINAL_RADIUS_MM) for a, t in zip(alphas, thetas)])
 
 
-def record_session(robot, seed, session, rows, position_noise_mm=0.1, orientation_noise_deg=0.05):
-    """One session's rows and figures: power-up, homing, then `rows` configurations in sequence."""
+def record_session(robot, seed, session, rows, position_noise_mm=0.1, orientation_noise_deg=0.05,
+                   payload_range_kg=None):
+    """One session's rows and figures: power-up, homing, then `rows` configurations in sequence. With
+    payload_range_kg (lo, hi) every row carries a payload uniform in it, from a stream of its own (the
+    configurations and the noise stay those of the session without it)."""
     rng = np.random.default_rng([seed, session])
+    payload_rng = np.random.default_rng([seed, session, 2000])
     friction = robot.new_friction(rng)
     # Power-up where the last session left the robot, then the homing move.
     commanded = random_configuration(rng)
@@ -275,7 +334,7 @@ def record_session(robot, seed, session, rows, position_noise_mm=0.1, orientatio
             friction.move(commanded, waypoint)
         commanded = waypoint
     out = {"t_s": [], "cables": [], "effective": [], "measured": [], "true": [], "repeatable": [],
-           "without_hysteresis": []}
+           "without_hysteresis": [], "payload_kg": [], "without_payload": []}
     t = 0.0
     noise_scale = 0.0 if robot.ideal else 1.0
     for _ in range(rows):
@@ -284,7 +343,8 @@ def record_session(robot, seed, session, rows, position_noise_mm=0.1, orientatio
         t += np.abs(target - commanded).max() / CABLE_SPEED_MM_PER_S + DWELL_S * rng.uniform(0.8, 1.2)
         commanded = target
         bend_noise = rng.normal(0.0, robot.repeatability_rad, (SEGMENTS, 2))
-        true = robot.true_pose(effective, bend_noise)
+        payload = 0.0 if payload_range_kg is None else float(payload_rng.uniform(*payload_range_kg))
+        true = robot.true_pose(effective, bend_noise, payload)
         measured = true.copy()
         measured[:3, 3] += noise_scale * rng.normal(0.0, position_noise_mm, 3)
         measured[:3, :3] = measured[:3, :3] @ small_rotation(rng, noise_scale * math.radians(orientation_noise_deg))
@@ -293,8 +353,10 @@ def record_session(robot, seed, session, rows, position_noise_mm=0.1, orientatio
         out["effective"].append(effective.copy())
         out["measured"].append(measured)
         out["true"].append(true)
-        out["repeatable"].append(robot.true_pose(effective, np.zeros((SEGMENTS, 2))))
-        out["without_hysteresis"].append(robot.true_pose(commanded, bend_noise))
+        out["repeatable"].append(robot.true_pose(effective, np.zeros((SEGMENTS, 2)), payload))
+        out["without_hysteresis"].append(robot.true_pose(commanded, bend_noise, payload))
+        out["payload_kg"].append(payload)
+        out["without_payload"].append(robot.true_pose(effective, bend_noise) if payload > 0.0 else true)
     return out
 
 
@@ -304,20 +366,26 @@ def mean_errors(poses_a, poses_b):
     return float(np.mean(position)), float(np.mean(orientation)), float(np.max(position))
 
 
-def write_csv(path, data, seed, session, robot, cables="cables"):
-    names = ["t_s"] + ["l{}_{}".format(i + 1, j + 1) for i in range(SEGMENTS) for j in range(4)]
-    names += ["x", "y", "z", "qw", "qx", "qy", "qz"]
+def write_csv(path, data, seed, session, robot, cables="cables", payload=False):
+    """The dataset CSV: t_s, cables, pose; with payload the rows are independent samples (the project takes no
+    time column with a payload column): cables, payload_kg, pose."""
+    names = ([] if payload else ["t_s"]) + ["l{}_{}".format(i + 1, j + 1) for i in range(SEGMENTS) for j in range(4)]
+    names += (["payload_kg"] if payload else []) + ["x", "y", "z", "qw", "qx", "qy", "qz"]
     with open(path, "w") as f:
         f.write("# independent robot (tools/bench/independent_robot.py): seed {}, session {}\n".format(seed, session))
         f.write("# nominal geometry: {} segments, L = {} mm, r = {} mm\n".format(
             SEGMENTS, NOMINAL_LENGTH_MM, NOMINAL_RADIUS_MM))
-        f.write("# rows are a motion sequence after the homing move; t_s in seconds\n")
+        if payload:
+            f.write("# rows are independent samples, each with its tip payload in kg\n")
+        else:
+            f.write("# rows are a motion sequence after the homing move; t_s in seconds\n")
         f.write("# hysteresis: {}\n".format("Bouc-Wen per cable" if robot.hysteresis else "off"))
         if cables == "effective":
             f.write("# cable columns: the effective lengths (commanded less the friction's lag), for reference\n")
         f.write(",".join(names) + "\n")
-        for t, lengths, pose in zip(data["t_s"], data[cables], data["measured"]):
-            values = ["{:.3f}".format(t)] + ["{:.6f}".format(c) for c in lengths]
+        for t, lengths, mass, pose in zip(data["t_s"], data[cables], data["payload_kg"], data["measured"]):
+            values = ([] if payload else ["{:.3f}".format(t)]) + ["{:.6f}".format(c) for c in lengths]
+            values += ["{:.6f}".format(mass)] if payload else []
             values += ["{:.6f}".format(v) for v in pose[:3, 3]] + ["{:.8f}".format(v) for v in quaternion(pose[:3, :3])]
             f.write(",".join(values) + "\n")
 
@@ -333,7 +401,23 @@ def main(argv=None):
     parser.add_argument("--effective", action="store_true",
                         help="also write sessionK.effective.csv: the effective cable lengths (what a model that "
                              "knew the friction exactly would see) in place of the commanded ones")
+    parser.add_argument("--payload-range", metavar="LO,HI",
+                        help="every row carries a tip payload uniform in [LO, HI] kg, written as payload_kg; the "
+                             "rows are then independent samples without t_s and without cable friction")
     args = parser.parse_args(argv)
+    payload_range = None
+    if args.payload_range is not None:
+        try:
+            payload_range = [float(v) for v in args.payload_range.split(",")]
+        except ValueError:
+            payload_range = []
+        if len(payload_range) != 2 or not all(math.isfinite(v) for v in payload_range) \
+                or not 0.0 <= payload_range[0] <= payload_range[1]:
+            sys.exit("independent_robot.py: error: --payload-range takes LO,HI in kg with 0 <= LO <= HI, "
+                     "not '{}'".format(args.payload_range))
+        if args.effective:
+            sys.exit("independent_robot.py: error: --effective has no meaning with --payload-range "
+                     "(payload rows have no cable friction)")
     try:
         rows = [int(v) for v in args.rows.split(",")]
     except ValueError:
@@ -342,15 +426,18 @@ def main(argv=None):
         sys.exit("independent_robot.py: error: --rows takes two positive counts, e.g. 700,200, not '{}'".format(args.rows))
     os.makedirs(args.out_dir, exist_ok=True)
 
-    robot = Robot(args.seed, hysteresis=not args.no_hysteresis)
+    robot = Robot(args.seed, hysteresis=not args.no_hysteresis and payload_range is None)
     report = {"seed": args.seed, "hysteresis": robot.hysteresis,
               "max_lag_mm": {"min": float(robot.new_friction(np.random.default_rng(0)).max_lag_mm().min()),
                              "max": float(robot.new_friction(np.random.default_rng(0)).max_lag_mm().max())},
               "sessions": []}
+    if payload_range is not None:
+        report["payload_range_kg"] = payload_range
+        report["straight_tip_sag_mm_first_kg"] = robot.straight_sag_mm(1.0)
     for session, count in enumerate(rows):
-        data = record_session(robot, args.seed, session, count)
+        data = record_session(robot, args.seed, session, count, payload_range_kg=payload_range)
         path = os.path.join(args.out_dir, "session{}.csv".format(session))
-        write_csv(path, data, args.seed, session, robot)
+        write_csv(path, data, args.seed, session, robot, payload=payload_range is not None)
         if args.effective:
             write_csv(os.path.join(args.out_dir, "session{}.effective.csv".format(session)), data, args.seed, session,
                       robot, cables="effective")
@@ -366,6 +453,10 @@ def main(argv=None):
             "hysteresis_tip_movement_mm": {"mean": effect[0], "max": effect[2], "orientation_deg": effect[1]},
             "nominal_error": {"position_mm": initial[0], "orientation_deg": initial[1]},
         })
+        if payload_range is not None:
+            moved = mean_errors(data["true"], data["without_payload"])
+            report["sessions"][-1]["payload_tip_movement_mm"] = {"mean": moved[0], "max": moved[2],
+                                                                 "orientation_deg": moved[1]}
     if args.report:
         with open(args.report, "w") as f:
             json.dump(report, f)
@@ -374,6 +465,9 @@ def main(argv=None):
     else:
         print("independent robot, seed {}: cable friction {} (largest lag per cable {:.2f} to {:.2f} mm)".format(
             args.seed, "Bouc-Wen" if robot.hysteresis else "off", report["max_lag_mm"]["min"], report["max_lag_mm"]["max"]))
+        if payload_range is not None:
+            print("  tip payload {:g} to {:g} kg per row; the first kg sags the straight tip {:.1f} mm".format(
+                payload_range[0], payload_range[1], report["straight_tip_sag_mm_first_kg"]))
         for s in report["sessions"]:
             print("  session {} ({} rows) -> {}".format(s["session"], s["rows"], s["file"]))
             print("    noise floor          {:.3f} mm / {:.4f} deg".format(
@@ -384,6 +478,9 @@ def main(argv=None):
                 s["hysteresis_tip_movement_mm"]["mean"], s["hysteresis_tip_movement_mm"]["max"]))
             print("    nominal model error  {:.3f} mm / {:.4f} deg".format(
                 s["nominal_error"]["position_mm"], s["nominal_error"]["orientation_deg"]))
+            if "payload_tip_movement_mm" in s:
+                print("    payload moves tip    {:.3f} mm mean, {:.3f} mm max".format(
+                    s["payload_tip_movement_mm"]["mean"], s["payload_tip_movement_mm"]["max"]))
     return 0
 
 
