@@ -49,6 +49,18 @@ robot's repeatable ones: what no model can predict, as the simulator
 defines it), the motion capture's share alone (true against measured poses),
 the tip movement the hysteresis causes (the true poses against the same
 commands without friction) and the nominal model's error.
+
+Payload mode (--payload-range LO,HI): every row carries a tip payload drawn
+uniform in [LO, HI] kg (a stream of its own: the configurations and noise are
+those of the session without it), and each segment bends further by the
+payload's weight moment about its base over the segment's bending stiffness
+(35 to 48 N m/rad per segment, drawn per seed from a stream of its own),
+softening by half from straight to the workspace's largest bend; the sag
+moves its own lever arms, solved by fixed-point iteration. The first
+kilogram sags the straight robot's tip by 60 to 77 mm. The rows are then
+independent samples without cable friction, written as cables, payload_kg,
+pose (no t_s: the project takes no time column with a payload). Zero
+payload is the robot without one, bit for bit.
 Only numpy; deterministic from the seed.
 """
 
@@ -72,7 +84,7 @@ CABLE_SPEED_MM_PER_S = 15.0
 DWELL_S = 0.4
 GRAVITY_M_PER_S2 = 9.81
 # Newton millimetres per radian per segment: the first kilogram at the tip
-# sags the straight robot's tip by 55 to 75 mm (the simulator's 75 mm).
+# sags the straight robot's tip by 60 to 77 mm (the simulator's 75 mm).
 PAYLOAD_STIFFNESS_N_MM_PER_RAD = (35000.0, 48000.0)
 PAYLOAD_ITERATIONS = 100
 
@@ -286,24 +298,27 @@ class Robot:
             bends[i] = np.array([local[1], -local[0]]) * self.compliance_rad_per_n_mm[i] * softening
         return bends
 
-    def true_pose(self, effective_mm, bend_noise, payload_kg=0.0):
-        """The platform's pose in the motion-capture base frame for the lengths that bend the segments, carrying
-        payload_kg at the end disk. The payload's sag moves its own lever arms: a fixed-point iteration."""
+    def loaded_bends(self, effective_mm, bend_noise, payload_kg):
+        """The payload's further bends at equilibrium (None without payload): the sag moves its own lever arms,
+        so a fixed-point iteration from the unloaded shape."""
         if not (math.isfinite(payload_kg) and payload_kg >= 0.0):
             raise ValueError("payload must be finite and not negative (got {} kg)".format(payload_kg))
-        pose, bases, thetas = self._end_disk(effective_mm, bend_noise)
-        if payload_kg > 0.0:
-            extra = np.zeros((SEGMENTS, 2))
-            for _ in range(PAYLOAD_ITERATIONS):
-                following = self.payload_bends(pose, bases, thetas, payload_kg)
-                change = np.abs(following - extra).max()
-                extra = following
-                pose, bases, thetas = self._end_disk(effective_mm, bend_noise, extra)
-                if change < 1e-12:
-                    break
-            else:
-                raise RuntimeError("payload sag does not converge: {} kg is too heavy for this robot".format(payload_kg))
-        return pose @ self.marker
+        if payload_kg == 0.0:
+            return None
+        extra = np.zeros((SEGMENTS, 2))
+        for _ in range(PAYLOAD_ITERATIONS):
+            following = self.payload_bends(*self._end_disk(effective_mm, bend_noise, extra), payload_kg)
+            change = np.abs(following - extra).max()
+            extra = following
+            if change < 1e-12:
+                return extra
+        raise RuntimeError("payload sag does not converge: {} kg is too heavy for this robot".format(payload_kg))
+
+    def true_pose(self, effective_mm, bend_noise, payload_kg=0.0):
+        """The platform's pose in the motion-capture base frame for the lengths that bend the segments, carrying
+        payload_kg at the end disk."""
+        extra = self.loaded_bends(effective_mm, bend_noise, payload_kg)
+        return self._end_disk(effective_mm, bend_noise, extra)[0] @ self.marker
 
     def straight_sag_mm(self, payload_kg=1.0):
         """How far payload_kg moves the tip of the straight robot (no noise): its first kilogram's sag."""

@@ -7,7 +7,8 @@
 # column is a GP input) and `cdcr eval`. Prints the compensated test error
 # against the test session's noise floor (the measured poses against the
 # repeatable ones, as each robot defines it). Writes to
-# $BUILD_DIR/payload_bench/.
+# $BUILD_DIR/payload_bench/. A reference row: the independent robot without
+# payload.
 #
 #   bash tools/bench/run_payload_bench.sh [--seed S]
 set -euo pipefail
@@ -23,10 +24,11 @@ payload_range=0,1
 # evaluates and prints the compensated error against the floor.
 report() {
   local name=$1 train=$2 test=$3 floor_mm=$4 floor_deg=$5
+  local file=$work_dir/${name//[^a-z]/_}
   shift 5
-  "$cdcr" train --data "$train" --out "$work_dir/$name.img" "$@" >"$work_dir/$name.train.txt"
-  "$cdcr" eval --model "$work_dir/$name.img" --data "$test" --json >"$work_dir/$name.eval.json"
-  "$python" - "$work_dir/$name.eval.json" "$name" "$floor_mm" "$floor_deg" <<'PYTHON'
+  "$cdcr" train --data "$train" --out "$file.img" "$@" >"$file.train.txt"
+  "$cdcr" eval --model "$file.img" --data "$test" --json >"$file.eval.json"
+  "$python" - "$file.eval.json" "$name" "$floor_mm" "$floor_deg" <<'PYTHON'
 import json
 import sys
 
@@ -52,6 +54,21 @@ print(s["noise_floor"]["position_mm"], s["noise_floor"]["orientation_deg"])' "$w
 # The robot's nominal geometry, as independent_robot.py states it.
 report independent "$work_dir/independent/session0.csv" "$work_dir/independent/session1.csv" "$floor_mm" "$floor_deg" \
   --segments 4 --length 110 --radius 60
+
+# A reference: the same robot and configurations without payload (payload
+# 0 kg, its column dropped): the part of the gap the payload does not cause.
+"$python" tools/bench/independent_robot.py --seed "$seed" --out-dir "$work_dir/unloaded" --payload-range 0,0 \
+  --report "$work_dir/unloaded.json" >/dev/null
+for session in 0 1; do
+  awk -F, 'BEGIN { OFS = "," } /^#/ { print; next } { $17 = ""; sub(/,,/, ","); print }' \
+    "$work_dir/unloaded/session$session.csv" >"$work_dir/unloaded/no_payload$session.csv"
+done
+read -r floor_mm floor_deg < <("$python" -c '
+import json, sys
+s = json.load(open(sys.argv[1]))["sessions"][1]
+print(s["noise_floor"]["position_mm"], s["noise_floor"]["orientation_deg"])' "$work_dir/unloaded.json")
+report "(without payload)" "$work_dir/unloaded/no_payload0.csv" "$work_dir/unloaded/no_payload1.csv" \
+  "$floor_mm" "$floor_deg" --segments 4 --length 110 --radius 60
 
 echo
 echo "== the simulator (seed $seed), payload $payload_range kg =="

@@ -4,7 +4,10 @@ simulator's: its own kinematics against the paper's Table 1 (case 2, as the
 kinematics notes give it) and, when CDCR_CLI names the cdcr executable,
 against `cdcr fk`; its Bouc-Wen friction against the closed forms of its
 parameters; its homing move; that with every error off it is the nominal
-model; and that its files are deterministic and in the dataset format."""
+model; that its files are deterministic and in the dataset format; and the
+payload mode's physics (the sag grows with the payload, towards gravity, by
+the tens of millimetres per kilogram it states; zero payload is the robot
+without one)."""
 
 import csv
 import io
@@ -215,6 +218,96 @@ class Sessions(unittest.TestCase):
             largest = robot.Robot(3).new_friction(np.random.default_rng(0)).max_lag_mm()
             self.assertTrue(np.all(np.abs(lag) <= largest + 1e-6))
             self.assertGreater(np.abs(lag).max(), 0.2)
+
+
+# The pose of Robot(7) for one configuration and bend noise, as the robot
+# computed it before it had a payload mode: zero payload must stay that robot.
+UNLOADED_POSE_SEED7 = [[9.9032113596711513e-01, -4.5315843354544298e-02, 1.3118887909372989e-01, 3.1604772731061960e+01],
+                       [4.8697187168635921e-02, 9.9855604433366230e-01, -2.2680614775001474e-02, -4.8834979576617874e+00],
+                       [-1.2997165698207325e-01, 2.8849621588082904e-02, 9.9109791025688210e-01, 4.3876361096492394e+02]]
+
+
+class Payload(unittest.TestCase):
+    def configuration(self, seed):
+        return (robot.random_configuration(np.random.default_rng(seed)),
+                np.random.default_rng(seed + 1).normal(0.0, 0.001, (robot.SEGMENTS, 2)))
+
+    def test_zero_payload_is_the_robot_without_one(self):
+        r = robot.Robot(7)
+        cables, noise = self.configuration(11)
+        np.testing.assert_allclose(r.true_pose(cables, noise, 0.0)[:3], UNLOADED_POSE_SEED7, rtol=0.0, atol=1e-9)
+        np.testing.assert_array_equal(r.true_pose(cables, noise, 0.0), r.true_pose(cables, noise))
+
+    def test_sag_grows_with_the_payload_towards_gravity(self):
+        for seed in range(5):
+            r = robot.Robot(seed)
+            cables, noise = self.configuration(20 + seed)
+            unloaded = r.true_pose(cables, noise)[:3, 3]
+            previous = 0.0
+            for payload in (0.1, 0.25, 0.5, 1.0):
+                moved = r.true_pose(cables, noise, payload)[:3, 3] - unloaded
+                self.assertGreater(np.linalg.norm(moved), previous + 1.0, (seed, payload))
+                previous = np.linalg.norm(moved)
+                # Mostly along gravity: the weight pulls the tip down.
+                self.assertGreater(moved @ r.gravity, 0.7 * np.linalg.norm(moved), (seed, payload))
+
+    def test_loaded_bends_are_the_moments_over_the_stiffness_of_the_loaded_shape(self):
+        r = robot.Robot(5)
+        cables, noise = self.configuration(40)
+        extra = r.loaded_bends(cables, noise, 0.8)
+        self.assertGreater(np.abs(extra).max(), 0.02)
+        shape = r._end_disk(cables, noise, extra)
+        np.testing.assert_allclose(r.payload_bends(*shape, 0.8), extra, rtol=0.0, atol=1e-10)
+        np.testing.assert_array_equal(r.true_pose(cables, noise, 0.8), shape[0] @ r.marker)
+        self.assertIsNone(r.loaded_bends(cables, noise, 0.0))
+
+    def test_first_kilogram_sags_the_straight_tip_by_tens_of_mm(self):
+        for seed in range(10):
+            sag = robot.Robot(seed).straight_sag_mm(1.0)
+            self.assertGreater(sag, 50.0, seed)
+            self.assertLess(sag, 90.0, seed)
+            # Small loads are nearly linear: a tenth of a kilogram, about a tenth of the sag.
+            self.assertAlmostEqual(robot.Robot(seed).straight_sag_mm(0.1) / sag, 0.1, delta=0.02)
+        self.assertEqual(robot.Robot(3, ideal=True).straight_sag_mm(1.0), 0.0)
+        with self.assertRaises(ValueError):
+            robot.Robot(3).true_pose(np.full(16, 110.0), np.zeros((4, 2)), -0.1)
+
+    def read(self, path):
+        with open(path) as f:
+            table = list(csv.reader(line for line in f.read().splitlines() if not line.startswith("#")))
+        return table[0], table[1:]
+
+    def test_payload_files_in_the_dataset_format_and_zero_payload_as_without(self):
+        with tempfile.TemporaryDirectory() as loaded, tempfile.TemporaryDirectory() as zero, \
+                tempfile.TemporaryDirectory() as plain:
+            with redirect_stdout(io.StringIO()):
+                robot.main(["--out-dir", loaded, "--rows", "30,12", "--seed", "3", "--payload-range", "0.2,0.9"])
+                robot.main(["--out-dir", zero, "--rows", "30,12", "--seed", "3", "--payload-range", "0,0"])
+                robot.main(["--out-dir", plain, "--rows", "30,12", "--seed", "3", "--no-hysteresis"])
+            cables = ["l{}_{}".format(i, j) for i in range(1, 5) for j in range(1, 5)]
+            pose = ["x", "y", "z", "qw", "qx", "qy", "qz"]
+            for session, rows in ((0, 30), (1, 12)):
+                name = "session{}.csv".format(session)
+                header, table = self.read(os.path.join(loaded, name))
+                self.assertEqual(header, cables + ["payload_kg"] + pose)
+                values = np.array(table, dtype=float)
+                self.assertEqual(values.shape, (rows, 24))
+                self.assertTrue(np.all((values[:, 16] >= 0.2) & (values[:, 16] <= 0.9)))
+                self.assertGreater(np.ptp(values[:, 16]), 0.3)
+                # Zero payload: the robot without friction, bit for bit as printed,
+                # on the same configurations (the payload's stream is its own).
+                _, unloaded = self.read(os.path.join(zero, name))
+                _, without = self.read(os.path.join(plain, name))
+                self.assertEqual([row[:16] + row[17:] for row in unloaded], [row[1:] for row in without])
+                self.assertEqual([row[:16] for row in table], [row[1:17] for row in without])
+                self.assertTrue(all(float(row[16]) == 0.0 for row in unloaded))
+
+    def test_bad_payload_range_is_one_clear_error(self):
+        with tempfile.TemporaryDirectory() as directory:
+            for bad in ("1,0", "-0.1,1", "0", "a,b", "0,inf"):
+                with self.assertRaises(SystemExit) as exit_:
+                    robot.main(["--out-dir", directory, "--payload-range=" + bad])
+                self.assertIn("--payload-range", str(exit_.exception.code))
 
 
 if __name__ == "__main__":
