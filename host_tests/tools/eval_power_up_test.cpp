@@ -87,7 +87,8 @@ class EvalPowerUp : public ::testing::Test {
 
   // A motion sequence of `rows` rows, in two sessions if longer than 60 (the
   // second from row 60): the bend drifts and wanders, so every cable soon travels more than
-  // twice its widest operator in one direction. Poses: the model's own.
+  // twice its widest operator in one direction. Poses: the commanded
+  // lengths' compensated ones (only the radii are compared).
   fs::path write_sequence(const training::TrainedModel& m, int rows) const {
     const std::vector<std::uint8_t> image = exporting::write_image(m);
     model::ImageView view{};
