@@ -205,8 +205,9 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     if (o.from_power_up) {
       output.text += fmt::format(
           "  hysteresis           carried from row to row over {} session(s), the first from power-up (state unknown "
-          "for its first {} rows, r95 widened), the others from home\n",
-          std::max<std::size_t>(1, data.session_starts.size()), power_up.unknown_rows);
+          "for its first {} rows, r95 widened){}\n",
+          std::max<std::size_t>(1, data.session_starts.size()), power_up.unknown_rows,
+          data.session_starts.size() > 1 ? ", the others from home" : "");
       if (report_power_up) {
         output.text += fmt::format("  within r95, first {:3} rows {:6.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
                                    first_coverage.samples, 100.0 * first_coverage.position_coverage,
@@ -214,7 +215,7 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
                                    first_coverage.median_r95_deg);
       }
       if (report_power_up && rest_coverage.samples > 0) {
-        output.text += fmt::format("  within r95, later rows  {:6.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
+        output.text += fmt::format("  within r95, later rows  {:9.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
                                    100.0 * rest_coverage.position_coverage, 100.0 * rest_coverage.orientation_coverage,
                                    rest_coverage.median_r95_mm, rest_coverage.median_r95_deg);
       }
