@@ -85,8 +85,10 @@ void HysteresisTracker::commanded_for(Cables& cables_mm) const {
 
 // The bend of segment i follows its cables as u = (l3 - l1) / (2 r s),
 // w = (l2 - l4) / (2 r s) with s = sinc(theta / 2) (segment.hpp), so each
-// bend coordinate's variance is that of two cables over (2 r s)^2; the
-// spatial Jacobian in the bend moves the tip position p by v + omega x p.
+// bend coordinate's variance is that of a cable difference over (2 r s)^2,
+// the difference's the largest its bound u_a + u_b allows (the header says
+// why); the spatial Jacobian in the bend moves the tip position p by
+// v + omega x p.
 void HysteresisTracker::begin_variance(const RobotModel& model, const PoseEstimate& estimate) {
   widening_ = active_ && !known_;
   if (!widening_) return;
@@ -100,8 +102,8 @@ void HysteresisTracker::begin_variance(const RobotModel& model, const PoseEstima
     const Scalar lever = Scalar(2) * geometry.segments[s].anchor_radius_mm *
                          model::series::sinc(Scalar(0.5) * estimate.joints[2 * s + 1]);
     const Scalar* u = uncertainty_mm_.data() + 4 * s;
-    const Scalar bend_variance[2] = {(u[0] * u[0] + u[2] * u[2]) / (Scalar(3) * lever * lever),
-                                     (u[1] * u[1] + u[3] * u[3]) / (Scalar(3) * lever * lever)};
+    const Scalar bend_variance[2] = {(u[0] + u[2]) * (u[0] + u[2]) / (lever * lever),
+                                     (u[1] + u[3]) * (u[1] + u[3]) / (lever * lever)};
     for (int k = 0; k < 2; ++k) {
       const model::Vec3<Scalar> v = jacobian.col(2 * s + k).head<3>();
       const model::Vec3<Scalar> omega = jacobian.col(2 * s + k).tail<3>();

@@ -252,8 +252,10 @@ TEST_F(RuntimeHysteresisTest, Float32FidelityOverTwoHundredRowsAgainstDouble) {
 
 // r95 while the state is unknown, against the same radii computed here in
 // double: the GP's covariance as gp_uncertainty.hpp forms it, plus the
-// effective lengths' uniform errors (variance u^2 / 3 per cable) taken to
-// the tip by central differences of the runtime's own forward path.
+// effective lengths' errors taken to the tip by central differences of the
+// runtime's own forward path. The errors enter through the differences of
+// opposite cables (l3 - l1, l2 - l4), each with the largest variance its
+// bound allows: (u_a + u_b)^2.
 TEST_F(RuntimeHysteresisTest, R95IsWiderWhileTheStateIsUnknownByTheCablesUncertainty) {
   const training::TrainedModel m = hysteresis_model(32);
   boot_with(m);
@@ -299,19 +301,25 @@ TEST_F(RuntimeHysteresisTest, R95IsWiderWhileTheStateIsUnknownByTheCablesUncerta
   model::effective_lengths(runtime->hysteresis().state(), host_model, effective);
   const Cables& u = runtime->hysteresis().uncertainty_mm();
   constexpr float kStepMm = 0.05f;
-  for (int c = 0; c < 8; ++c) {
-    ASSERT_GT(u[c], 0.0f);
+  for (int c = 0; c < 8; ++c) ASSERT_GT(u[c], 0.0f);
+  // Per segment the pairs (l1, l3) and (l2, l4): their difference moves by
+  // 2 kStepMm either way (4 kStepMm from minus to plus), their mean stays.
+  const int pairs[4][2] = {{0, 2}, {1, 3}, {4, 6}, {5, 7}};
+  for (const auto& pair : pairs) {
+    const int a = pair[0], b = pair[1];
     Cables plus = effective, minus = effective;
-    plus[c] += kStepMm;
-    minus[c] -= kStepMm;
+    plus[b] += kStepMm;
+    plus[a] -= kStepMm;
+    minus[b] -= kStepMm;
+    minus[a] += kStepMm;
     PoseEstimate up, down;
     ASSERT_EQ(runtime->estimate_pose(plus, up), model::Status::ok);
     ASSERT_EQ(runtime->estimate_pose(minus, down), model::Status::ok);
-    const Eigen::Vector3d dp = (up.pose.position_mm - down.pose.position_mm).cast<double>() / (2.0 * kStepMm);
+    const Eigen::Vector3d dp = (up.pose.position_mm - down.pose.position_mm).cast<double>() / (4.0 * kStepMm);
     const Eigen::Matrix3d dr = (up.pose.rotation * down.pose.rotation.transpose()).cast<double>();
     const Eigen::Vector3d dw = Eigen::Vector3d(dr(2, 1) - dr(1, 2), dr(0, 2) - dr(2, 0), dr(1, 0) - dr(0, 1)) /
-                               (2.0 * 2.0 * kStepMm);
-    const double variance = double(u[c]) * u[c] / 3.0;
+                               (2.0 * 4.0 * kStepMm);
+    const double variance = (double(u[a]) + u[b]) * (double(u[a]) + u[b]);
     cable_position += variance * dp * dp.transpose();
     cable_rotation += variance * dw * dw.transpose();
   }

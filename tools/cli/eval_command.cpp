@@ -17,6 +17,7 @@
 #include "dataset_input.hpp"
 #include "image_input.hpp"
 #include "json_output.hpp"
+#include "power_up_estimates.hpp"
 #include "train/evaluation.hpp"
 #include "train/training_set.hpp"
 
@@ -28,7 +29,28 @@ struct EvalCommandOptions {
   std::string data_path;
   std::string rows_path;
   bool json = false;
+  // The first session starts at power-up with the hysteresis state unknown
+  // (no homing), as the board does; its first `first_rows` rows are
+  // reported apart.
+  bool from_power_up = false;
+  int first_rows = 20;
 };
+
+Json coverage_json(const training::CoverageCheck& c) {
+  return {{"rows", c.samples},
+          {"r95_mm", c.position_coverage},
+          {"r95_deg", c.orientation_coverage},
+          {"median_r95_mm", c.median_r95_mm},
+          {"median_r95_deg", c.median_r95_deg}};
+}
+
+// The coverage of rows [begin, end), or none for an empty range.
+training::CoverageCheck coverage_of(const std::vector<model::Pose<double>>& measured,
+                                    const std::vector<training::FirmwareEstimate>& estimates, int begin, int end) {
+  if (begin >= end) return training::CoverageCheck{};
+  return training::check_coverage({measured.begin() + begin, measured.begin() + end},
+                                   {estimates.begin() + begin, estimates.begin() + end});
+}
 
 // One line per sample: its bend angles, errors, radii and flags, for plots
 // and for checks that need the rows (written atomically).
@@ -85,8 +107,15 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
   }
   // A model of the cables' hysteresis needs the rows' order and sessions:
   // rows without a time column are independent samples.
+  if (o.from_power_up && !data.has_time) {
+    throw InputError(fmt::format("{}: --from-power-up needs a motion sequence (a t_s column), but the rows have no time",
+                                 o.data_path));
+  }
   model::HysteresisModel<float> hysteresis;
   const bool with_hysteresis = model::hysteresis_from_image(image.view, hysteresis);
+  if (o.from_power_up && !with_hysteresis) {
+    throw InputError(fmt::format("{}: --from-power-up needs an image with a hysteresis block", o.model_path));
+  }
   if (with_hysteresis && !data.has_time) {
     throw InputError(fmt::format("{}: the model compensates the cables' hysteresis and needs a motion sequence (a t_s "
                                  "column), but the rows have no time",
@@ -96,6 +125,7 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
   training::TrainingSet set;
   std::vector<model::Pose<double>> compensated;
   std::vector<training::FirmwareEstimate> estimates;
+  PowerUpEstimates power_up;
   try {
     set = training::make_training_set(data, geometry, image.view.encoding, payload_input);
     // The nominal (initial) error stays that of the commanded lengths.
@@ -104,6 +134,16 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     compensated =
         training::firmware_poses(image.view, cables_mm, training::FirmwareAccumulator::float64, set.payload_kg);
     estimates = training::firmware_estimates(image.view, cables_mm, set.payload_kg);
+    if (o.from_power_up) {
+      // The first session again, from power-up: the board's own path.
+      const Eigen::Index first_session_rows =
+          data.session_starts.size() > 1 ? data.session_starts[1] : set.cables_mm.rows();
+      power_up = estimates_from_power_up(image.view, set.cables_mm.topRows(first_session_rows));
+      for (std::size_t i = 0; i < power_up.estimates.size(); ++i) {
+        estimates[i] = power_up.estimates[i];
+        compensated[i] = power_up.estimates[i].pose;
+      }
+    }
   } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
   }
@@ -111,6 +151,10 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
   const training::MeanErrors after = training::mean_errors(set.measured, compensated);
   const bool has_variance = image.view.variance_rank > 0;
   const training::CoverageCheck coverage = training::check_coverage(set.measured, estimates);
+  const int first_rows = std::min(o.first_rows, set.size());
+  const training::CoverageCheck first_coverage = coverage_of(set.measured, estimates, 0, first_rows);
+  const training::CoverageCheck rest_coverage = coverage_of(set.measured, estimates, first_rows, set.size());
+  const bool report_power_up = o.from_power_up && has_variance;
 
   if (!o.rows_path.empty()) write_rows(o.rows_path, set, estimates);
 
@@ -123,7 +167,15 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     j["extrapolating"] = coverage.extrapolating;
     j["outside_range"] = coverage.outside_range;
     j["payload"] = payload_use;
-    j["hysteresis"] = with_hysteresis ? "carried over the sequence" : "none";
+    j["hysteresis"] = o.from_power_up     ? "carried over the sequence, the first session from power-up"
+                      : with_hysteresis ? "carried over the sequence"
+                                        : "none";
+    if (o.from_power_up) {
+      j["power_up"] = {{"unknown_rows", power_up.unknown_rows},
+                       {"first_rows", report_power_up ? coverage_json(first_coverage) : Json(nullptr)},
+                       {"later_rows", report_power_up && rest_coverage.samples > 0 ? coverage_json(rest_coverage)
+                                                                                 : Json(nullptr)}};
+    }
     if (has_variance) {
       j["coverage"] = {{"r95_mm", coverage.position_coverage},
                        {"r95_deg", coverage.orientation_coverage},
@@ -150,7 +202,24 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     }
     output.text += fmt::format("  extrapolating        {} of {} samples ({} outside the fitted input range)\n",
                                coverage.extrapolating, set.size(), coverage.outside_range);
-    if (with_hysteresis) {
+    if (o.from_power_up) {
+      output.text += fmt::format(
+          "  hysteresis           carried from row to row over {} session(s), the first from power-up (state unknown "
+          "for its first {} rows, r95 widened){}\n",
+          std::max<std::size_t>(1, data.session_starts.size()), power_up.unknown_rows,
+          data.session_starts.size() > 1 ? ", the others from home" : "");
+      if (report_power_up) {
+        output.text += fmt::format("  within r95, first {:3} rows {:6.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
+                                   first_coverage.samples, 100.0 * first_coverage.position_coverage,
+                                   100.0 * first_coverage.orientation_coverage, first_coverage.median_r95_mm,
+                                   first_coverage.median_r95_deg);
+      }
+      if (report_power_up && rest_coverage.samples > 0) {
+        output.text += fmt::format("  within r95, later rows  {:9.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
+                                   100.0 * rest_coverage.position_coverage, 100.0 * rest_coverage.orientation_coverage,
+                                   rest_coverage.median_r95_mm, rest_coverage.median_r95_deg);
+      }
+    } else if (with_hysteresis) {
       output.text += fmt::format("  hysteresis           carried from row to row over {} session(s), each from home\n",
                                  std::max<std::size_t>(1, data.session_starts.size()));
     }
@@ -173,6 +242,12 @@ void register_eval_command(CLI::App& app, CommandOutput& output) {
   command->add_option("--rows", o->rows_path,
                       "Also write one CSV line per sample: bend angles, errors, r95 radii, latent share and flags");
   command->add_flag("--json", o->json, "Print one JSON object");
+  command->add_flag("--from-power-up", o->from_power_up,
+                    "Start the first session at power-up with the hysteresis state unknown (no homing), widening r95 "
+                    "as the board does; needs a t_s column and a hysteresis image");
+  command->add_option("--first-rows", o->first_rows,
+                      "With --from-power-up: the rows whose r95 coverage is reported apart (default 20)")
+      ->check(CLI::Range(1, 1000000));
   command->callback([o, &output] { output = run_eval(*o); });
 }
 

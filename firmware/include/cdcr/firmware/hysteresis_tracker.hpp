@@ -9,9 +9,15 @@
 // becomes known once every cable has travelled twice its widest operator in
 // one direction, or at once with a HOMING frame (the robot has just ended
 // the homing move: model::start_at_home). While it is unknown the effective
-// lengths carry an error of up to +-u per cable (model::effective_lengths);
-// taken as uniform (variance u^2 / 3) and independent per cable, it reaches
-// the tip through the nominal kinematics' sensitivity to the cables, and its
+// lengths carry an error of up to +-u per cable (model::effective_lengths).
+// A segment bends with the differences of opposite cables (l3 - l1,
+// l2 - l4), whose errors are then bounded by u_1 + u_3 and u_2 + u_4; each
+// is given the largest variance its bound allows, (u_a + u_b)^2: a lag that
+// is unknown is mostly at one end of its interval after a move, not spread
+// over it, and opposite cables move in opposite directions, so their errors
+// add (a uniform, independent error per cable, u^2 / 3 each, covered about
+// 60 % of the rows while the state was unknown). It reaches the tip through
+// the nominal kinematics' sensitivity to the bend, and its
 // covariance is added to the GP's before the r95 radii are taken
 // (model::gaussian_radius_95), so the radii widen while the state is unknown
 // and are the GP's own, unchanged, once it is known.
