@@ -18,6 +18,7 @@
 #include "c_api_check.h"
 #include "export/image_writer.hpp"
 #include "train/predictive_variance.hpp"
+#include "../support/variance_block.hpp"
 #include "synthetic_trained_model.hpp"
 
 namespace cdcr::firmware {
@@ -142,9 +143,7 @@ TEST_F(CApiPose, PoseCarriesTheRadiiOfTheImagesVariance) {
   options.segments = 2;
   options.training_points = 40;
   training::TrainedModel m = test_support::synthetic_trained_model(options);
-  m.signal_variance.setConstant(m.signal_variance[0]);
-  m.noise_variance.setConstant(m.noise_variance[0]);
-  m.variance = training::fit_variance_factor(m, m.inputs, training::variance_points(m, m.inputs, 12, 1));
+  test_support::add_variance_block(m, 12);
   ASSERT_NO_FATAL_FAILURE(run_both(exporting::write_image(m), 12));
   const model::PoseUncertainty<Scalar> radii = runtime->estimate_uncertainty(expected);
   ASSERT_GT(radii.r95_mm, 0.0f);

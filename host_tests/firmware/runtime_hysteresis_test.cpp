@@ -19,6 +19,7 @@
 #include "cdcr/model/pose_error_summary.hpp"
 #include "runtime_test_fixture.hpp"
 #include "train/predictive_variance.hpp"
+#include "../support/variance_block.hpp"
 
 #include "../support/image_in_double.hpp"
 
@@ -34,11 +35,7 @@ training::TrainedModel hysteresis_model(int rank = 0) {
   training::TrainedModel m = test_support::small_correction_model(rank > 0 ? 200 : 5);
   std::mt19937 rng(11);
   m.hysteresis = test_support::synthetic_hysteresis(m.geometry, 2, rng);
-  if (rank > 0) {
-    m.signal_variance.setConstant(m.signal_variance[0]);
-    m.noise_variance.setConstant(m.noise_variance[0]);
-    m.variance = training::fit_variance_factor(m, m.inputs, training::variance_points(m, m.inputs, rank, 1));
-  }
+  if (rank > 0) test_support::add_variance_block(m, rank);
   return m;
 }
 

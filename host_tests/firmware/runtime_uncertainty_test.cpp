@@ -11,6 +11,7 @@
 
 #include "runtime_test_fixture.hpp"
 #include "train/predictive_variance.hpp"
+#include "../support/variance_block.hpp"
 
 namespace cdcr::firmware {
 namespace {
@@ -22,9 +23,7 @@ using test_support::RuntimeTest;
 // factor of `rank` points over its rows.
 std::vector<std::uint8_t> image_with_variance(int rank, double extrapolation_variance = 1.0, int points = 200) {
   training::TrainedModel m = test_support::small_correction_model(points);
-  m.signal_variance.setConstant(m.signal_variance[0]);
-  m.noise_variance.setConstant(m.noise_variance[0]);
-  m.variance = training::fit_variance_factor(m, m.inputs, training::variance_points(m, m.inputs, rank, 1));
+  test_support::add_variance_block(m, rank);
   m.variance.extrapolation_variance = extrapolation_variance;
   return exporting::write_image(m);
 }
@@ -195,12 +194,8 @@ class RefusalOutsideTheRange : public RuntimeUncertaintyTest, public ::testing::
 TEST_P(RefusalOutsideTheRange, ATargetThatRefusesExtrapolationIsRefusedOutsideTheFittedRange) {
   const int rank = GetParam();
   training::TrainedModel m = test_support::small_correction_model(200);
-  m.signal_variance.setConstant(m.signal_variance[0]);
-  m.noise_variance.setConstant(m.noise_variance[0]);
-  if (rank > 0) {
-    m.variance = training::fit_variance_factor(m, m.inputs, training::variance_points(m, m.inputs, rank, 1));
-    m.variance.extrapolation_variance = 1.0;  // the variance alone never flags
-  }
+  test_support::add_variance_block(m, rank);
+  if (rank > 0) m.variance.extrapolation_variance = 1.0;  // the variance alone never flags
   {
     // The held pose (fixture's bent cables) before the image is made: boot
     // once without a model to read its joints.

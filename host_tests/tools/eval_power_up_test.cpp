@@ -22,6 +22,7 @@
 #include "export/image_writer.hpp"
 #include "test_work_dir.hpp"
 #include "train/predictive_variance.hpp"
+#include "../support/variance_block.hpp"
 
 #include "../support/run_cdcr.hpp"
 #include "../support/synthetic_trained_model.hpp"
@@ -79,9 +80,7 @@ class EvalPowerUp : public ::testing::Test {
     options.position_output_factor = 0.1;
     options.rotation_output_factor = 0.001;
     training::TrainedModel m = test_support::synthetic_trained_model(options);
-    m.signal_variance.setConstant(m.signal_variance[0]);
-    m.noise_variance.setConstant(m.noise_variance[0]);
-    m.variance = training::fit_variance_factor(m, m.inputs, training::variance_points(m, m.inputs, 8, 1));
+    test_support::add_variance_block(m, 8);
     return m;
   }
 

@@ -37,14 +37,7 @@ PowerUpEstimates estimates_from_power_up(const model::ImageView& image, const Ei
     model::PoseUncertainty<firmware::Scalar> radii = firmware::estimate_uncertainty(*robot, estimate);
     tracker->widen(*robot, radii);
     if (!tracker->known()) result.unknown_rows = static_cast<int>(i) + 1;
-    training::FirmwareEstimate e;
-    e.pose = estimate.pose.cast<double>();
-    e.uncertainty.r95_mm = radii.r95_mm;
-    e.uncertainty.r95_deg = radii.r95_deg;
-    e.uncertainty.latent_share = radii.latent_share;
-    e.uncertainty.outside_range = radii.outside_range;
-    e.uncertainty.extrapolating = radii.extrapolating;
-    result.estimates.push_back(e);
+    result.estimates.push_back(training::firmware_estimate(estimate.pose, radii));
   }
   return result;
 }

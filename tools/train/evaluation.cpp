@@ -85,14 +85,7 @@ std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, cons
     float z[model::GpCorrection<float>::kMaxInputs];
     correction.kernel_coordinates(model::bend_from_joints(result.joints), z);
     const model::PoseUncertainty<float> u = uncertainty.evaluate(z, result.compensated.position_mm);
-    FirmwareEstimate e;
-    e.pose = result.compensated.cast<double>();
-    e.uncertainty.r95_mm = u.r95_mm;
-    e.uncertainty.r95_deg = u.r95_deg;
-    e.uncertainty.latent_share = u.latent_share;
-    e.uncertainty.outside_range = u.outside_range;
-    e.uncertainty.extrapolating = u.extrapolating;
-    estimates.push_back(e);
+    estimates.push_back(firmware_estimate(result.compensated, u));
   }
   return estimates;
 }
@@ -118,6 +111,17 @@ std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, c
       break;
   }
   return firmware_poses_with<double>(image, cables_mm, payload_kg);
+}
+
+FirmwareEstimate firmware_estimate(const model::Pose<float>& pose, const model::PoseUncertainty<float>& radii) {
+  FirmwareEstimate e;
+  e.pose = pose.cast<double>();
+  e.uncertainty.r95_mm = radii.r95_mm;
+  e.uncertainty.r95_deg = radii.r95_deg;
+  e.uncertainty.latent_share = radii.latent_share;
+  e.uncertainty.outside_range = radii.outside_range;
+  e.uncertainty.extrapolating = radii.extrapolating;
+  return e;
 }
 
 std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,

@@ -61,6 +61,8 @@ struct FirmwareEstimate {
   model::Pose<double> pose;
   model::PoseUncertainty<double> uncertainty;
 };
+// The board's float32 pose and radii, widened to double.
+FirmwareEstimate firmware_estimate(const model::Pose<float>& pose, const model::PoseUncertainty<float>& radii);
 std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
                                                 const Eigen::VectorXd& payload_kg = {});
 
