@@ -11,15 +11,6 @@ namespace cdcr::firmware {
 
 namespace {
 
-// tr S and tr S^2 of the symmetric 3 x 3 S = a + b, each given as xx, yy,
-// zz, xy, xz, yz.
-void traces(const Scalar (&a)[6], const Scalar (&b)[6], Scalar& trace, Scalar& trace_of_square) {
-  Scalar s[6];
-  for (int i = 0; i < 6; ++i) s[i] = a[i] + b[i];
-  trace = s[0] + s[1] + s[2];
-  trace_of_square = s[0] * s[0] + s[1] * s[1] + s[2] * s[2] + Scalar(2) * (s[3] * s[3] + s[4] * s[4] + s[5] * s[5]);
-}
-
 void add_outer(Scalar (&covariance)[6], const model::Vec3<Scalar>& v, Scalar variance) {
   covariance[0] += variance * v.x() * v.x();
   covariance[1] += variance * v.y() * v.y();
@@ -126,21 +117,15 @@ void HysteresisTracker::widen(const RobotModel& model, model::PoseUncertainty<Sc
   const Scalar os = Scalar(image.variance_calibration[model::image_variance_field::orientation_scale]);
   const Scalar ps2 = ps * ps;
   const Scalar os2 = os * os;
-  // S_p = diag(v) + [p]x diag(w) [p]x^T, as gaussian_radii_95.
-  const Scalar* w = v + 3;
-  const Scalar px = tip_mm_.x(), py = tip_mm_.y(), pz = tip_mm_.z();
-  const Scalar gp_position[6] = {ps2 * (v[0] + w[1] * pz * pz + w[2] * py * py),
-                                 ps2 * (v[1] + w[0] * pz * pz + w[2] * px * px),
-                                 ps2 * (v[2] + w[0] * py * py + w[1] * px * px),
-                                 -ps2 * w[2] * px * py,
-                                 -ps2 * w[1] * px * pz,
-                                 -ps2 * w[0] * py * pz};
-  const Scalar gp_orientation[6] = {os2 * w[0], os2 * w[1], os2 * w[2], Scalar(0), Scalar(0), Scalar(0)};
-  Scalar trace = 0, trace_of_square = 0;
-  traces(gp_position, position_covariance_, trace, trace_of_square);
-  radii.r95_mm = model::gaussian_radius_95(trace, trace_of_square);
-  traces(gp_orientation, orientation_covariance_, trace, trace_of_square);
-  radii.r95_deg = model::gaussian_radius_95(trace, trace_of_square) * Scalar(model::kDegreesPerRadian);
+  // The GP's covariance, as gaussian_radii_95 forms it, calibrated; the
+  // unknown state's added on top.
+  model::SymmetricCovariance3<Scalar> position, orientation = {};
+  model::tip_position_covariance(v, tip_mm_, position);
+  for (int i = 0; i < 6; ++i) position[i] = ps2 * position[i] + position_covariance_[i];
+  for (int i = 0; i < 3; ++i) orientation[i] = os2 * v[3 + i];
+  for (int i = 0; i < 6; ++i) orientation[i] += orientation_covariance_[i];
+  radii.r95_mm = model::gaussian_radius_95(position);
+  radii.r95_deg = model::gaussian_radius_95(orientation) * Scalar(model::kDegreesPerRadian);
 }
 
 }  // namespace cdcr::firmware

@@ -57,25 +57,44 @@ S gaussian_radius_95(S trace, S trace_of_square) {
   return std::sqrt(scale * dof * cube_root * cube_root * cube_root);
 }
 
+// A symmetric 3 x 3 covariance as xx, yy, zz, xy, xz, yz.
+template <typename S>
+using SymmetricCovariance3 = S[6];
+
+// The radius of gaussian_radius_95 for a covariance given as above.
+template <typename S>
+S gaussian_radius_95(const SymmetricCovariance3<S>& c) {
+  const S trace = c[0] + c[1] + c[2];
+  const S trace_of_square = c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + S(2) * (c[3] * c[3] + c[4] * c[4] + c[5] * c[5]);
+  return gaussian_radius_95(trace, trace_of_square);
+}
+
+// The tip position's covariance for independent error-twist variances
+// (v in mm^2, then omega in rad^2) at tip_mm: S_p = diag(v) + P diag(w) P^T
+// with P = [p]x.
+template <typename S>
+void tip_position_covariance(const S (&variances)[kImageOutputs], const Vec3<S>& tip_mm, SymmetricCovariance3<S>& c) {
+  const S* v = variances;
+  const S* w = variances + 3;
+  const S px = tip_mm.x();
+  const S py = tip_mm.y();
+  const S pz = tip_mm.z();
+  c[0] = v[0] + w[1] * pz * pz + w[2] * py * py;
+  c[1] = v[1] + w[0] * pz * pz + w[2] * px * px;
+  c[2] = v[2] + w[0] * py * py + w[1] * px * px;
+  c[3] = -w[2] * px * py;
+  c[4] = -w[1] * px * pz;
+  c[5] = -w[0] * py * pz;
+}
+
 // The uncalibrated radii (mm, deg) for independent error-twist variances
 // (v in mm^2, then omega in rad^2) at a compensated tip position.
 template <typename S>
 void gaussian_radii_95(const S (&variances)[kImageOutputs], const Vec3<S>& tip_mm, S& r95_mm, S& r95_deg) {
-  const S* v = variances;
   const S* w = variances + 3;
-  // S_p = diag(v) + P diag(w) P^T with P = [p]x.
-  const S px = tip_mm.x();
-  const S py = tip_mm.y();
-  const S pz = tip_mm.z();
-  const S xx = v[0] + w[1] * pz * pz + w[2] * py * py;
-  const S yy = v[1] + w[0] * pz * pz + w[2] * px * px;
-  const S zz = v[2] + w[0] * py * py + w[1] * px * px;
-  const S xy = -w[2] * px * py;
-  const S xz = -w[1] * px * pz;
-  const S yz = -w[0] * py * pz;
-  const S trace = xx + yy + zz;
-  const S trace_of_square = xx * xx + yy * yy + zz * zz + S(2) * (xy * xy + xz * xz + yz * yz);
-  r95_mm = gaussian_radius_95(trace, trace_of_square);
+  SymmetricCovariance3<S> position;
+  tip_position_covariance(variances, tip_mm, position);
+  r95_mm = gaussian_radius_95(position);
   r95_deg = gaussian_radius_95(w[0] + w[1] + w[2], w[0] * w[0] + w[1] * w[1] + w[2] * w[2]) * S(kDegreesPerRadian);
 }
 
