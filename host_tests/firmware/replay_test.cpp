@@ -291,7 +291,9 @@ TEST(RuntimeReplay, AHysteresisImageCarriesTheStateOverTheSequence) {
     ASSERT_TRUE(std::getline(in, line)) << i;
     double x = 0, y = 0, z = 0;
     ASSERT_EQ(std::sscanf(line.c_str(), "%lf,%lf,%lf", &x, &y, &z), 3);
-    if (i == 0 || i == 35) ASSERT_EQ(model::start_at_home(state, h, runtime.geometry()), model::Status::ok);
+    if (i == 0 || i == 35) {
+      ASSERT_EQ(model::start_at_home(state, h, runtime.geometry()), model::Status::ok);
+    }
     const Cables commanded = written.cables_mm.row(i).transpose().cast<float>();
     model::update_hysteresis(state, h, commanded);
     Cables effective;

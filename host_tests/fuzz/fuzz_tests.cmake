@@ -13,7 +13,7 @@
 # install command.
 
 find_program(CDCR_CLANGXX NAMES clang++ clang++-14 DOC "clang++ for the libFuzzer targets")
-set(CDCR_FUZZ_SECONDS 20 CACHE STRING "How long ctest runs each fuzzer (seconds)")
+set(CDCR_FUZZ_SECONDS 10 CACHE STRING "How long ctest runs each fuzzer (seconds)")
 
 set(fuzz_dir ${CMAKE_BINARY_DIR}/fuzz)
 

@@ -13,11 +13,12 @@
 // board's budget (80,000 instructions on the Cortex-M7, 120,000 on the
 // Cortex-M4F).
 //
-// Built with CDCR_BUDGET_WITH_HYSTERESIS (cdcr_qemu_cycle_budget_hysteresis)
-// the image carries a hysteresis block: the runtime starts with the state
-// unknown (its r95 widening runs), the drives' moves make it known, and the
-// program also reports what the hysteresis itself costs: the tracking of a
-// cable set and the widening's Jacobian, at most, in instructions.
+// Linked with an image that has a hysteresis block
+// (cdcr_qemu_cycle_budget_hysteresis, kExpectHysteresisBlock), the runtime
+// starts with the state unknown (its r95 widening runs), the drives' moves
+// make it known, and the program also reports what the hysteresis itself
+// costs: the tracking of a cable set and the widening's Jacobian, at most,
+// in instructions.
 
 #include <algorithm>
 #include <cmath>
@@ -28,6 +29,7 @@
 #include "board.hpp"
 #include "golden_check.hpp"
 #include "instruction_count.hpp"
+#include "program_expectation.hpp"
 #include "workload.hpp"
 
 namespace {
@@ -251,7 +253,6 @@ void report_unit_costs() {
   console::console_write("\n");
 }
 
-#ifdef CDCR_BUDGET_WITH_HYSTERESIS
 firmware::HysteresisTracker probe_tracker;
 firmware::RobotModel probe_model;
 
@@ -291,7 +292,6 @@ void report_hysteresis_costs(const model::ImageView& image) {
   console::console_write_int(static_cast<std::int32_t>(firmware::hysteresis_units(runtime.hysteresis())));
   console::console_write(" units a cycle\n");
 }
-#endif
 
 }  // namespace
 
@@ -306,13 +306,19 @@ int main() {
   console::console_write_int(static_cast<std::int32_t>(runtime.ik_units_per_cycle()));
   console::console_write(" units\n");
   report_unit_costs();
-#ifdef CDCR_BUDGET_WITH_HYSTERESIS
-  if (!runtime.hysteresis().active() || runtime.hysteresis().known()) {
-    console::console_write("FAIL: the image's hysteresis block is not tracked, or its state is known at power-up\n");
+  const bool with_hysteresis = cdcr::qemu_programs::kExpectHysteresisBlock;
+  if (runtime.hysteresis().active() != with_hysteresis) {
+    console::console_write(with_hysteresis ? "FAIL: the image's hysteresis block is not tracked\n"
+                                           : "FAIL: a hysteresis block where the image has none\n");
     return 1;
   }
-  report_hysteresis_costs(image);
-#endif
+  if (with_hysteresis) {
+    if (runtime.hysteresis().known()) {
+      console::console_write("FAIL: the hysteresis state is known at power-up\n");
+      return 1;
+    }
+    report_hysteresis_costs(image);
+  }
 
   // The drives start where golden case 0 has them.
   for (int s = 0; s < segments; ++s) {
@@ -444,12 +450,10 @@ int main() {
     console::console_write("FAIL: targets refusing extrapolation were all accepted or all refused\n");
     ok = false;
   }
-#ifdef CDCR_BUDGET_WITH_HYSTERESIS
-  if (!runtime.hysteresis().known()) {
+  if (with_hysteresis && !runtime.hysteresis().known()) {
     console::console_write("FAIL: the drives' moves did not make the hysteresis state known\n");
     ok = false;
   }
-#endif
   if (cycles_run < 2000) {
     console::console_write("FAIL: fewer than 2,000 cycles\n");
     ok = false;

@@ -1,7 +1,7 @@
 // The runtime on the board, replaying the host's golden cases through the
 // CAN mailbox one cycle each, as the drives would send them. With the image
 // intact it must boot into RUN and publish the compensated poses the host
-// computed in double; with a corrupted image (CDCR_REPLAY_EXPECT_DEGRADED) it
+// computed in double; with a corrupted image (kExpectDegradedBoot) it
 // must boot into DEGRADED, report the image fault on the bus and publish the
 // nominal poses. Prints what it saw and PASS or FAIL; the exit status says
 // the same to ctest.
@@ -12,10 +12,7 @@
 
 #include "board.hpp"
 #include "golden_check.hpp"
-
-#ifndef CDCR_REPLAY_EXPECT_DEGRADED
-#define CDCR_REPLAY_EXPECT_DEGRADED 0
-#endif
+#include "program_expectation.hpp"
 
 namespace {
 
@@ -25,9 +22,9 @@ namespace console = cdcr::cortexm;
 using cdcr::firmware::FaultCode;
 using cdcr::firmware::RuntimeState;
 
-constexpr bool kExpectDegraded = CDCR_REPLAY_EXPECT_DEGRADED != 0;
-constexpr RuntimeState kExpectedState = kExpectDegraded ? RuntimeState::degraded : RuntimeState::run;
-constexpr FaultCode kExpectedFault = kExpectDegraded ? FaultCode::image_invalid : FaultCode::none;
+const bool kExpectDegraded = cdcr::qemu_programs::kExpectDegradedBoot;
+const RuntimeState kExpectedState = kExpectDegraded ? RuntimeState::degraded : RuntimeState::run;
+const FaultCode kExpectedFault = kExpectDegraded ? FaultCode::image_invalid : FaultCode::none;
 
 // Float32 fidelity: the float path against the host's double path.
 constexpr double kPositionToleranceMm = 0.01;

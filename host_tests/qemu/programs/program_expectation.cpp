@@ -1,0 +1,15 @@
+#include "program_expectation.hpp"
+
+#ifndef CDCR_EXPECT_DEGRADED_BOOT
+#error "CDCR_EXPECT_DEGRADED_BOOT must be defined by the program's build (0 or 1)"
+#endif
+#ifndef CDCR_EXPECT_HYSTERESIS_BLOCK
+#error "CDCR_EXPECT_HYSTERESIS_BLOCK must be defined by the program's build (0 or 1)"
+#endif
+
+namespace cdcr::qemu_programs {
+
+const bool kExpectDegradedBoot = CDCR_EXPECT_DEGRADED_BOOT != 0;
+const bool kExpectHysteresisBlock = CDCR_EXPECT_HYSTERESIS_BLOCK != 0;
+
+}  // namespace cdcr::qemu_programs
