@@ -11,7 +11,6 @@ namespace cdcr::firmware {
 namespace {
 
 using protocol::UpdateReason;
-constexpr std::uint32_t kBlockBytes = protocol::kUpdateBlockBytes;
 
 }  // namespace
 
@@ -133,7 +132,7 @@ void ModelUpdate::start_transfer(const protocol::UpdateCommandFrame& command) {
     return;
   }
   writer_.target_other_slot();
-  const std::uint32_t blocks = (command.image_size + kBlockBytes - 1) / kBlockBytes;
+  const std::uint32_t blocks = (command.image_size + protocol::kUpdateBlockBytes - 1) / protocol::kUpdateBlockBytes;
   if (!writer_.fits(command.image_size, blocks)) {
     report(UpdateReason::too_large);
     return;

@@ -7,7 +7,6 @@ namespace cdcr::firmware {
 namespace {
 
 using protocol::UpdateReason;
-constexpr std::uint32_t kBlockBytes = protocol::kUpdateBlockBytes;
 
 }  // namespace
 
@@ -26,14 +25,14 @@ UpdateReceiver::Answer UpdateReceiver::on_digest(const hal::CanFrame& frame) {
 
 void UpdateReceiver::begin(std::uint32_t image_size, std::uint32_t blocks_in_flash) {
   image_size_ = image_size;
-  total_blocks_ = (image_size + kBlockBytes - 1) / kBlockBytes;
+  total_blocks_ = (image_size + protocol::kUpdateBlockBytes - 1) / protocol::kUpdateBlockBytes;
   durable_ = received_ = blocks_in_flash;
   incoming_ = false;
 }
 
 std::uint32_t UpdateReceiver::block_length(std::uint32_t block) const {
-  const std::uint32_t start = block * kBlockBytes;
-  return image_size_ - start < kBlockBytes ? image_size_ - start : kBlockBytes;
+  const std::uint32_t start = block * protocol::kUpdateBlockBytes;
+  return image_size_ - start < protocol::kUpdateBlockBytes ? image_size_ - start : protocol::kUpdateBlockBytes;
 }
 
 UpdateReceiver::Answer UpdateReceiver::on_block(const hal::CanFrame& frame, bool receiving) {

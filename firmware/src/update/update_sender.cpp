@@ -6,14 +6,13 @@ namespace {
 
 using protocol::UpdateReason;
 using protocol::UpdateState;
-constexpr std::uint32_t kBlockBytes = protocol::kUpdateBlockBytes;
 
 }  // namespace
 
 UpdateSender::UpdateSender(const std::uint8_t* image, std::uint32_t size_bytes) : image_(image), size_(size_bytes) {
   sha256(image_, size_, digest_);
   transfer_id_ = static_cast<std::uint16_t>(digest_[0] | (digest_[1] << 8));
-  total_blocks_ = (size_ + kBlockBytes - 1) / kBlockBytes;
+  total_blocks_ = (size_ + protocol::kUpdateBlockBytes - 1) / protocol::kUpdateBlockBytes;
 }
 
 template <typename Message>
@@ -134,8 +133,8 @@ void UpdateSender::pump(std::int64_t now, hal::CanBus& bus, std::uint32_t max_fr
 }
 
 void UpdateSender::send_block(std::uint32_t block, hal::CanBus& bus) {
-  const std::uint32_t at = block * kBlockBytes;
-  const std::uint32_t length = size_ - at < kBlockBytes ? size_ - at : kBlockBytes;
+  const std::uint32_t at = block * protocol::kUpdateBlockBytes;
+  const std::uint32_t length = size_ - at < protocol::kUpdateBlockBytes ? size_ - at : protocol::kUpdateBlockBytes;
   protocol::UpdateBlock header;
   header.block = static_cast<std::uint16_t>(block);
   header.length = static_cast<std::uint8_t>(length);
