@@ -115,7 +115,9 @@ hal::CanStatus XilinxCanController::write_frame(std::uint32_t id_offset, std::ui
   if (!hal::is_valid(frame)) return hal::CanStatus::invalid_frame;
   if (error_state() == CanErrorState::bus_off) return hal::CanStatus::bus_off;
   if ((reg(kStatus) & full_flag) != 0) return hal::CanStatus::queue_full;
-  // All four words, in this order: the write of DATA2 queues the frame.
+  // All four words, in this order: the write of DATA2 queues the frame
+  // (QEMU 7.2 takes the words in write order, and DATA2's address as the
+  // trigger).
   reg(id_offset) = frame.id << kIdShift;
   reg(id_offset + kDlcWord) = static_cast<std::uint32_t>(frame.dlc) << kDlcShift;
   reg(id_offset + kData1Word) = pack_data_word(frame.data);
@@ -135,7 +137,9 @@ bool XilinxCanController::receive(hal::CanFrame& frame) {
   for (;;) {
     if ((reg(kInterruptStatus) & kInterruptRxNotEmpty) == 0) return false;
     // Reading the ID word takes the frame off the FIFO; the other three
-    // words then hold the same frame.
+    // words then hold the same frame. Read in this order: QEMU 7.2's model
+    // hands out the frame's words in read order, whichever of the four
+    // registers is read.
     const std::uint32_t id_word = reg(kRxFifoId);
     const std::uint32_t dlc_word = reg(kRxFifoDlc);
     const std::uint32_t data1 = reg(kRxFifoData1);

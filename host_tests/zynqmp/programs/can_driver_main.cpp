@@ -204,10 +204,19 @@ void check_error_state() {
   check_equal(can0.error_counters().bus_errors, 0, "no error frames on a clean bus");
 }
 
-// In loopback the controller hears itself and puts nothing on the bus.
+// In loopback the controller hears itself and puts nothing on the bus. It
+// also takes another bit timing, every field of it other than 1 (a field of
+// 1 is 0 in the register, wherever it lands): 125 kbit/s, 16 quanta.
 void check_loopback() {
   zynqmp::XilinxCanController looped{zynqmp::kCan1Base};
-  check(looped.start(kTiming, zynqmp::CanMode::loopback), "can1 enters loopback mode");
+  constexpr zynqmp::CanBitTiming kSlowTiming{12, 11, 4, 3};
+  static_assert(zynqmp::bitrate(kSlowTiming, zynqmp::kCanReferenceClockHz) == 125'000, "125 kbit/s");
+  check(looped.start(kSlowTiming, zynqmp::CanMode::loopback), "can1 enters loopback mode");
+  const zynqmp::CanBitTiming held = looped.bit_timing();
+  check_equal(held.prescaler, kSlowTiming.prescaler, "BRPR holds another prescaler");
+  check_equal(held.tseg1, kSlowTiming.tseg1, "BTR holds another TS1");
+  check_equal(held.tseg2, kSlowTiming.tseg2, "BTR holds another TS2");
+  check_equal(held.sjw, kSlowTiming.sjw, "BTR holds another SJW");
   const CanFrame sent = make_frame(0x0F0, 4, 0x0F);
   check(looped.transmit(sent) == CanStatus::ok, "can1 sends in loopback");
   CanFrame received;
