@@ -1,11 +1,14 @@
-# cmake -DQEMU=<qemu-system-aarch64> -DELF= -DWORK_DIR= [-DICOUNT=shift] [-DTIMEOUT_SECONDS=60] -P run_r5f.cmake
+# cmake -DQEMU=<qemu-system-aarch64> -DELF= -DWORK_DIR= [-DICOUNT=shift] [-DTIMEOUT_SECONDS=60]
+#       [-DEXPECT_STATUS=n -DEXPECT=regex] -P run_r5f.cmake
 # Runs a program on the first Cortex-R5F of QEMU's xlnx-zcu102, with both
 # CAN controllers on one emulated bus. The R5F starts powered off and
 # -kernel alone does not start it: QEMU starts stopped (-S), and QMP on stdin
 # powers the core on, resets the machine (the loader puts the core at the
 # ELF's entry) and continues. The program's console is uart0, written to
 # WORK_DIR/uart.log and printed here; its exit status comes through
-# semihosting. It passes when QEMU exits with 0 and the UART printed PASS.
+# semihosting. It passes when QEMU exits with 0 and the UART printed PASS;
+# with EXPECT_STATUS, when QEMU exits with that status and the UART output
+# matches EXPECT (a program that must fail in a given way).
 # With ICOUNT, each instruction advances the virtual clock by 2^ICOUNT ns.
 foreach(variable QEMU ELF WORK_DIR)
   if(NOT ${variable})
@@ -53,6 +56,15 @@ if(NOT status EQUAL 0 AND qemu_errors)
 endif()
 if(status EQUAL 124)
   message(FATAL_ERROR "${ELF} on the zcu102 R5F: timed out after ${seconds} s")
+endif()
+if(DEFINED EXPECT_STATUS)
+  if(NOT status EQUAL EXPECT_STATUS)
+    message(FATAL_ERROR "${ELF} on the zcu102 R5F: exit status ${status} instead of ${EXPECT_STATUS}")
+  endif()
+  if(NOT output MATCHES "${EXPECT}")
+    message(FATAL_ERROR "${ELF} on the zcu102 R5F: UART output does not match '${EXPECT}'")
+  endif()
+  return()
 endif()
 if(NOT status EQUAL 0)
   if(NOT qmp_output MATCHES "\"RESUME\"")

@@ -45,7 +45,7 @@ const char* const kExceptionNames[] = {"reset", "undefined instruction", "SVC", 
 extern "C" [[noreturn]] void cdcr_zynqmp_exception(std::uint32_t exception, std::uint32_t return_address) {
   cdcr::zynqmp::console_write("HARDFAULT: ");
   cdcr::zynqmp::console_write(exception < 8 ? kExceptionNames[exception] : "unknown");
-  cdcr::zynqmp::console_write(" at ");
+  cdcr::zynqmp::console_write(", return address ");
   cdcr::zynqmp::console_write_hex(return_address);
   cdcr::zynqmp::console_write("\n");
   // An SVC taken as an exception means QEMU's semihosting is off: exiting
