@@ -37,8 +37,9 @@ file(WRITE ${qmp_commands}
 # -smp 6: four A53s and the two R5Fs; the A53s stay powered off.
 # The bus object must not be called canbus0 (an ambiguous QOM path).
 # -audiodev none: the DisplayPort's audio would otherwise look for a sound card.
+# timeout -k: under -icount a QEMU whose guest spins may not act on SIGTERM.
 execute_process(
-  COMMAND timeout ${seconds} ${QEMU} -M xlnx-zcu102 -smp 6 -global xlnx-zynqmp.boot-cpu=rpu-cpu[0] ${icount_args}
+  COMMAND timeout -k 5 ${seconds} ${QEMU} -M xlnx-zcu102 -smp 6 -global xlnx-zynqmp.boot-cpu=rpu-cpu[0] ${icount_args}
           -object can-bus,id=r5f_can_bus -machine canbus0=r5f_can_bus,canbus1=r5f_can_bus
           -audiodev none,id=no_audio -display none -monitor none -serial file:${uart_log}
           -semihosting-config enable=on,target=native -kernel ${ELF} -qmp stdio -S
