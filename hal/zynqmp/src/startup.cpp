@@ -27,10 +27,12 @@ extern "C" [[noreturn]] void cdcr_zynqmp_start() {
   const std::uint32_t* from = __data_load_start__;
   for (std::uint32_t* to = __data_start__; to < __data_end__;) *to++ = *from++;
   for (std::uint32_t* to = __bss_start__; to < __bss_end__;) *to++ = 0;
+  // The UART before the static constructors, so that a fault or a failed
+  // assertion in one of them is reported.
+  cdcr::zynqmp::console_init();
   // -nostartfiles leaves no _init to run the static constructors.
   for (void (**constructor)() = __init_array_start; constructor < __init_array_end; ++constructor) (*constructor)();
 
-  cdcr::zynqmp::console_init();
   cdcr::zynqmp::exit(cdcr_zynqmp_application_main());
 }
 
