@@ -7,6 +7,11 @@
 // decoded from the bus must be the runtime's own, within the frames'
 // rounding; then the drives go silent and STATUS must turn to FAULT
 // (stale input).
+//
+// The test runs it under -icount shift=0: one instruction advances QEMU's
+// virtual clock by 1 ns, and the cycle counter counts 1 GHz of it, so the
+// counter counts instructions; no release may be missed, and the costliest
+// cycle is printed as `worst cycle: N instructions over C cycles`.
 
 #include <cmath>
 #include <cstdint>
@@ -150,10 +155,18 @@ int main() {
   BusView bus;
   Deviation worst;
   int poses_compared = 0;
+  std::uint64_t worst_cycle_counts = 0;
   for (int cycle = 0; cycle < kCycles; ++cycle) {
     const cdcr::hal::TimerTick tick = board.timer.wait_next();
     send_cables(cycle);
+    asm volatile("" ::: "memory");
+    const std::uint64_t cycle_start = board.timer.now_counts();
+    asm volatile("" ::: "memory");
     runtime.run_cycle(tick);
+    asm volatile("" ::: "memory");
+    const std::uint64_t cycle_counts = board.timer.now_counts() - cycle_start;
+    asm volatile("" ::: "memory");
+    if (cycle_counts > worst_cycle_counts) worst_cycle_counts = cycle_counts;
     const int pose_frames_before = bus.pose_frames;
     drain(bus);
     check(bus.pose_frames == pose_frames_before + 3, "a pose on the bus for every complete cable set");
@@ -168,6 +181,14 @@ int main() {
   zynqmp::console_write(" nm position, ");
   write_micro(worst.rotation);
   zynqmp::console_write(" ppm rotation\n");
+  zynqmp::console_write("worst cycle: ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(worst_cycle_counts));
+  zynqmp::console_write(" instructions over ");
+  zynqmp::console_write_int(kCycles);
+  zynqmp::console_write(" cycles\n");
+  check(worst_cycle_counts < static_cast<std::uint64_t>(cdcr::boards::zcu102_r5f::kCyclePeriodNs),
+        "every cycle within its 1 ms period");
+  check(board.timer.overruns() == 0, "no release missed");
   check(worst.position_mm <= kBusPositionToleranceMm, "the pose's position on the bus is the runtime's");
   check(worst.rotation <= kBusRotationTolerance, "the pose's orientation on the bus is the runtime's");
   check(bus.status_frames >= kCycles / cdcr::firmware::kStatusEveryCycles, "STATUS every kStatusEveryCycles");
