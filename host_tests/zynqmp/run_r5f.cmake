@@ -1,5 +1,5 @@
 # cmake -DQEMU=<qemu-system-aarch64> -DELF= -DWORK_DIR= [-DICOUNT=shift] [-DTIMEOUT_SECONDS=60]
-#       [-DEXPECT_STATUS=n -DEXPECT=regex] -P run_r5f.cmake
+#       [-DEXPECT_STATUS=n -DEXPECT=regex | -DRUN_SECONDS=s -DEXPECT=regex] -P run_r5f.cmake
 # Runs a program on the first Cortex-R5F of QEMU's xlnx-zcu102, with both
 # CAN controllers on one emulated bus. The R5F starts powered off and
 # -kernel alone does not start it: QEMU starts stopped (-S), and QMP on stdin
@@ -8,7 +8,9 @@
 # WORK_DIR/uart.log and printed here; its exit status comes through
 # semihosting. It passes when QEMU exits with 0 and the UART printed PASS;
 # with EXPECT_STATUS, when QEMU exits with that status and the UART output
-# matches EXPECT (a program that must fail in a given way).
+# matches EXPECT (a program that must fail in a given way). A program that
+# runs forever (RUN_SECONDS) passes when it is still running after that long
+# and its UART output matched EXPECT.
 # With ICOUNT, each instruction advances the virtual clock by 2^ICOUNT ns.
 foreach(variable QEMU ELF WORK_DIR)
   if(NOT ${variable})
@@ -18,6 +20,9 @@ endforeach()
 set(seconds 60)
 if(DEFINED TIMEOUT_SECONDS)
   set(seconds ${TIMEOUT_SECONDS})
+endif()
+if(DEFINED RUN_SECONDS)
+  set(seconds ${RUN_SECONDS})
 endif()
 set(icount_args)
 if(DEFINED ICOUNT)
@@ -55,6 +60,16 @@ message("${output}")
 if(NOT status EQUAL 0 AND qemu_errors)
   message("${qemu_errors}")
 endif()
+string(REPLACE "\\n" "\n" expected "${EXPECT}")
+if(DEFINED RUN_SECONDS)
+  if(NOT status EQUAL 124)
+    message(FATAL_ERROR "${ELF} on the zcu102 R5F: stopped with status ${status} instead of running on")
+  endif()
+  if(NOT output MATCHES "${expected}")
+    message(FATAL_ERROR "${ELF} on the zcu102 R5F: UART output does not match '${EXPECT}'")
+  endif()
+  return()
+endif()
 if(status EQUAL 124)
   message(FATAL_ERROR "${ELF} on the zcu102 R5F: timed out after ${seconds} s")
 endif()
@@ -62,7 +77,7 @@ if(DEFINED EXPECT_STATUS)
   if(NOT status EQUAL EXPECT_STATUS)
     message(FATAL_ERROR "${ELF} on the zcu102 R5F: exit status ${status} instead of ${EXPECT_STATUS}")
   endif()
-  if(NOT output MATCHES "${EXPECT}")
+  if(NOT output MATCHES "${expected}")
     message(FATAL_ERROR "${ELF} on the zcu102 R5F: UART output does not match '${EXPECT}'")
   endif()
   return()
