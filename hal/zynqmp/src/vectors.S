@@ -24,6 +24,24 @@
     .equ SCTLR_V, (1 << 13)  /* high vectors at 0xFFFF0000 */
     .equ SCTLR_TE, (1 << 30) /* exceptions in Thumb state */
 
+/* MPU regions (RGNR, DRBAR, DRSR, DRACR). A region covers 2^(N+1) bytes
+ * for a DRSR size field of N, at a base aligned to its size.
+ *   0: the DDR's low 2 GiB (program, data, stacks): normal memory, write-back
+ *      write-allocate cacheable, full access, executable.
+ *   1: the low-power domain's peripherals, 8 MiB at 0xFF000000 (uart0,
+ *      can0, can1, the timers): device memory, never executed. */
+    .equ MPU_REGION_MEMORY, 0
+    .equ MPU_MEMORY_BASE, 0x00000000
+    .equ MPU_MEMORY_SIZE_ENABLE, (30 << 1) | 1
+    .equ MPU_MEMORY_ACCESS, (0x3 << 8) | (0x1 << 3) | (1 << 1) | (1 << 0)
+    .equ MPU_REGION_PERIPHERALS, 1
+    .equ MPU_PERIPHERALS_BASE, 0xFF000000
+    .equ MPU_PERIPHERALS_SIZE_ENABLE, (22 << 1) | 1
+    .equ MPU_PERIPHERALS_ACCESS, (1 << 12) | (0x3 << 8) | (1 << 0)
+/* DRACR: XN bit 12, AP bits 10:8 (0b011 full access), TEX bits 5:3, C bit 1,
+ * B bit 0. TEX 001 C B: normal, write-back write-allocate; TEX 000 B:
+ * shareable device. */
+
 /* Exception numbers cdcr_zynqmp_exception reports (startup.cpp). */
     .equ EXC_UNDEFINED, 1
     .equ EXC_SVC, 2
@@ -86,14 +104,54 @@ cdcr_zynqmp_reset:
     mov r0, #(1 << 30)
     vmsr fpexc, r0
 
-    /* The instruction cache: invalidated, then enabled. It caches nothing
-     * wrongly whatever the memory map. The data cache waits for MPU regions
-     * that mark the peripherals as device memory (not set up yet). */
+    /* The MPU: two regions and nothing else, so a stray access anywhere
+     * else (the OCM, the DDR above 2 GiB, the other peripherals) is a data
+     * abort instead of a silent read or write. No background region. */
+    mov r0, #MPU_REGION_MEMORY
+    mcr p15, 0, r0, c6, c2, 0           /* RGNR */
+    ldr r0, =MPU_MEMORY_BASE
+    mcr p15, 0, r0, c6, c1, 0           /* DRBAR */
+    ldr r0, =MPU_MEMORY_ACCESS
+    mcr p15, 0, r0, c6, c1, 4           /* DRACR */
+    ldr r0, =MPU_MEMORY_SIZE_ENABLE
+    mcr p15, 0, r0, c6, c1, 2           /* DRSR */
+    mov r0, #MPU_REGION_PERIPHERALS
+    mcr p15, 0, r0, c6, c2, 0
+    ldr r0, =MPU_PERIPHERALS_BASE
+    mcr p15, 0, r0, c6, c1, 0
+    ldr r0, =MPU_PERIPHERALS_ACCESS
+    mcr p15, 0, r0, c6, c1, 4
+    ldr r0, =MPU_PERIPHERALS_SIZE_ENABLE
+    mcr p15, 0, r0, c6, c1, 2
+
+    /* Both caches invalidated before they are enabled (their contents are
+     * unknown after reset): the instruction cache at once, the data cache
+     * set by set and way over the geometry CCSIDR reports. */
     mov r0, #0
     mcr p15, 0, r0, c7, c5, 0           /* ICIALLU */
+    mcr p15, 2, r0, c0, c0, 0           /* CSSELR: level 1 data cache */
+    isb
+    mrc p15, 1, r1, c0, c0, 0           /* CCSIDR */
+    and r2, r1, #7
+    add r2, r2, #4                      /* log2(line bytes): the set's shift */
+    ubfx r3, r1, #3, #10                /* ways - 1 */
+    ubfx r4, r1, #13, #15               /* sets - 1 */
+    clz r5, r3                          /* the way's shift */
+1:  mov r6, r4                          /* each way ... */
+2:  lsl r7, r3, r5                      /* ... each set */
+    orr r7, r7, r6, lsl r2
+    mcr p15, 0, r7, c7, c6, 2           /* DCISW */
+    subs r6, r6, #1
+    bge 2b
+    subs r3, r3, #1
+    bge 1b
     dsb
+
+    /* MPU, data cache, instruction cache on. */
     mrc p15, 0, r0, c1, c0, 0
-    orr r0, r0, #SCTLR_I
+    ldr r1, =(SCTLR_M | SCTLR_C | SCTLR_I)
+    orr r0, r0, r1
+    dsb
     mcr p15, 0, r0, c1, c0, 0
     isb
 
