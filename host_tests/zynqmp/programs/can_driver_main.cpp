@@ -88,6 +88,17 @@ void check_bit_timing() {
   check_equal(held.tseg2, kTiming.tseg2, "BTR holds TS2");
   check_equal(held.sjw, kTiming.sjw, "BTR holds SJW");
   check_equal(zynqmp::bitrate(held, zynqmp::kCanReferenceClockHz), kBitrate, "bitrate from the registers");
+  zynqmp::console_write("bit timing held: prescaler ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(held.prescaler));
+  zynqmp::console_write(", 1 + ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(held.tseg1));
+  zynqmp::console_write(" + ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(held.tseg2));
+  zynqmp::console_write(" quanta, SJW ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(held.sjw));
+  zynqmp::console_write(": ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(zynqmp::bitrate(held, zynqmp::kCanReferenceClockHz)));
+  zynqmp::console_write(" bit/s from 24 MHz\n");
   check(!is_valid(zynqmp::CanBitTiming{0, 6, 1, 1}), "a prescaler of 0 is refused");
   check(!is_valid(zynqmp::CanBitTiming{3, 17, 1, 1}), "a TS1 of 17 quanta is refused");
   check(!is_valid(zynqmp::CanBitTiming{3, 6, 9, 1}), "a TS2 of 9 quanta is refused");
@@ -185,6 +196,13 @@ void check_rx_overflow() {
     in_order = in_order && received.id == 0x300 + arrived && received.data[0] == static_cast<std::uint8_t>(arrived);
     ++arrived;
   }
+  zynqmp::console_write("RX flood: ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(kSent));
+  zynqmp::console_write(" frames sent unread, ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(arrived));
+  zynqmp::console_write(" received, ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(can0.error_counters().rx_overruns));
+  zynqmp::console_write(" overflow counted\n");
   check_equal(arrived, zynqmp::kXilinxCanFifoFrames, "the RX FIFO's 64 frames arrive");
   check(in_order, "the frames the FIFO held arrive in order");
   check_equal(can0.error_counters().rx_overruns, 1, "the overflow is counted");
