@@ -1,0 +1,54 @@
+#include "cdcr/zynqmp/cycle_counter_timer.hpp"
+
+namespace cdcr::zynqmp {
+namespace {
+
+// PMCR: E (enable all counters), C (reset the cycle counter).
+constexpr std::uint32_t kPmcrEnable = 1u << 0;
+constexpr std::uint32_t kPmcrResetCycleCounter = 1u << 2;
+// PMCNTENSET: bit 31 enables the cycle counter.
+constexpr std::uint32_t kCycleCounterEnable = 1u << 31;
+
+std::uint32_t read_cycle_counter() {
+  std::uint32_t value;
+  asm volatile("mrc p15, 0, %0, c9, c13, 0" : "=r"(value));
+  return value;
+}
+
+}  // namespace
+
+void CycleCounterTimer::enable() {
+  if (enabled_) return;
+  std::uint32_t control;
+  asm volatile("mrc p15, 0, %0, c9, c12, 0" : "=r"(control));
+  control |= kPmcrEnable | kPmcrResetCycleCounter;
+  asm volatile("mcr p15, 0, %0, c9, c12, 0" ::"r"(control));
+  asm volatile("mcr p15, 0, %0, c9, c12, 1" ::"r"(kCycleCounterEnable));
+  asm volatile("isb" ::: "memory");
+  last_low_ = 0;
+  high_ = 0;
+  enabled_ = true;
+}
+
+std::uint64_t CycleCounterTimer::now_counts() const {
+  const std::uint32_t low = read_cycle_counter();
+  if (low < last_low_) high_ += std::uint64_t{1} << 32;
+  last_low_ = low;
+  return high_ | low;
+}
+
+void CycleCounterTimer::start(std::int64_t period_ns) {
+  enable();
+  schedule_.start(now_ns() + period_ns, period_ns);
+}
+
+hal::TimerTick CycleCounterTimer::wait_next() {
+  hal::TimerTick tick;
+  tick.missed_releases = schedule_.skip_past(now_ns());
+  tick.release_ns = schedule_.take();
+  while (now_ns() < tick.release_ns) {
+  }
+  return tick;
+}
+
+}  // namespace cdcr::zynqmp

@@ -1,0 +1,93 @@
+# cmake -DQEMU=<qemu-system-aarch64> -DELF= -DWORK_DIR= [-DICOUNT=shift] [-DTIMEOUT_SECONDS=60]
+#       [-DEXPECT_STATUS=n -DEXPECT=regex | -DRUN_SECONDS=s -DEXPECT=regex] -P run_r5f.cmake
+# Runs a program on the first Cortex-R5F of QEMU's xlnx-zcu102, with both
+# CAN controllers on one emulated bus. The R5F starts powered off and
+# -kernel alone does not start it: QEMU starts stopped (-S), and QMP on stdin
+# powers the core on, resets the machine (the loader puts the core at the
+# ELF's entry) and continues. The program's console is uart0, written to
+# WORK_DIR/uart.log and printed here; its exit status comes through
+# semihosting. It passes when QEMU exits with 0 and the UART printed PASS;
+# with EXPECT_STATUS, when QEMU exits with that status and the UART output
+# matches EXPECT (a program that must fail in a given way). A program that
+# runs forever (RUN_SECONDS) passes when it is still running after that long
+# and its UART output matched EXPECT.
+# With ICOUNT, each instruction advances the virtual clock by 2^ICOUNT ns.
+foreach(variable QEMU ELF WORK_DIR)
+  if(NOT ${variable})
+    message(FATAL_ERROR "run_r5f.cmake: ${variable} is not set")
+  endif()
+endforeach()
+set(seconds 60)
+if(DEFINED TIMEOUT_SECONDS)
+  set(seconds ${TIMEOUT_SECONDS})
+endif()
+if(DEFINED RUN_SECONDS)
+  set(seconds ${RUN_SECONDS})
+endif()
+set(icount_args)
+if(DEFINED ICOUNT)
+  set(icount_args -icount shift=${ICOUNT})
+endif()
+
+file(MAKE_DIRECTORY ${WORK_DIR})
+set(uart_log ${WORK_DIR}/uart.log)
+set(qmp_commands ${WORK_DIR}/start_rpu.qmp)
+file(REMOVE ${uart_log})
+file(WRITE ${qmp_commands}
+  "{\"execute\":\"qmp_capabilities\"}\n"
+  "{\"execute\":\"qom-set\",\"arguments\":{\"path\":\"/machine/soc/rpu-cluster/rpu-cpu[0]\",\"property\":\"start-powered-off\",\"value\":false}}\n"
+  "{\"execute\":\"system_reset\"}\n"
+  "{\"execute\":\"cont\"}\n")
+
+# -smp 6: four A53s and the two R5Fs; the A53s stay powered off.
+# The bus object must not be called canbus0 (an ambiguous QOM path).
+# -audiodev none: the DisplayPort's audio would otherwise look for a sound card.
+# timeout -k: under -icount a QEMU whose guest spins may not act on SIGTERM.
+execute_process(
+  COMMAND timeout -k 5 ${seconds} ${QEMU} -M xlnx-zcu102 -smp 6 -global xlnx-zynqmp.boot-cpu=rpu-cpu[0] ${icount_args}
+          -object can-bus,id=r5f_can_bus -machine canbus0=r5f_can_bus,canbus1=r5f_can_bus
+          -audiodev none,id=no_audio -display none -monitor none -serial file:${uart_log}
+          -semihosting-config enable=on,target=native -kernel ${ELF} -qmp stdio -S
+  INPUT_FILE ${qmp_commands}
+  OUTPUT_VARIABLE qmp_output
+  ERROR_VARIABLE qemu_errors
+  RESULT_VARIABLE status)
+set(output "")
+if(EXISTS ${uart_log})
+  file(READ ${uart_log} output)
+endif()
+message("${output}")
+if(NOT status EQUAL 0 AND qemu_errors)
+  message("${qemu_errors}")
+endif()
+string(REPLACE "\\n" "\n" expected "${EXPECT}")
+if(DEFINED RUN_SECONDS)
+  if(NOT status EQUAL 124)
+    message(FATAL_ERROR "${ELF} on the zcu102 R5F: stopped with status ${status} instead of running on")
+  endif()
+  if(NOT output MATCHES "${expected}")
+    message(FATAL_ERROR "${ELF} on the zcu102 R5F: UART output does not match '${EXPECT}'")
+  endif()
+  return()
+endif()
+if(status EQUAL 124)
+  message(FATAL_ERROR "${ELF} on the zcu102 R5F: timed out after ${seconds} s")
+endif()
+if(DEFINED EXPECT_STATUS)
+  if(NOT status EQUAL EXPECT_STATUS)
+    message(FATAL_ERROR "${ELF} on the zcu102 R5F: exit status ${status} instead of ${EXPECT_STATUS}")
+  endif()
+  if(NOT output MATCHES "${expected}")
+    message(FATAL_ERROR "${ELF} on the zcu102 R5F: UART output does not match '${EXPECT}'")
+  endif()
+  return()
+endif()
+if(NOT status EQUAL 0)
+  if(NOT qmp_output MATCHES "\"RESUME\"")
+    message("QMP:\n${qmp_output}")
+  endif()
+  message(FATAL_ERROR "${ELF} on the zcu102 R5F: exit status ${status}")
+endif()
+if(NOT output MATCHES "(^|\n)PASS\n")
+  message(FATAL_ERROR "${ELF} on the zcu102 R5F: no PASS line on the UART")
+endif()
