@@ -27,8 +27,9 @@ sim::SimulatorConfig gravity_only() {
 
 // Commanded cables from random joints through the design geometry; each row
 // carries a payload uniform in 0-1 kg (none when with_payload is false) and
-// the pose where `robot` takes it.
-dataset::Dataset recorded(const sim::SimulatedRobot& robot, int samples, bool with_payload) {
+// the pose where `robot` takes it (as motion capture measures it when
+// measured is true).
+dataset::Dataset recorded(sim::SimulatedRobot& robot, int samples, bool with_payload, bool measured = false) {
   const model::RobotGeometry<double>& design = robot.nominal_geometry();
   dataset::Dataset data;
   data.segment_count = design.segment_count;
@@ -47,7 +48,7 @@ dataset::Dataset recorded(const sim::SimulatedRobot& robot, int samples, bool wi
     data.cables_mm.row(k) = cables.transpose();
     const double kg = with_payload ? payload(rng) : 0.0;
     if (with_payload) data.payload_kg[k] = kg;
-    data.poses.push_back(robot.true_pose(cables, kg));
+    data.poses.push_back(measured ? robot.measure(cables, kg).measured_pose : robot.true_pose(cables, kg));
   }
   return data;
 }
@@ -55,7 +56,7 @@ dataset::Dataset recorded(const sim::SimulatedRobot& robot, int samples, bool wi
 TEST(ComplianceIdentification, FindsTheSimulatorsStiffnessPlatformMassAndGravity) {
   const auto design = model::RobotGeometry<double>::prototype();
   const sim::SimulatorConfig config = gravity_only();
-  const sim::SimulatedRobot robot(design, config);
+  sim::SimulatedRobot robot(design, config);
   const TrainingSet set = make_training_set(recorded(robot, 120, true), design, model::InputEncoding::bend_vector);
   ComplianceStructure structure;
   structure.unloaded_mass = true;
@@ -88,19 +89,22 @@ TEST(ComplianceIdentification, TheChoiceTakesTheSagWhereThereIsOneAndNoneWhereTh
   std::vector<ComplianceStructure> structures(2);
   structures[1].unloaded_mass = true;
 
-  const sim::SimulatedRobot sagging(design, gravity_only());
+  sim::SimulatedRobot sagging(design, gravity_only());
   const TrainingSet loaded = make_training_set(recorded(sagging, 80, true), design, model::InputEncoding::bend_vector);
   const ComplianceChoice with_sag = choose_compliance(loaded, design, options, structures);
   ASSERT_TRUE(with_sag.attempted);
   EXPECT_FALSE(with_sag.model.empty());
   EXPECT_TRUE(with_sag.structure.unloaded_mass);
 
-  // The same rows where nothing sags (gravity off): the payload column is
-  // there but moves nothing, and a model without sag is the better one.
+  // The same rows where nothing sags (gravity off), measured by motion
+  // capture: the payload column is there but moves nothing, a fitted sag
+  // only follows the noise, and a model without sag is the better one.
   sim::SimulatorConfig still = gravity_only();
   still.gravity.enabled = false;
-  const sim::SimulatedRobot rigid(design, still);
-  const TrainingSet unloaded = make_training_set(recorded(rigid, 80, true), design, model::InputEncoding::bend_vector);
+  still.mocap_noise.enabled = true;
+  sim::SimulatedRobot rigid(design, still);
+  const TrainingSet unloaded =
+      make_training_set(recorded(rigid, 80, true, true), design, model::InputEncoding::bend_vector);
   const ComplianceChoice without_sag = choose_compliance(unloaded, design, options, structures);
   ASSERT_TRUE(without_sag.attempted);
   EXPECT_TRUE(without_sag.model.empty());
@@ -108,7 +112,7 @@ TEST(ComplianceIdentification, TheChoiceTakesTheSagWhereThereIsOneAndNoneWhereTh
 
 TEST(ComplianceIdentification, DataWithoutPayloadTrainsAsItAlwaysDid) {
   const auto design = model::RobotGeometry<double>::prototype();
-  const sim::SimulatedRobot robot(design, gravity_only());
+  sim::SimulatedRobot robot(design, gravity_only());
   const TrainingSet set = make_training_set(recorded(robot, 40, false), design, model::InputEncoding::bend_vector);
   const ComplianceChoice choice = choose_compliance(set, design, TrainingOptions{});
   EXPECT_FALSE(choice.attempted);
@@ -126,7 +130,7 @@ TEST(ComplianceIdentification, DataWithoutPayloadTrainsAsItAlwaysDid) {
 
 TEST(ComplianceIdentification, TooFewRowsAreRefused) {
   const auto design = model::RobotGeometry<double>::prototype();
-  const sim::SimulatedRobot robot(design, gravity_only());
+  sim::SimulatedRobot robot(design, gravity_only());
   ComplianceStructure structure;
   structure.unloaded_mass = true;  // 4 parameters: 8 rows at least
   const TrainingSet set = make_training_set(recorded(robot, 7, true), design, model::InputEncoding::bend_vector);
