@@ -5,6 +5,7 @@
 #include <stdexcept>
 #include <string>
 
+#include <Eigen/QR>
 #include <unsupported/Eigen/NonLinearOptimization>
 #include <unsupported/Eigen/NumericalDiff>
 
@@ -23,6 +24,9 @@ constexpr int kSagIterations = 8;
 // A softening s is plausible while 1 + s |b| stays positive for bends up to
 // this (a quarter turn, beyond any segment's design limit here).
 constexpr double kLargestBendRad = 1.5707963267948966;
+// The background (see background_basis) is projected out of the residuals
+// only with at least this many rows per column of it (180 for 4 segments).
+constexpr int kBackgroundRowsPerColumn = 4;
 
 ComplianceModel compliance_at(const ComplianceStructure& s, int segments, const Eigen::VectorXd& p) {
   ComplianceModel c;
@@ -48,6 +52,9 @@ struct SagResiduals {
   model::RobotGeometry<double> geometry;
   ComplianceStructure structure;
   double rotation_weight_mm = 1.0;
+  // Orthonormal columns spanning the background features of the rows (see
+  // background_basis); empty: none.
+  Eigen::MatrixXd background;
 
   int inputs() const { return structure.parameter_count(geometry.segment_count); }
   int values() const { return 6 * set->size(); }
@@ -61,9 +68,37 @@ struct SagResiduals {
       residuals.segment<3>(6 * i) = twist.head<3>();
       residuals.segment<3>(6 * i + 3) = rotation_weight_mm * twist.tail<3>();
     }
+    if (background.cols() > 0) {
+      Eigen::Map<Eigen::Matrix<double, 6, Eigen::Dynamic>> by_row(residuals.data(), 6, set->size());
+      by_row -= (by_row * background) * background.transpose();
+    }
     return 0;
   }
 };
+
+// The errors that do not depend on the payload (the geometry's, the robot's
+// own sag) are smooth in the bends; left in the residuals they pull the
+// identified direction and compliances towards themselves. The payload is
+// drawn independently of the configuration, so its sag is nearly orthogonal
+// to functions of the bends alone: the fit sees the residuals less their
+// least-squares projection on 1, b and the products b_j b_k.
+Eigen::Index background_columns(const TrainingSet& set) {
+  const Eigen::Index n = set.bends.cols();
+  return 1 + n + n * (n + 1) / 2;
+}
+
+Eigen::MatrixXd background_basis(const TrainingSet& set) {
+  const Eigen::Index n = set.bends.cols();
+  Eigen::MatrixXd features(set.size(), 1 + n + n * (n + 1) / 2);
+  features.col(0).setOnes();
+  features.middleCols(1, n) = set.bends;
+  Eigen::Index column = 1 + n;
+  for (Eigen::Index j = 0; j < n; ++j) {
+    for (Eigen::Index k = j; k < n; ++k) features.col(column++) = set.bends.col(j).cwiseProduct(set.bends.col(k));
+  }
+  const Eigen::HouseholderQR<Eigen::MatrixXd> qr(features);
+  return qr.householderQ() * Eigen::MatrixXd::Identity(set.size(), features.cols());
+}
 
 }  // namespace
 
@@ -144,6 +179,10 @@ ComplianceModel identify_compliance(const TrainingSet& set, const model::RobotGe
   residuals.geometry = geometry;
   residuals.structure = structure;
   for (int s = 0; s < geometry.segment_count; ++s) residuals.rotation_weight_mm += geometry.segments[s].backbone_length_mm;
+  // Too few rows to spare the background's columns: the residuals as they are.
+  if (set.size() >= kBackgroundRowsPerColumn * background_columns(set)) {
+    residuals.background = background_basis(set);
+  }
   // From no sag; the ratios from equal compliances (at zero weight their
   // gradients vanish, so they must not start at zero too).
   Eigen::VectorXd p = Eigen::VectorXd::Zero(parameters);

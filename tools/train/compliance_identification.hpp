@@ -16,7 +16,12 @@
 // and left out they pull the identified direction towards their sag).
 //
 // Identified by Levenberg-Marquardt (Eigen's) on the tip error twists, the
-// rotation weighted by the robot's length as in calibration.hpp; the
+// rotation weighted by the robot's length as in calibration.hpp, less their
+// projection on smooth functions of the bends alone (1, b, b_j b_k) when
+// there are rows enough: the errors that do not depend on the payload (the
+// geometry's, the robot's own sag) would otherwise pull the identified
+// direction and compliances towards themselves, while the payload, drawn
+// independently of the configuration, keeps its sag out of that span. The
 // structure (which of the parameters beyond g c_0 are free) and whether the
 // sag is used at all are chosen by the GP's log marginal likelihood less one
 // per parameter (Akaike's criterion, as hysteresis_identification.hpp does),
