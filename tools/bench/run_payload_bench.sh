@@ -8,7 +8,10 @@
 # against the test session's noise floor (the measured poses against the
 # repeatable ones, as each robot defines it). Writes to
 # $BUILD_DIR/payload_bench/. A reference row: the independent robot without
-# payload.
+# payload. Then, on the same rows, the payload model with the segments'
+# compliance identified (cdcr-bench-compliance: every candidate structure,
+# the one the GP's likelihood chooses, and the baseline again, each with the
+# same search as `cdcr train`).
 #
 #   bash tools/bench/run_payload_bench.sh [--seed S]
 set -euo pipefail
@@ -16,7 +19,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 source tools/bench/bench_build.sh
 
 seed=$(seed_option 7 "$@")
-bench_work payload_bench base "" cdcr
+bench_work payload_bench base "" cdcr cdcr-bench-compliance
 python=/usr/bin/python3
 payload_range=0,1
 
@@ -55,6 +58,11 @@ print(s["noise_floor"]["position_mm"], s["noise_floor"]["orientation_deg"])' "$w
 report independent "$work_dir/independent/session0.csv" "$work_dir/independent/session1.csv" "$floor_mm" "$floor_deg" \
   --segments 4 --length 110 --radius 60
 
+echo "  -- with the segments' compliance identified --"
+"$build_dir/bin/cdcr-bench-compliance" --train "$work_dir/independent/session0.csv" \
+  --test "$work_dir/independent/session1.csv" --floor-mm "$floor_mm" --floor-deg "$floor_deg" \
+  --segments 4 --length 110 --radius 60 | tee "$work_dir/independent.compliance.txt"
+
 # A reference: the same robot and configurations without payload (payload
 # 0 kg, its column dropped): the part of the gap the payload does not cause.
 "$python" tools/bench/independent_robot.py --seed "$seed" --out-dir "$work_dir/unloaded" --payload-range 0,0 \
@@ -78,5 +86,8 @@ echo "== the simulator (seed $seed), payload $payload_range kg =="
   --out "$work_dir/simulator1.csv" --json >"$work_dir/simulator1.json"
 IFS=, read -r floor_mm floor_deg < <(noise_floor "$work_dir/simulator1.json")
 report simulator "$work_dir/simulator0.csv" "$work_dir/simulator1.csv" "$floor_mm" "$floor_deg"
+echo "  -- with the segments' compliance identified --"
+"$build_dir/bin/cdcr-bench-compliance" --train "$work_dir/simulator0.csv" --test "$work_dir/simulator1.csv" \
+  --floor-mm "$floor_mm" --floor-deg "$floor_deg" | tee "$work_dir/simulator.compliance.txt"
 echo
 echo "models, reports and data in $work_dir"

@@ -1,0 +1,179 @@
+// Compliance identification against the simulator with only its gravity sag
+// on (no geometric errors, no noise, no distributed segment weight): the
+// sag of a tip load on a segment of stiffness K = EI / L + 2 k r^2 is the
+// sagged nominal model's, so the identification must find 1 / K, the end
+// platform's mass and gravity's direction. Data without payload must keep
+// the training set it always had.
+#include <cmath>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "cdcr/model/chain.hpp"
+#include "sim/simulated_robot.hpp"
+#include "train/compliance_identification.hpp"
+
+#include "../../support/random_joints.hpp"
+
+namespace cdcr::training {
+namespace {
+
+sim::SimulatorConfig gravity_only() {
+  sim::SimulatorConfig config = sim::SimulatorConfig::nominal_only();
+  config.gravity.enabled = true;
+  config.gravity.segment_mass_kg = 0.0;  // the tip load alone: what the sagged nominal model describes
+  return config;
+}
+
+// Commanded cables from random joints through the design geometry; each row
+// carries a payload uniform in 0-1 kg (none when with_payload is false) and
+// the pose where `robot` takes it (as motion capture measures it when
+// measured is true).
+dataset::Dataset recorded(sim::SimulatedRobot& robot, int samples, bool with_payload, bool measured = false) {
+  const model::RobotGeometry<double>& design = robot.nominal_geometry();
+  dataset::Dataset data;
+  data.segment_count = design.segment_count;
+  data.has_poses = true;
+  data.has_payload = with_payload;
+  data.cables_mm.resize(samples, 4 * design.segment_count);
+  if (with_payload) data.payload_kg.resize(samples);
+  std::mt19937_64 rng(11);
+  std::uniform_real_distribution<double> alpha(-3.1, 3.1);
+  std::uniform_real_distribution<double> theta(0.0, 0.2);
+  std::uniform_real_distribution<double> payload(0.0, 1.0);
+  for (int k = 0; k < samples; ++k) {
+    const model::JointVector<double> joints = test_support::random_joints(design.segment_count, rng, alpha, theta);
+    model::CableVector<double> cables;
+    EXPECT_EQ(model::cables_from_joints(joints, design, cables), model::Status::ok);
+    data.cables_mm.row(k) = cables.transpose();
+    const double kg = with_payload ? payload(rng) : 0.0;
+    if (with_payload) data.payload_kg[k] = kg;
+    data.poses.push_back(measured ? robot.measure(cables, kg).measured_pose : robot.true_pose(cables, kg));
+  }
+  return data;
+}
+
+TEST(ComplianceIdentification, FindsTheSimulatorsStiffnessPlatformMassAndGravity) {
+  const auto design = model::RobotGeometry<double>::prototype();
+  const sim::SimulatorConfig config = gravity_only();
+  sim::SimulatedRobot robot(design, config);
+  // 240 rows: enough for the background's 45 columns to be projected out,
+  // as on real data.
+  const TrainingSet set = make_training_set(recorded(robot, 240, true), design, model::InputEncoding::bend_vector);
+  ComplianceStructure structure;
+  structure.unloaded_mass = true;
+  const ComplianceModel c = identify_compliance(set, design, structure);
+
+  // The simulator's stiffness of the (uniform) prototype's segments.
+  const double length = design.segments[0].backbone_length_mm, radius = design.segments[0].anchor_radius_mm;
+  const double stiffness = config.structure.backbone_bending_stiffness_n_mm2 / length +
+                           2.0 * config.structure.cable_stiffness_n_per_mm * radius * radius;
+  // Tolerances: 0.1 % on the compliance, 1 g on the platform, 0.05 deg on
+  // the direction (the sag is the same formula; eight fixed-point steps
+  // against the simulator's converged equilibrium).
+  for (int s = 0; s < design.segment_count; ++s) {
+    EXPECT_NEAR(c.compliance_rad_per_n_mm(s) * stiffness, 1.0, 1e-3) << s;
+  }
+  EXPECT_NEAR(c.unloaded_mass_kg, config.gravity.platform_mass_kg, 1e-3);
+  const double off_deg = std::acos(std::min(1.0, c.gravity_direction().dot(config.gravity.direction.normalized()))) *
+                         180.0 / 3.141592653589793;
+  EXPECT_LT(off_deg, 0.05);
+  // And the sagged nominal model leaves (almost) nothing.
+  const TrainingSet sagged = with_compliance(set, design, c);
+  EXPECT_GT(set.error_twists.leftCols<3>().rowwise().norm().mean(), 20.0);
+  EXPECT_LT(sagged.error_twists.leftCols<3>().rowwise().norm().mean(), 0.05);
+}
+
+// An error of the bends alone (here a tip offset linear in them, millimetres
+// over the workspace, whatever the payload) is projected out of the
+// residuals: the stiffness, platform and direction stay where they were.
+TEST(ComplianceIdentification, AnErrorOfTheBendsAloneDoesNotMoveTheStiffness) {
+  const auto design = model::RobotGeometry<double>::prototype();
+  const sim::SimulatorConfig config = gravity_only();
+  sim::SimulatedRobot robot(design, config);
+  dataset::Dataset data = recorded(robot, 240, true);
+  const TrainingSet clean = make_training_set(data, design, model::InputEncoding::bend_vector);
+  std::mt19937_64 rng(5);
+  std::normal_distribution<double> gain(0.0, 20.0);  // mm per rad of bend
+  Eigen::Matrix<double, 3, 8> offset_per_bend;
+  for (double& v : offset_per_bend.reshaped()) v = gain(rng);
+  for (int i = 0; i < clean.size(); ++i) {
+    data.poses[static_cast<std::size_t>(i)].position_mm +=
+        Eigen::Vector3d(1.0, -2.0, 0.5) + offset_per_bend * clean.bends.row(i).transpose();
+  }
+  const TrainingSet set = make_training_set(data, design, model::InputEncoding::bend_vector);
+  ComplianceStructure structure;
+  structure.unloaded_mass = true;
+  const ComplianceModel c = identify_compliance(set, design, structure);
+  const double length = design.segments[0].backbone_length_mm, radius = design.segments[0].anchor_radius_mm;
+  const double stiffness = config.structure.backbone_bending_stiffness_n_mm2 / length +
+                           2.0 * config.structure.cable_stiffness_n_per_mm * radius * radius;
+  const double off_deg = std::acos(std::min(1.0, c.gravity_direction().dot(config.gravity.direction.normalized()))) *
+                         180.0 / 3.141592653589793;
+  // Tolerances as without the offset, but for the platform's mass, whose
+  // sag is mostly a function of the bends alone (what is left of it is the
+  // change of the lever arms with the payload's own sag): 10 g.
+  EXPECT_NEAR(c.compliance_rad_per_n_mm(0) * stiffness, 1.0, 1e-3);
+  EXPECT_LT(off_deg, 0.05);
+  EXPECT_NEAR(c.unloaded_mass_kg, config.gravity.platform_mass_kg, 0.01);
+}
+
+TEST(ComplianceIdentification, TheChoiceTakesTheSagWhereThereIsOneAndNoneWhereThereIsNot) {
+  const auto design = model::RobotGeometry<double>::prototype();
+  TrainingOptions options;
+  options.search.restarts = 0;
+  std::vector<ComplianceStructure> structures(2);
+  structures[1].unloaded_mass = true;
+
+  sim::SimulatedRobot sagging(design, gravity_only());
+  const TrainingSet loaded = make_training_set(recorded(sagging, 80, true), design, model::InputEncoding::bend_vector);
+  const ComplianceChoice with_sag = choose_compliance(loaded, design, options, structures);
+  ASSERT_TRUE(with_sag.attempted);
+  EXPECT_FALSE(with_sag.model.empty());
+  EXPECT_TRUE(with_sag.structure.unloaded_mass);
+
+  // The same rows where nothing sags (gravity off), measured by motion
+  // capture: the payload column is there but moves nothing, a fitted sag
+  // only follows the noise, and a model without sag is the better one.
+  sim::SimulatorConfig still = gravity_only();
+  still.gravity.enabled = false;
+  still.mocap_noise.enabled = true;
+  sim::SimulatedRobot rigid(design, still);
+  const TrainingSet unloaded =
+      make_training_set(recorded(rigid, 80, true, true), design, model::InputEncoding::bend_vector);
+  const ComplianceChoice without_sag = choose_compliance(unloaded, design, options, structures);
+  ASSERT_TRUE(without_sag.attempted);
+  EXPECT_TRUE(without_sag.model.empty());
+}
+
+TEST(ComplianceIdentification, DataWithoutPayloadTrainsAsItAlwaysDid) {
+  const auto design = model::RobotGeometry<double>::prototype();
+  sim::SimulatedRobot robot(design, gravity_only());
+  const TrainingSet set = make_training_set(recorded(robot, 40, false), design, model::InputEncoding::bend_vector);
+  const ComplianceChoice choice = choose_compliance(set, design, TrainingOptions{});
+  EXPECT_FALSE(choice.attempted);
+  EXPECT_EQ(choice.skipped_reason, "the data have no payload_kg column");
+  EXPECT_TRUE(choice.model.empty());
+  // The empty model leaves the set bit for bit.
+  const TrainingSet same = with_compliance(set, design, choice.model);
+  EXPECT_EQ(same.inputs, set.inputs);
+  EXPECT_EQ(same.error_twists, set.error_twists);
+  for (int i = 0; i < set.size(); ++i) {
+    EXPECT_EQ(same.nominal[i].matrix(), set.nominal[i].matrix()) << i;
+  }
+  EXPECT_THROW(identify_compliance(set, design, ComplianceStructure{}), std::invalid_argument);
+}
+
+TEST(ComplianceIdentification, TooFewRowsAreRefused) {
+  const auto design = model::RobotGeometry<double>::prototype();
+  sim::SimulatedRobot robot(design, gravity_only());
+  ComplianceStructure structure;
+  structure.unloaded_mass = true;  // 4 parameters: 8 rows at least
+  const TrainingSet set = make_training_set(recorded(robot, 7, true), design, model::InputEncoding::bend_vector);
+  EXPECT_THROW(identify_compliance(set, design, structure), std::invalid_argument);
+  const TrainingSet enough = make_training_set(recorded(robot, 8, true), design, model::InputEncoding::bend_vector);
+  EXPECT_NO_THROW(identify_compliance(enough, design, structure));
+}
+
+}  // namespace
+}  // namespace cdcr::training
