@@ -19,6 +19,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <cdcr/baremetal/mmio.hpp>
+
 #include <cdcr/hal/can_bus.hpp>
 
 #include "cdcr/zynqmp/can_bit_timing.hpp"
@@ -92,9 +94,7 @@ class XilinxCanController {
   std::uint32_t skipped_frames() const { return skipped_frames_; }
 
  private:
-  volatile std::uint32_t& reg(std::uint32_t offset) const {
-    return *reinterpret_cast<volatile std::uint32_t*>(base_ + offset);
-  }
+  volatile std::uint32_t& reg(std::uint32_t offset) const { return baremetal::register_at(base_, offset); }
   hal::CanStatus write_frame(std::uint32_t id_offset, std::uint32_t full_flag, const hal::CanFrame& frame);
 
   std::uintptr_t base_;
