@@ -20,12 +20,16 @@
 #include <cstdint>
 
 #include <cdcr/baremetal/mmio.hpp>
-
 #include <cdcr/hal/can_bus.hpp>
 
 #include "cdcr/zynqmp/can_bit_timing.hpp"
 
 namespace cdcr::zynqmp {
+
+enum class CanMode : std::uint8_t {
+  normal,
+  loopback,  // the controller receives what it sends and drives nothing onto the bus
+};
 
 // SR.ESTAT.
 enum class CanErrorState : std::uint8_t {
@@ -33,11 +37,6 @@ enum class CanErrorState : std::uint8_t {
   error_active = 1,
   bus_off = 2,
   error_passive = 3,
-};
-
-enum class CanMode : std::uint8_t {
-  normal,
-  loopback,  // the controller receives what it sends and drives nothing onto the bus
 };
 
 // What the controller's error registers say.
