@@ -1,9 +1,8 @@
-# cmake -DQEMU= -DMACHINE= -DCPU= -DELF= [-DICOUNT=shift] [-DRUN_SECONDS=s -DEXPECT=regex] -P run_qemu.cmake
-# Runs a semihosting program under QEMU. A program that ends passes when QEMU
-# exits with 0 (the program's own status) and it printed PASS. A program that
-# runs forever (RUN_SECONDS) passes when it is still running after that long
-# and its output matched EXPECT. The program's output goes to stdout through
-# the semihosting chardev, the UART nowhere. With ICOUNT, each instruction
+# cmake -DQEMU= -DMACHINE= -DCPU= -DELF= [-DICOUNT=shift]
+#       [-DEXPECT_STATUS=n -DEXPECT=regex | -DRUN_SECONDS=s -DEXPECT=regex] -P run_qemu.cmake
+# Runs a semihosting program under QEMU and judges it (qemu_verdict.cmake).
+# The program's output goes to stdout through the semihosting chardev, the
+# UART nowhere. With ICOUNT, each instruction
 # advances the virtual clock by 2^ICOUNT ns.
 set(icount_args)
 if(DEFINED ICOUNT)
@@ -20,22 +19,5 @@ execute_process(
   ERROR_VARIABLE output
   RESULT_VARIABLE status)
 message("${output}")
-if(DEFINED RUN_SECONDS)
-  if(NOT status EQUAL 124)
-    message(FATAL_ERROR "${ELF} on ${MACHINE}: stopped with status ${status} instead of running on")
-  endif()
-  string(REPLACE "\\n" "\n" expected "${EXPECT}")
-  if(NOT output MATCHES "${expected}")
-    message(FATAL_ERROR "${ELF} on ${MACHINE}: output does not match '${EXPECT}'")
-  endif()
-  return()
-endif()
-if(status EQUAL 124)
-  message(FATAL_ERROR "${ELF} on ${MACHINE}: timed out")
-endif()
-if(NOT status EQUAL 0)
-  message(FATAL_ERROR "${ELF} on ${MACHINE}: exit status ${status}")
-endif()
-if(NOT output MATCHES "(^|\n)PASS\n")
-  message(FATAL_ERROR "${ELF} on ${MACHINE}: no PASS line")
-endif()
+include(${CMAKE_CURRENT_LIST_DIR}/qemu_verdict.cmake)
+cdcr_qemu_verdict("${ELF} on ${MACHINE}" "${status}" "${output}")

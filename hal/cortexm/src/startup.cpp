@@ -4,18 +4,12 @@
 
 #include <cstdint>
 
+#include <cdcr/baremetal/startup.hpp>
+
 #include "cdcr/cortexm/semihosting.hpp"
 
 extern "C" {
-// From mps2.ld.
-extern std::uint32_t __data_load_start__[];
-extern std::uint32_t __data_start__[];
-extern std::uint32_t __data_end__[];
-extern std::uint32_t __bss_start__[];
-extern std::uint32_t __bss_end__[];
-extern std::uint32_t __stack_top__[];
-extern void (*__init_array_start[])();
-extern void (*__init_array_end[])();
+extern std::uint32_t __stack_top__[];  // mps2.ld
 
 // ISO C++ forbids calling main, so the startup code reaches the program's
 // main through another name for the same symbol.
@@ -46,11 +40,8 @@ extern "C" [[noreturn]] void cdcr_cortexm_reset_handler() {
   cpacr() = cpacr() | kCpacrFpuFullAccess;
   asm volatile("dsb\n\tisb" ::: "memory");
 
-  const std::uint32_t* from = __data_load_start__;
-  for (std::uint32_t* to = __data_start__; to < __data_end__;) *to++ = *from++;
-  for (std::uint32_t* to = __bss_start__; to < __bss_end__;) *to++ = 0;
-  // -nostartfiles leaves no _init to run the static constructors.
-  for (void (**constructor)() = __init_array_start; constructor < __init_array_end; ++constructor) (*constructor)();
+  cdcr::baremetal::initialise_data_and_bss();
+  cdcr::baremetal::run_static_constructors();
 
   cdcr::cortexm::exit(cdcr_cortexm_application_main());
 }

@@ -4,12 +4,14 @@ namespace cdcr::zynqmp {
 namespace {
 
 // Register offsets (UG1085, UART registers).
-constexpr std::uint32_t kControl = 0x00;       // XUARTPS_CR
-constexpr std::uint32_t kMode = 0x04;          // XUARTPS_MR
-constexpr std::uint32_t kBaudGenerator = 0x18; // XUARTPS_BAUDGEN
-constexpr std::uint32_t kChannelStatus = 0x2C; // XUARTPS_SR
-constexpr std::uint32_t kFifo = 0x30;          // XUARTPS_FIFO
-constexpr std::uint32_t kBaudDivider = 0x34;   // XUARTPS_BAUDDIV
+enum RegisterOffset : std::uint32_t {
+  kControl = 0x00,        // XUARTPS_CR
+  kMode = 0x04,           // XUARTPS_MR
+  kBaudGenerator = 0x18,  // XUARTPS_BAUDGEN
+  kChannelStatus = 0x2C,  // XUARTPS_SR
+  kFifo = 0x30,           // XUARTPS_FIFO
+  kBaudDivider = 0x34,    // XUARTPS_BAUDDIV
+};
 
 constexpr std::uint32_t kControlRxReset = 1u << 0;
 constexpr std::uint32_t kControlTxReset = 1u << 1;

@@ -4,18 +4,11 @@
 
 #include <cstdint>
 
+#include <cdcr/baremetal/startup.hpp>
+
 #include "cdcr/zynqmp/console.hpp"
 
 extern "C" {
-// From zcu102_r5f.ld.
-extern std::uint32_t __data_load_start__[];
-extern std::uint32_t __data_start__[];
-extern std::uint32_t __data_end__[];
-extern std::uint32_t __bss_start__[];
-extern std::uint32_t __bss_end__[];
-extern void (*__init_array_start[])();
-extern void (*__init_array_end[])();
-
 // ISO C++ forbids calling main, so the start-up reaches the program's main
 // through another name for the same symbol.
 int cdcr_zynqmp_application_main() __asm__("main");
@@ -24,14 +17,11 @@ int cdcr_zynqmp_application_main() __asm__("main");
 }
 
 extern "C" [[noreturn]] void cdcr_zynqmp_start() {
-  const std::uint32_t* from = __data_load_start__;
-  for (std::uint32_t* to = __data_start__; to < __data_end__;) *to++ = *from++;
-  for (std::uint32_t* to = __bss_start__; to < __bss_end__;) *to++ = 0;
+  cdcr::baremetal::initialise_data_and_bss();
   // The UART before the static constructors, so that a fault or a failed
   // assertion in one of them is reported.
   cdcr::zynqmp::console_init();
-  // -nostartfiles leaves no _init to run the static constructors.
-  for (void (**constructor)() = __init_array_start; constructor < __init_array_end; ++constructor) (*constructor)();
+  cdcr::baremetal::run_static_constructors();
 
   cdcr::zynqmp::exit(cdcr_zynqmp_application_main());
 }

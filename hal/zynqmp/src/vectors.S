@@ -82,18 +82,16 @@ cdcr_zynqmp_reset:
     /* One stack per exception mode, so a fault handler runs on a stack of its
      * own even when the program's stack is what went wrong; the program runs
      * in System mode on the main stack. Interrupts stay masked. */
-    cps #MODE_FIQ
-    ldr sp, =__fiq_stack_top__
-    cps #MODE_IRQ
-    ldr sp, =__irq_stack_top__
-    cps #MODE_ABT
-    ldr sp, =__abort_stack_top__
-    cps #MODE_UND
-    ldr sp, =__undefined_stack_top__
-    cps #MODE_SVC
-    ldr sp, =__svc_stack_top__
-    cps #MODE_SYS
-    ldr sp, =__stack_top__
+    .macro mode_stack mode, top
+    cps #\mode
+    ldr sp, =\top
+    .endm
+    mode_stack MODE_FIQ, __fiq_stack_top__
+    mode_stack MODE_IRQ, __irq_stack_top__
+    mode_stack MODE_ABT, __abort_stack_top__
+    mode_stack MODE_UND, __undefined_stack_top__
+    mode_stack MODE_SVC, __svc_stack_top__
+    mode_stack MODE_SYS, __stack_top__
 
     /* The FPU before any C++ code: the compiler may use its registers
      * anywhere. Full access to CP10 and CP11 (CPACR), then FPEXC.EN. */

@@ -11,6 +11,7 @@
 #include <cdcr/firmware/runtime.hpp>
 
 #include "board.hpp"
+#include "bus_view.hpp"
 #include "golden_check.hpp"
 #include "program_expectation.hpp"
 
@@ -19,6 +20,7 @@ namespace {
 namespace golden = cdcr::qemu_golden;
 namespace protocol = cdcr::firmware::protocol;
 namespace console = cdcr::cortexm;
+using namespace cdcr::board_tests;  // BusView, record
 using cdcr::firmware::FaultCode;
 using cdcr::firmware::RuntimeState;
 
@@ -69,50 +71,10 @@ int selected_and_portable_mean_differences() {
   return differences;
 }
 
-struct BusView {
-  double position_mm[3] = {};
-  double quaternion[4] = {1, 0, 0, 0};
-  int pose_frames = 0;
-  bool compensated_flag = false;
-  int status_frames = 0;
-  int reported_state = -1;
-  int reported_fault = -1;
-  cdcr::firmware::FaultDetail reported_detail;
-};
-
-// Every frame the runtime sent, decoded; STATS follows the STATUS whose
-// FAULT types its detail.
+// Every frame the runtime sent, decoded.
 void drain(BusView& bus) {
   cdcr::hal::CanFrame frame;
-  protocol::PosePositionXy xy;
-  protocol::PosePositionZ z;
-  protocol::PoseOrientation orientation;
-  protocol::Status status;
-  protocol::Stats stats;
-  constexpr protocol::DecodeStatus ok = protocol::DecodeStatus::ok;
-  while (board.can.take_transmitted(frame)) {
-    if (protocol::decode(frame, xy) == ok) {
-      bus.position_mm[0] = xy.x_mm;
-      bus.position_mm[1] = xy.y_mm;
-      bus.pose_frames += 1;
-    } else if (protocol::decode(frame, z) == ok) {
-      bus.position_mm[2] = z.z_mm;
-      bus.compensated_flag = z.compensated;
-      bus.pose_frames += 1;
-    } else if (protocol::decode(frame, orientation) == ok) {
-      bus.quaternion[0] = orientation.qw;
-      bus.quaternion[1] = orientation.qx;
-      bus.quaternion[2] = orientation.qy;
-      bus.quaternion[3] = orientation.qz;
-      bus.pose_frames += 1;
-    } else if (protocol::decode(frame, status) == ok) {
-      bus.reported_state = static_cast<int>(status.state);
-      bus.reported_fault = static_cast<int>(status.fault);
-      bus.status_frames += 1;
-    } else if (protocol::decode(frame, static_cast<FaultCode>(bus.reported_fault), stats) == ok) {
-      bus.reported_detail = stats.fault_detail;
-    }
-  }
+  while (board.can.take_transmitted(frame)) record(bus, frame);
 }
 
 // The pose as decoded from the bus, for the same comparison.

@@ -14,12 +14,15 @@
 #include <cdcr/zynqmp/xilinx_can_controller.hpp>
 #include <cdcr/zynqmp/zcu102.hpp>
 
+#include "checks.hpp"
+
 namespace {
 
 using cdcr::hal::CanFilter;
 using cdcr::hal::CanFrame;
 using cdcr::hal::CanStatus;
 namespace zynqmp = cdcr::zynqmp;
+using namespace cdcr::zynqmp_checks;  // check, check_equal, verdict
 
 constexpr std::uint32_t kBitrate = 1'000'000;
 constexpr zynqmp::CanBitTiming kTiming = zynqmp::compute_bit_timing(zynqmp::kCanReferenceClockHz, kBitrate);
@@ -34,28 +37,6 @@ constexpr std::size_t kRxQueueDepth = 16;
 
 zynqmp::XilinxCan<kRxQueueDepth> can0{zynqmp::kCan0Base};
 zynqmp::XilinxCanController peer{zynqmp::kCan1Base};
-
-int failures = 0;
-
-void check(bool condition, const char* what) {
-  if (condition) return;
-  failures += 1;
-  zynqmp::console_write("FAIL: ");
-  zynqmp::console_write(what);
-  zynqmp::console_write("\n");
-}
-
-void check_equal(std::uint32_t actual, std::uint32_t expected, const char* what) {
-  if (actual == expected) return;
-  failures += 1;
-  zynqmp::console_write("FAIL: ");
-  zynqmp::console_write(what);
-  zynqmp::console_write(": ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(actual));
-  zynqmp::console_write(" instead of ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(expected));
-  zynqmp::console_write("\n");
-}
 
 CanFrame make_frame(std::uint32_t id, std::uint8_t dlc, std::uint8_t first_byte) {
   CanFrame frame;
@@ -88,17 +69,8 @@ void check_bit_timing() {
   check_equal(held.tseg2, kTiming.tseg2, "BTR holds TS2");
   check_equal(held.sjw, kTiming.sjw, "BTR holds SJW");
   check_equal(zynqmp::bitrate(held, zynqmp::kCanReferenceClockHz), kBitrate, "bitrate from the registers");
-  zynqmp::console_write("bit timing held: prescaler ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(held.prescaler));
-  zynqmp::console_write(", 1 + ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(held.tseg1));
-  zynqmp::console_write(" + ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(held.tseg2));
-  zynqmp::console_write(" quanta, SJW ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(held.sjw));
-  zynqmp::console_write(": ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(zynqmp::bitrate(held, zynqmp::kCanReferenceClockHz)));
-  zynqmp::console_write(" bit/s from 24 MHz\n");
+  print("bit timing held: prescaler ", held.prescaler, ", 1 + ", held.tseg1, " + ", held.tseg2, " quanta, SJW ",
+        held.sjw, ": ", zynqmp::bitrate(held, zynqmp::kCanReferenceClockHz), " bit/s from 24 MHz\n");
   check(!is_valid(zynqmp::CanBitTiming{0, 6, 1, 1}), "a prescaler of 0 is refused");
   check(!is_valid(zynqmp::CanBitTiming{3, 17, 1, 1}), "a TS1 of 17 quanta is refused");
   check(!is_valid(zynqmp::CanBitTiming{3, 6, 9, 1}), "a TS2 of 9 quanta is refused");
@@ -196,13 +168,8 @@ void check_rx_overflow() {
     in_order = in_order && received.id == 0x300 + arrived && received.data[0] == static_cast<std::uint8_t>(arrived);
     ++arrived;
   }
-  zynqmp::console_write("RX flood: ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(kSent));
-  zynqmp::console_write(" frames sent unread, ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(arrived));
-  zynqmp::console_write(" received, ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(can0.error_counters().rx_overruns));
-  zynqmp::console_write(" overflow counted\n");
+  print("RX flood: ", kSent, " frames sent unread, ", arrived, " received, ", can0.error_counters().rx_overruns,
+        " overflow counted\n");
   check_equal(arrived, zynqmp::kXilinxCanFifoFrames, "the RX FIFO's 64 frames arrive");
   check(in_order, "the frames the FIFO held arrive in order");
   check_equal(can0.error_counters().rx_overruns, 1, "the overflow is counted");
@@ -256,11 +223,5 @@ int main() {
   check_rx_overflow();
   check_error_state();
   check_loopback();
-  if (failures != 0) {
-    zynqmp::console_write_int(failures);
-    zynqmp::console_write(" checks failed\n");
-    return 1;
-  }
-  zynqmp::console_write("PASS\n");
-  return 0;
+  return verdict();
 }

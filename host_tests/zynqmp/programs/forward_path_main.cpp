@@ -22,11 +22,15 @@
 #include <cdcr/zynqmp/xilinx_can_controller.hpp>
 
 #include "board.hpp"
+#include "bus_view.hpp"
+#include "checks.hpp"
 
 namespace {
 
 namespace protocol = cdcr::firmware::protocol;
 namespace zynqmp = cdcr::zynqmp;
+using namespace cdcr::zynqmp_checks;  // check, check_equal, verdict
+using namespace cdcr::board_tests;  // BusView, record
 using cdcr::firmware::FaultCode;
 using cdcr::firmware::RuntimeState;
 
@@ -40,53 +44,10 @@ cdcr::boards::zcu102_r5f::Board board;
 cdcr::firmware::Runtime runtime(board.hal(), cdcr::firmware::Geometry::prototype());
 zynqmp::XilinxCanController drives{zynqmp::kCan1Base};
 
-int failures = 0;
-
-void check(bool condition, const char* what) {
-  if (condition) return;
-  failures += 1;
-  zynqmp::console_write("FAIL: ");
-  zynqmp::console_write(what);
-  zynqmp::console_write("\n");
-}
-
-struct BusView {
-  double position_mm[3] = {};
-  double quaternion[4] = {1, 0, 0, 0};
-  int pose_frames = 0;
-  int status_frames = 0;
-  int reported_state = -1;
-  int reported_fault = -1;
-};
-
 // Everything the runtime sent, as the drives' controller received it.
 void drain(BusView& bus) {
   cdcr::hal::CanFrame frame;
-  protocol::PosePositionXy xy;
-  protocol::PosePositionZ z;
-  protocol::PoseOrientation orientation;
-  protocol::Status status;
-  constexpr protocol::DecodeStatus ok = protocol::DecodeStatus::ok;
-  while (drives.receive(frame)) {
-    if (protocol::decode(frame, xy) == ok) {
-      bus.position_mm[0] = xy.x_mm;
-      bus.position_mm[1] = xy.y_mm;
-      bus.pose_frames += 1;
-    } else if (protocol::decode(frame, z) == ok) {
-      bus.position_mm[2] = z.z_mm;
-      bus.pose_frames += 1;
-    } else if (protocol::decode(frame, orientation) == ok) {
-      bus.quaternion[0] = orientation.qw;
-      bus.quaternion[1] = orientation.qx;
-      bus.quaternion[2] = orientation.qy;
-      bus.quaternion[3] = orientation.qz;
-      bus.pose_frames += 1;
-    } else if (protocol::decode(frame, status) == ok) {
-      bus.reported_state = static_cast<int>(status.state);
-      bus.reported_fault = static_cast<int>(status.fault);
-      bus.status_frames += 1;
-    }
-  }
+  while (drives.receive(frame)) record(bus, frame);
 }
 
 // One cable set per cycle: every segment bent about its own axis by an
@@ -142,11 +103,8 @@ int main() {
   check(drives.start(cdcr::boards::zcu102_r5f::kCanTiming), "can1 starts at 1 Mbit/s");
 
   const RuntimeState state = runtime.init();
-  zynqmp::console_write("boot: state ");
-  zynqmp::console_write(cdcr::firmware::to_string(state));
-  zynqmp::console_write(", fault ");
-  zynqmp::console_write(cdcr::firmware::to_string(runtime.boot_fault()));
-  zynqmp::console_write("\n");
+  print("boot: state ", cdcr::firmware::to_string(state), ", fault ", cdcr::firmware::to_string(runtime.boot_fault()),
+        "\n");
   check(state == RuntimeState::degraded, "no image linked: DEGRADED");
   check(runtime.boot_fault() == FaultCode::image_missing, "no image linked: image missing");
   check(runtime.can_filters_accepted(), "the controller takes the runtime's acceptance filters");
@@ -174,18 +132,11 @@ int main() {
     compare(bus, worst);
     poses_compared += 1;
   }
-  zynqmp::console_write("poses: ");
-  zynqmp::console_write_int(poses_compared);
-  zynqmp::console_write(" cycles; largest difference bus - runtime: ");
+  print("poses: ", poses_compared, " cycles; largest difference bus - runtime: ");
   write_micro(worst.position_mm);
   zynqmp::console_write(" nm position, ");
   write_micro(worst.rotation);
-  zynqmp::console_write(" ppm rotation\n");
-  zynqmp::console_write("worst cycle: ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(worst_cycle_counts));
-  zynqmp::console_write(" instructions over ");
-  zynqmp::console_write_int(kCycles);
-  zynqmp::console_write(" cycles\n");
+  print(" ppm rotation\n", "worst cycle: ", worst_cycle_counts, " instructions over ", kCycles, " cycles\n");
   check(worst_cycle_counts < static_cast<std::uint64_t>(cdcr::boards::zcu102_r5f::kCyclePeriodNs),
         "every cycle within its 1 ms period");
   check(board.timer.overruns() == 0, "no release missed");
@@ -201,31 +152,14 @@ int main() {
     runtime.run_cycle(board.timer.wait_next());
     drain(bus);
   }
-  zynqmp::console_write("drives silent: STATUS state ");
-  zynqmp::console_write_int(bus.reported_state);
-  zynqmp::console_write(", fault ");
-  zynqmp::console_write_int(bus.reported_fault);
-  zynqmp::console_write("\n");
+  print("drives silent: STATUS state ", bus.reported_state, ", fault ", bus.reported_fault, "\n");
   check(bus.reported_state == static_cast<int>(RuntimeState::fault), "STATUS reports FAULT once the drives are silent");
   check(bus.reported_fault == static_cast<int>(FaultCode::cable_input_stale), "STATUS reports stale cable input");
 
   const cdcr::hal::CanErrorCounters counters = board.can.error_counters();
-  zynqmp::console_write("can0: ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(counters.tx_dropped));
-  zynqmp::console_write(" dropped, ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(counters.rx_overruns));
-  zynqmp::console_write(" overruns, ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(counters.bus_errors));
-  zynqmp::console_write(" bus errors; ");
-  zynqmp::console_write_int(static_cast<std::int32_t>(board.timer.overruns()));
-  zynqmp::console_write(" releases missed\n");
+  print("can0: ", counters.tx_dropped, " dropped, ", counters.rx_overruns, " overruns, ", counters.bus_errors,
+        " bus errors; ", board.timer.overruns(), " releases missed\n");
   check(counters.tx_dropped == 0 && counters.rx_overruns == 0 && counters.bus_errors == 0, "a clean bus");
 
-  if (failures != 0) {
-    zynqmp::console_write_int(failures);
-    zynqmp::console_write(" checks failed\n");
-    return 1;
-  }
-  zynqmp::console_write("PASS\n");
-  return 0;
+  return verdict();
 }

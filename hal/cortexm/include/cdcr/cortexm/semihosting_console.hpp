@@ -2,18 +2,10 @@
 // The runtime's log lines over semihosting. On a board without a debugger
 // attached, a UART console takes its place (hal/README.md).
 
-#include <cdcr/hal/console.hpp>
-
-#include "cdcr/cortexm/semihosting.hpp"
+#include <cdcr/baremetal/line_console.hpp>
 
 namespace cdcr::cortexm {
 
-class SemihostingConsole final : public hal::Console {
- public:
-  void write_line(const char* line) override {
-    console_write(line);
-    console_write("\n");
-  }
-};
+using SemihostingConsole = baremetal::LineConsole;
 
 }  // namespace cdcr::cortexm

@@ -5,6 +5,8 @@
 
 #include <cstdint>
 
+#include <cdcr/baremetal/mmio.hpp>
+
 namespace cdcr::zynqmp {
 
 class CadenceUart {
@@ -21,9 +23,7 @@ class CadenceUart {
   void flush();
 
  private:
-  volatile std::uint32_t& reg(std::uint32_t offset) const {
-    return *reinterpret_cast<volatile std::uint32_t*>(base_ + offset);
-  }
+  volatile std::uint32_t& reg(std::uint32_t offset) const { return baremetal::register_at(base_, offset); }
 
   std::uintptr_t base_;
 };

@@ -19,11 +19,17 @@
 #include <cstddef>
 #include <cstdint>
 
+#include <cdcr/baremetal/mmio.hpp>
 #include <cdcr/hal/can_bus.hpp>
 
 #include "cdcr/zynqmp/can_bit_timing.hpp"
 
 namespace cdcr::zynqmp {
+
+enum class CanMode : std::uint8_t {
+  normal,
+  loopback,  // the controller receives what it sends and drives nothing onto the bus
+};
 
 // SR.ESTAT.
 enum class CanErrorState : std::uint8_t {
@@ -31,11 +37,6 @@ enum class CanErrorState : std::uint8_t {
   error_active = 1,
   bus_off = 2,
   error_passive = 3,
-};
-
-enum class CanMode : std::uint8_t {
-  normal,
-  loopback,  // the controller receives what it sends and drives nothing onto the bus
 };
 
 // What the controller's error registers say.
@@ -92,9 +93,7 @@ class XilinxCanController {
   std::uint32_t skipped_frames() const { return skipped_frames_; }
 
  private:
-  volatile std::uint32_t& reg(std::uint32_t offset) const {
-    return *reinterpret_cast<volatile std::uint32_t*>(base_ + offset);
-  }
+  volatile std::uint32_t& reg(std::uint32_t offset) const { return baremetal::register_at(base_, offset); }
   hal::CanStatus write_frame(std::uint32_t id_offset, std::uint32_t full_flag, const hal::CanFrame& frame);
 
   std::uintptr_t base_;
