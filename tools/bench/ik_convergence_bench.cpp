@@ -181,6 +181,50 @@ void nominal_sets(int count, unsigned seed) {
   }
 }
 
+// Targets the compensated model reaches by construction: its own poses at
+// the sets' bends. The board's solver on the runtime's correction, from
+// the runtime's straight start, within the runtime's per-cycle budget and
+// kMaxIkCycles; converged means the solver's own tolerance on the
+// compensated model (2 um, 2e-5 rad in float).
+void compensated_sets(const fw::Runtime& runtime) {
+  const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
+  fw::SolverCorrection correction(runtime.correction());
+  model::IkSolverOptions<float> options;
+  options.max_corrections = fw::kMaxIkCorrections;
+  options.max_iterations = fw::kMaxIkIterations;
+  fw::Solver solver;
+  solver.configure(runtime.geometry(), correction, options, fw::kIkWorkCosts);
+  const int n = 200;
+  std::printf("the compensated model's own poses as targets, %d each, the board's solver from straight, %u units per "
+              "cycle:\n",
+              n, unsigned(runtime.ik_units_per_cycle()));
+  for (const TargetSet set : {TargetSet::paper, TargetSet::full_range, TargetSet::near_straight, TargetSet::at_limit}) {
+    int converged = 0;
+    std::vector<int> cycles_taken;
+    for (const model::JointVector<double>& joints : target_joints(set, n, 77u, geometry)) {
+      const fw::Joints bend = model::bend_from_joints(model::JointVector<float, model::kMaxSegments>(joints.cast<float>()));
+      const model::Pose<float> target =
+          model::exp(runtime.correction().predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
+      solver.start(target, model::IkTargetKind::pose, board_straight_start(geometry.segment_count));
+      int cycles = 0;
+      while (solver.state() == model::IkSolveState::running && cycles < fw::kMaxIkCycles) {
+        solver.run(runtime.ik_units_per_cycle());
+        ++cycles;
+      }
+      if (solver.state() == model::IkSolveState::converged) {
+        ++converged;
+        cycles_taken.push_back(cycles);
+      }
+    }
+    std::sort(cycles_taken.begin(), cycles_taken.end());
+    const auto at = [&](double q) {
+      return cycles_taken.empty() ? 0 : cycles_taken[std::size_t(q * double(cycles_taken.size() - 1))];
+    };
+    std::printf("  %-32s converged %3d / %3d; cycles p50 %3d p99 %3d max %3d\n", name_of(set), converged, n, at(0.5),
+                at(0.99), at(1.0));
+  }
+}
+
 // The single pose target to the circle's start on the runtime (part 2).
 void circle_start(const std::string& image_path, double radius_mm) {
   sim::SimulatedPlatform platform;
@@ -234,6 +278,38 @@ void circle_start(const std::string& image_path, double radius_mm) {
     ++cycles;
   } while ((runtime.ik_running() || runtime.last_ik_report().sequence != 7) && cycles < 2 * fw::kMaxIkCycles);
   const fw::IkReport& report = runtime.last_ik_report();
+  {
+    // The compensated model at the bends that made the target (on the
+    // simulated robot): how far the model's own image is from it there.
+    const fw::Joints bend = model::bend_from_joints(joints_at(bend_rad, 0.0).cast<float>());
+    const model::Pose<double> at =
+        (model::exp(runtime.correction().predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry()))
+            .cast<double>();
+    std::printf("  the compensated model at the target's own bends: %.4f um, %.3g rad off the target\n",
+                1000.0 * (at.position_mm - target.position_mm).norm(),
+                Eigen::AngleAxis<double>(model::Mat3<double>(target.rotation * at.rotation.transpose())).angle());
+  }
+  // The same solve by the solver alone on the runtime's correction, with the
+  // runtime's per-cycle budget: its outer iterations, for a closer look.
+  {
+    fw::SolverCorrection correction(runtime.correction());
+    fw::Solver solver;
+    model::IkSolverOptions<float> options;
+    options.max_corrections = fw::kMaxIkCorrections;
+    options.max_iterations = fw::kMaxIkIterations;
+    solver.configure(runtime.geometry(), correction, options, fw::kIkWorkCosts);
+    solver.start(target.cast<float>(), model::IkTargetKind::pose, joints_at(0.5 * bend_rad, 0.0).cast<float>());
+    int solver_cycles = 0;
+    while (solver.state() == model::IkSolveState::running && solver_cycles < fw::kMaxIkCycles) {
+      solver.run(runtime.ik_units_per_cycle());
+      ++solver_cycles;
+    }
+    std::printf("  the solver alone: %s after %d cycles, %d corrections, %d iterations, %d restarts; residual %.4f um, "
+                "%.3g rad\n",
+                solver.state() == model::IkSolveState::converged ? "converged" : "not converged", solver_cycles,
+                solver.corrections(), solver.iterations(), solver.restarts(), 1000.0 * double(solver.best_position_error_mm()),
+                double(solver.best_orientation_error_rad()));
+  }
   std::printf("single pose target to the circle's start (radius %.1f mm, every segment bent %.4f rad), from half "
               "the bend, %u IK units per cycle:\n",
               radius_mm, bend_rad, unsigned(runtime.ik_units_per_cycle()));
@@ -250,6 +326,7 @@ void circle_start(const std::string& image_path, double radius_mm) {
                 1000.0 * (at.position_mm - target.position_mm).norm(),
                 Eigen::AngleAxis<double>(model::Mat3<double>(target.rotation * at.rotation.transpose())).angle());
   }
+  compensated_sets(runtime);
 }
 
 }  // namespace
