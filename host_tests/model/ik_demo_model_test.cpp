@@ -56,8 +56,10 @@ void load(DemoModel& m) {
   ASSERT_EQ(m.correction.bind(m.view), Status::ok);
 }
 
-// Targets converged of `targets` compensated poses with theta up to theta_max.
-int converged_from_straight(const DemoModel& m, Solver& solver, double theta_max, int targets, unsigned seed) {
+// Targets converged of `targets` compensated poses with theta up to
+// theta_max; with one_at_limit, one segment (in turn) bent to its limit.
+int converged_from_straight(const DemoModel& m, Solver& solver, double theta_max, int targets, unsigned seed,
+                            bool one_at_limit = false) {
   IkSolverOptions<float> options;
   options.max_corrections = 40;  // the runtime's kMaxIkCorrections and kMaxIkIterations
   options.max_iterations = 400;
@@ -77,6 +79,7 @@ int converged_from_straight(const DemoModel& m, Solver& solver, double theta_max
       q[2 * s] = float(alpha(rng));
       q[2 * s + 1] = float(theta(rng));
     }
+    if (one_at_limit) q[2 * (t % segments) + 1] = m.geometry.segments[t % segments].theta_max_rad;
     const JointVector<float> b = bend_from_joints(q);
     const Pose<float> target = exp(m.correction.predict(b)) * forward_kinematics_bend(b, m.geometry);
     EXPECT_EQ(solver.start(target, IkTargetKind::pose, straight), Status::ok);
@@ -108,6 +111,21 @@ TEST(IkDemoModel, PaperWorkspacePoseTargetsConvergeFromStraight) {
   const int converged = converged_from_straight(m, solver, 0.2, 200, 2620u);
   RecordProperty("converged", converged);
   EXPECT_GE(converged, 199);
+}
+
+// The full design range and targets on the theta limit: the restarts and
+// the active set (the floors guard those; this change leaves them as they
+// were).
+TEST(IkDemoModel, FullRangeAndLimitPoseTargetsConvergeFromStraight) {
+  DemoModel m;
+  ASSERT_NO_FATAL_FAILURE(load(m));
+  static Solver solver;
+  const int full_range = converged_from_straight(m, solver, kPi / 2, 200, 2657u);
+  const int at_limit = converged_from_straight(m, solver, kPi / 2, 200, 2658u, true);
+  RecordProperty("full_range_converged", full_range);
+  RecordProperty("at_limit_converged", at_limit);
+  EXPECT_GE(full_range, 198);
+  EXPECT_GE(at_limit, 196);
 }
 
 }  // namespace
