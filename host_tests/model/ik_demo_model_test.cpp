@@ -12,7 +12,7 @@
 // wander at 2-3 um (2.1 -> 2.5 -> 3.5 um), and the floor rule stopped the
 // solve a few um short after two stalled iterations: 190 of 200 near
 // straight and 197 of 200 in the paper's workspace converged. With a third
-// iteration allowed at the floor (ik_solver.hpp, outer_step): 200 and 200.
+// iteration allowed within 3 tolerances (ik_solver.hpp, outer_step): 199 and 200.
 // The floors sit just under that.
 
 #include <algorithm>
@@ -101,7 +101,7 @@ TEST(IkDemoModel, NearStraightPoseTargetsConvergeFromStraight) {
   static Solver solver;
   const int converged = converged_from_straight(m, solver, 0.06, 200, 2606u);
   RecordProperty("converged", converged);
-  EXPECT_GE(converged, 198);
+  EXPECT_GE(converged, 197);
 }
 
 TEST(IkDemoModel, PaperWorkspacePoseTargetsConvergeFromStraight) {

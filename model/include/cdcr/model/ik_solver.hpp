@@ -599,8 +599,11 @@ class IkSolver {
     // 86 um outside the compensated model's image near the straight robot
     // (the tip cannot rise that far along the backbone at that bend and
     // orientation; 300 random starts end no closer), which no step fixes.
+    // Only within a few tolerances of the target: farther out a third
+    // evaluation only costs cycles (the runtime accepts such a residual).
     const bool at_floor = position_error <= S(20) * options_.position_tolerance_mm;
-    if (stalled_outer_ >= (at_floor ? 3 : 2)) {
+    const bool wandering_at_tolerance = position_error <= S(3) * options_.position_tolerance_mm;
+    if (stalled_outer_ >= (wandering_at_tolerance ? 3 : 2)) {
       if (at_floor || !restart()) state_ = IkSolveState::not_converged;
       return;
     }
