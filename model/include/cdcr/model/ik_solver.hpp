@@ -581,10 +581,29 @@ class IkSolver {
       state_ = IkSolveState::not_converged;
       return;
     }
-    if (stalled_outer_ >= 2) {
-      // Near the tolerance a stall is the arithmetic's floor, not a bad
-      // start (the gradient was evaluated after the first stalled step).
-      const bool at_floor = position_error <= S(20) * options_.position_tolerance_mm;
+    // Near the tolerance a stall is the arithmetic's floor, not a bad start,
+    // but it takes a third stalled iteration to say so. Near the straight robot
+    // the tip's travel along the backbone and its roll about it are weakly
+    // actuated: a few mm/rad of nominal gain, no more than a trained
+    // correction's slope, so a secant slope a little off, and the float
+    // correction's own scatter (about 1 um: two summation orders of the
+    // demo model differ by that), let the residual wander at 2-3 um against
+    // a 2 um tolerance (2.1 -> 2.5 -> 3.5 um in a row). Two stalls ended
+    // such solves a few um short; the third iteration, one more correction
+    // evaluation, mostly lands inside (the demo model's own poses from the
+    // straight start, tools/bench/ik_convergence_bench.cpp: 199 of 200 near
+    // straight and 199 of 200 in the paper's workspace, 191 and 191 with
+    // two). A gradient refresh near the floor as well gave the same counts
+    // for more cycles. The stalls that end far from the target are another
+    // matter: the demo circle's start (a pose of the simulated robot) lies
+    // 86 um outside the compensated model's image near the straight robot
+    // (the tip cannot rise that far along the backbone at that bend and
+    // orientation; 300 random starts end no closer), which no step fixes.
+    // Only within a few tolerances of the target: farther out a third
+    // evaluation only costs cycles (the runtime accepts such a residual).
+    const bool at_floor = position_error <= S(20) * options_.position_tolerance_mm;
+    const bool wandering_at_tolerance = position_error <= S(3) * options_.position_tolerance_mm;
+    if (stalled_outer_ >= (wandering_at_tolerance ? 3 : 2)) {
       if (at_floor || !restart()) state_ = IkSolveState::not_converged;
       return;
     }

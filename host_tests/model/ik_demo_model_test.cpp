@@ -1,0 +1,132 @@
+// IK convergence on the demo's model: the image tools/demo.sh trains (700
+// samples of the simulated robot, seed 1), made by the qemu.golden fixture.
+// The targets are the compensated model's own poses at fixed, seeded bends,
+// so every one is reachable; each is solved by the board's solver type in
+// float from the runtime's straight start (alpha 0, theta 0.1 on every
+// segment) with the runtime's bounds, to the solver's float tolerance
+// (2 um, 2e-5 rad) on the compensated model.
+//
+// Near the straight robot the tip's travel along the backbone and its roll
+// about it are weakly actuated (a few mm/rad, no more than the slope of
+// this model's correction): the last outer iterations let the residual
+// wander at 2-3 um (2.1 -> 2.5 -> 3.5 um), and the floor rule stopped the
+// solve a few um short after two stalled iterations: 190 of 200 near
+// straight and 197 of 200 in the paper's workspace converged. With a third
+// iteration allowed within 3 tolerances (ik_solver.hpp, outer_step): 199 and 200.
+// The floors sit just under that.
+
+#include <algorithm>
+#include <cstdint>
+#include <fstream>
+#include <iterator>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "cdcr/model/compensated_kinematics.hpp"
+#include "cdcr/model/flash_image.hpp"
+#include "cdcr/model/gp_correction.hpp"
+#include "cdcr/model/ik_solver.hpp"
+
+namespace cdcr::model {
+namespace {
+
+using Correction = GpCorrection<float, double, kMaxSegments>;
+using Solver = IkSolver<float, kMaxSegments, Correction>;
+
+constexpr double kPi = 3.14159265358979323846;
+
+struct DemoModel {
+  std::vector<std::uint8_t> image;
+  ImageView view{};
+  RobotGeometry<float> geometry;
+  Correction correction;
+};
+
+void load(DemoModel& m) {
+  std::ifstream file(CDCR_DEMO_MODEL_IMAGE, std::ios::binary);
+  ASSERT_TRUE(file) << "no demo model at " CDCR_DEMO_MODEL_IMAGE " (the qemu.golden test makes it)";
+  m.image.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
+  ImageCapacity capacity;
+  capacity.max_training_points = 4096;
+  ASSERT_EQ(parse_image(m.image.data(), m.image.size(), m.view, capacity), ImageStatus::ok);
+  ASSERT_EQ(geometry_from_image(m.view, m.geometry), Status::ok);
+  ASSERT_EQ(m.correction.bind(m.view), Status::ok);
+}
+
+// Targets converged of `targets` compensated poses with theta up to
+// theta_max; with one_at_limit, one segment (in turn) bent to its limit.
+int converged_from_straight(const DemoModel& m, Solver& solver, double theta_max, int targets, unsigned seed,
+                            bool one_at_limit = false) {
+  IkSolverOptions<float> options;
+  options.max_corrections = 40;  // the runtime's kMaxIkCorrections and kMaxIkIterations
+  options.max_iterations = 400;
+  solver.configure(m.geometry, m.correction, options);
+  const int segments = m.geometry.segment_count;
+  JointVector<float> straight(2 * segments);
+  for (int s = 0; s < segments; ++s) {
+    straight[2 * s] = 0.0f;
+    straight[2 * s + 1] = 0.1f;
+  }
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> alpha(-kPi, kPi), theta(0.0, theta_max);
+  int converged = 0;
+  for (int t = 0; t < targets; ++t) {
+    JointVector<float> q(2 * segments);
+    for (int s = 0; s < segments; ++s) {
+      q[2 * s] = float(alpha(rng));
+      q[2 * s + 1] = float(theta(rng));
+    }
+    if (one_at_limit) q[2 * (t % segments) + 1] = m.geometry.segments[t % segments].theta_max_rad;
+    const JointVector<float> b = bend_from_joints(q);
+    const Pose<float> target = exp(m.correction.predict(b)) * forward_kinematics_bend(b, m.geometry);
+    EXPECT_EQ(solver.start(target, IkTargetKind::pose, straight), Status::ok);
+    solver.run_to_end();
+    if (solver.state() != IkSolveState::converged) continue;
+    ++converged;
+    // Independently: the compensated model at the answer (predict() sums in
+    // another order than the sliced evaluation: about 1 um apart here).
+    const JointVector<float> answer = bend_from_joints(solver.best_joints());
+    const Pose<float> tip = exp(m.correction.predict(answer)) * forward_kinematics_bend(answer, m.geometry);
+    EXPECT_LE((tip.position_mm - target.position_mm).norm(), 5e-3f) << "target " << t;
+  }
+  return converged;
+}
+
+TEST(IkDemoModel, NearStraightPoseTargetsConvergeFromStraight) {
+  DemoModel m;
+  ASSERT_NO_FATAL_FAILURE(load(m));
+  static Solver solver;
+  const int converged = converged_from_straight(m, solver, 0.06, 200, 2606u);
+  RecordProperty("converged", converged);
+  EXPECT_GE(converged, 197);
+}
+
+TEST(IkDemoModel, PaperWorkspacePoseTargetsConvergeFromStraight) {
+  DemoModel m;
+  ASSERT_NO_FATAL_FAILURE(load(m));
+  static Solver solver;
+  const int converged = converged_from_straight(m, solver, 0.2, 200, 2620u);
+  RecordProperty("converged", converged);
+  EXPECT_GE(converged, 199);
+}
+
+// The full design range and targets on the theta limit: the restarts and
+// the active set (the floors guard those; this change leaves them as they
+// were).
+TEST(IkDemoModel, FullRangeAndLimitPoseTargetsConvergeFromStraight) {
+  DemoModel m;
+  ASSERT_NO_FATAL_FAILURE(load(m));
+  static Solver solver;
+  const int full_range = converged_from_straight(m, solver, kPi / 2, 200, 2657u);
+  const int at_limit = converged_from_straight(m, solver, kPi / 2, 200, 2658u, true);
+  RecordProperty("full_range_converged", full_range);
+  RecordProperty("at_limit_converged", at_limit);
+  EXPECT_GE(full_range, 198);
+  EXPECT_GE(at_limit, 196);
+}
+
+}  // namespace
+}  // namespace cdcr::model

@@ -1,0 +1,361 @@
+// cdcr-bench-ik: how often the IK solver converges, over fixed, seeded sets
+// of reachable pose targets, and what the single pose target to the start of
+// the demo's streamed circle costs the runtime.
+//
+// Part 1, the nominal model (no correction), each set from a straight start:
+//   * "board": the resumable solver in float with the runtime's bounds
+//     (kMaxIkCorrections, kMaxIkIterations) from the runtime's straight
+//     start (alpha 0, theta 0.1 on every segment);
+//   * "cdcr ik": solve_ik in double with the options and the start
+//     (alpha 0, theta 0.05) that `cdcr ik --pose` uses.
+// A target counts as converged when forward kinematics (in double) of the
+// cables the solver returned, read back into joints, is within 0.01 mm and
+// 0.01 deg of the target; the solver's own verdict is counted beside it.
+// The sets: paper workspace (theta <= 0.2), full design range (theta <=
+// pi/2), near-straight (theta <= 0.06), at the limit (one segment bent to
+// theta_max, the others anywhere).
+//
+// Part 2 (--image): the firmware runtime with that image on the simulated
+// board and robot, as `cdcr-runtime --sim --circle` runs it: the drives hold
+// the cables of half the circle's bend, and a single (not streamed) pose
+// target to the circle's start (40 mm radius, bend direction 0) is sent. It
+// prints the cycles and iterations the request took, its outcome, how far
+// the compensated model is from the target at the bends that made it, and
+// the same solve by the solver alone (cycles, corrections, restarts).
+// Then the compensated model's own poses at the four sets' bends (200
+// each, reachable by construction), solved by the board's solver type from
+// the straight start within the runtime's per-cycle budget: converged to
+// the solver's float tolerance (2 um, 2e-5 rad), and the cycles it took.
+//
+//   cdcr-bench-ik [--targets 2000] [--seed 26] [--image model.img]
+//   bash tools/bench/run_ik_convergence_bench.sh   (trains the demo's image)
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <random>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include <CLI/CLI.hpp>
+#include <Eigen/Geometry>
+
+#include <cdcr/firmware/capacity.hpp>
+#include <cdcr/firmware/runtime.hpp>
+#include <cdcr/model/compensation.hpp>
+#include <cdcr/model/inverse_kinematics.hpp>
+#include <cdcr/model/kinematics.hpp>
+
+#include "export/binary_file.hpp"
+#include "sim/simulated_drives.hpp"
+#include "sim/simulated_platform.hpp"
+#include "sim/simulated_robot.hpp"
+#include "sim/target_frames.hpp"
+
+namespace {
+
+namespace fw = cdcr::firmware;
+namespace model = cdcr::model;
+namespace protocol = cdcr::firmware::protocol;
+namespace sim = cdcr::sim;
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kCheckPositionMm = 0.01;
+constexpr double kCheckOrientationRad = 0.01 * kPi / 180.0;
+
+enum class TargetSet { paper, full_range, near_straight, at_limit };
+
+const char* name_of(TargetSet set) {
+  switch (set) {
+    case TargetSet::paper: return "paper workspace (theta <= 0.2)";
+    case TargetSet::full_range: return "full range (theta <= pi/2)";
+    case TargetSet::near_straight: return "near straight (theta <= 0.06)";
+    case TargetSet::at_limit: return "one segment at theta_max";
+  }
+  return "?";
+}
+
+// The joints of the set's targets, in a fixed order for a seed.
+std::vector<model::JointVector<double>> target_joints(TargetSet set, int count, unsigned seed,
+                                                      const model::RobotGeometry<double>& geometry) {
+  std::mt19937 rng(seed + 1000u * unsigned(set));
+  const auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+  std::vector<model::JointVector<double>> all;
+  for (int k = 0; k < count; ++k) {
+    model::JointVector<double> joints(2 * geometry.segment_count);
+    const double theta_cap = set == TargetSet::paper ? 0.2 : set == TargetSet::near_straight ? 0.06 : kPi / 2;
+    for (int i = 0; i < geometry.segment_count; ++i) {
+      joints[2 * i] = uniform(-kPi, kPi);
+      joints[2 * i + 1] = uniform(0, std::min(theta_cap, geometry.segments[i].theta_max_rad));
+    }
+    if (set == TargetSet::at_limit) {
+      const int segment = k % geometry.segment_count;
+      joints[2 * segment + 1] = geometry.segments[segment].theta_max_rad;
+    }
+    all.push_back(joints);
+  }
+  return all;
+}
+
+// Forward kinematics in double of the cables the solver returned (computed
+// in its own arithmetic, as the board computes its setpoints), read back
+// into joints: what the robot would do with the setpoints. A float cable
+// length is within a rounding step (below 1e-4 mm) of the double one.
+constexpr double kCableResolutionMm = 1e-4;
+
+template <typename S>
+bool reaches(const model::JointVector<S>& joints, const model::RobotGeometry<double>& geometry,
+             const model::Pose<double>& target, double& position_mm, double& orientation_rad) {
+  model::CableVector<S> cables;
+  model::JointVector<double> read_back;
+  model::Pose<double> tip;
+  if (model::cables_from_joints(joints, geometry.cast<S>(), cables) != model::Status::ok ||
+      model::joints_from_cables(model::CableVector<double>(cables.template cast<double>()), geometry, read_back,
+                                kCableResolutionMm) != model::Status::ok ||
+      model::forward_kinematics(read_back, geometry, tip) != model::Status::ok) {
+    position_mm = orientation_rad = INFINITY;
+    return false;
+  }
+  position_mm = (tip.position_mm - target.position_mm).norm();
+  orientation_rad = Eigen::AngleAxis<double>(model::Mat3<double>(target.rotation * tip.rotation.transpose())).angle();
+  return position_mm <= kCheckPositionMm && orientation_rad <= kCheckOrientationRad;
+}
+
+struct Tally {
+  int targets = 0;
+  int checked = 0;         // within 0.01 mm / 0.01 deg by forward kinematics of the cables
+  int solver_says = 0;     // the solver's own verdict
+  std::vector<int> iterations;  // of the checked ones
+  void print(const char* solver) const {
+    std::vector<int> sorted = iterations;
+    std::sort(sorted.begin(), sorted.end());
+    const auto at = [&](double q) { return sorted.empty() ? 0 : sorted[std::size_t(q * double(sorted.size() - 1))]; };
+    std::printf("  %-8s converged %5d / %5d (%6.2f %%), solver says %5d; iterations p50 %3d p99 %3d max %3d\n", solver,
+                checked, targets, 100.0 * checked / std::max(1, targets), solver_says, at(0.5), at(0.99), at(1.0));
+  }
+};
+
+model::JointVector<float> board_straight_start(int segments) {
+  model::JointVector<float> joints(2 * segments);
+  for (int i = 0; i < segments; ++i) {
+    joints[2 * i] = 0.0f;
+    joints[2 * i + 1] = 0.1f;
+  }
+  return joints;
+}
+
+void nominal_sets(int count, unsigned seed) {
+  const model::RobotGeometry<double> geometry = model::RobotGeometry<double>::prototype();
+  const model::RobotGeometry<float> geometry_f = geometry.cast<float>();
+  model::IkSolverOptions<float> board_options;
+  board_options.max_corrections = fw::kMaxIkCorrections;
+  board_options.max_iterations = fw::kMaxIkIterations;
+  model::IkSolver<float, model::kMaxSegments> board;
+  board.configure(geometry_f, nullptr, board_options);
+  model::JointVector<double> cli_start(2 * geometry.segment_count);
+  for (int i = 0; i < geometry.segment_count; ++i) {
+    cli_start[2 * i] = 0.0;
+    cli_start[2 * i + 1] = 0.05;
+  }
+  for (const TargetSet set : {TargetSet::paper, TargetSet::full_range, TargetSet::near_straight, TargetSet::at_limit}) {
+    const int n = set == TargetSet::full_range ? count : std::max(1, count / 4);
+    Tally on_board, on_cli;
+    for (const model::JointVector<double>& joints : target_joints(set, n, seed, geometry)) {
+      model::Pose<double> target;
+      model::forward_kinematics(joints, geometry, target);
+      double position_mm = 0, orientation_rad = 0;
+
+      ++on_board.targets;
+      board.start(target.cast<float>(), model::IkTargetKind::pose, board_straight_start(geometry.segment_count));
+      board.run_to_end();
+      on_board.solver_says += board.state() == model::IkSolveState::converged;
+      if (reaches(board.best_joints(), geometry, target, position_mm, orientation_rad)) {
+        ++on_board.checked;
+        on_board.iterations.push_back(board.iterations());
+      }
+
+      ++on_cli.targets;
+      const model::IkResult<double> result = model::solve_ik(target, geometry, cli_start);
+      on_cli.solver_says += result.converged();
+      if (reaches(result.joints, geometry, target, position_mm, orientation_rad)) {
+        ++on_cli.checked;
+        on_cli.iterations.push_back(result.iterations);
+      }
+    }
+    std::printf("%s, %d pose targets from straight:\n", name_of(set), n);
+    on_board.print("board");
+    on_cli.print("cdcr ik");
+  }
+}
+
+// Targets the compensated model reaches by construction: its own poses at
+// the sets' bends. The board's solver on the runtime's correction, from
+// the runtime's straight start, within the runtime's per-cycle budget and
+// kMaxIkCycles; converged means the solver's own tolerance on the
+// compensated model (2 um, 2e-5 rad in float).
+void compensated_sets(const fw::Runtime& runtime) {
+  const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
+  fw::SolverCorrection correction(runtime.correction());
+  model::IkSolverOptions<float> options;
+  options.max_corrections = fw::kMaxIkCorrections;
+  options.max_iterations = fw::kMaxIkIterations;
+  fw::Solver solver;
+  solver.configure(runtime.geometry(), correction, options, fw::kIkWorkCosts);
+  const int n = 200;
+  std::printf("the compensated model's own poses as targets, %d each, the board's solver from straight, %u units per "
+              "cycle:\n",
+              n, unsigned(runtime.ik_units_per_cycle()));
+  for (const TargetSet set : {TargetSet::paper, TargetSet::full_range, TargetSet::near_straight, TargetSet::at_limit}) {
+    int converged = 0;
+    std::vector<int> cycles_taken;
+    for (const model::JointVector<double>& joints : target_joints(set, n, 77u, geometry)) {
+      const fw::Joints bend = model::bend_from_joints(model::JointVector<float, model::kMaxSegments>(joints.cast<float>()));
+      const model::Pose<float> target =
+          model::exp(runtime.correction().predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
+      solver.start(target, model::IkTargetKind::pose, board_straight_start(geometry.segment_count));
+      int cycles = 0;
+      while (solver.state() == model::IkSolveState::running && cycles < fw::kMaxIkCycles) {
+        solver.run(runtime.ik_units_per_cycle());
+        ++cycles;
+      }
+      if (solver.state() == model::IkSolveState::converged) {
+        ++converged;
+        cycles_taken.push_back(cycles);
+      }
+    }
+    std::sort(cycles_taken.begin(), cycles_taken.end());
+    const auto at = [&](double q) {
+      return cycles_taken.empty() ? 0 : cycles_taken[std::size_t(q * double(cycles_taken.size() - 1))];
+    };
+    std::printf("  %-32s converged %3d / %3d; cycles p50 %3d p99 %3d max %3d\n", name_of(set), converged, n, at(0.5),
+                at(0.99), at(1.0));
+  }
+}
+
+// The single pose target to the circle's start on the runtime (part 2).
+void circle_start(const std::string& image_path, double radius_mm) {
+  sim::SimulatedPlatform platform;
+  platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
+  fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
+  runtime.init();
+  if (runtime.state() != fw::RuntimeState::run) throw std::runtime_error("the image did not boot into RUN");
+  const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
+  sim::SimulatedRobot robot(geometry, sim::SimulatorConfig{});
+  const auto joints_at = [&](double bend_rad, double direction_rad) {
+    model::JointVector<double> joints(2 * geometry.segment_count);
+    for (int s = 0; s < geometry.segment_count; ++s) {
+      joints[2 * s] = direction_rad;
+      joints[2 * s + 1] = bend_rad;
+    }
+    return joints;
+  };
+  // The bend that puts the nominal tip radius_mm off the axis (as --circle).
+  double low = 0, high = geometry.segments[0].theta_max_rad;
+  for (int i = 0; i < 60; ++i) {
+    model::Pose<double> tip;
+    model::forward_kinematics(joints_at(0.5 * (low + high), 0.0), geometry, tip);
+    (tip.position_mm.head<2>().norm() < radius_mm ? low : high) = 0.5 * (low + high);
+  }
+  const double bend_rad = 0.5 * (low + high);
+  model::CableVector<double> target_cables, start_cables;
+  model::cables_from_joints(joints_at(bend_rad, 0.0), geometry, target_cables);
+  model::cables_from_joints(joints_at(0.5 * bend_rad, 0.0), geometry, start_cables);
+  const model::Pose<double> target = robot.true_pose(target_cables);
+
+  sim::SimulatedCableDrives drives(platform.bus.node(1), start_cables, 50.0);
+  cdcr::hal::CanBus& host = platform.bus.node(2);
+  host.set_filters(&protocol::kIkReportFrames, 1);
+  platform.timer.start(1'000'000);
+  const auto cycle = [&] {
+    const cdcr::hal::TimerTick tick = platform.timer.wait_next();
+    drives.step(1e-3);
+    robot.move_cables(drives.cables_mm());
+    runtime.run_cycle(tick);
+    cdcr::hal::CanFrame frame;
+    while (host.receive(frame) == cdcr::hal::CanStatus::ok) {
+    }
+  };
+  for (int k = 0; k < 20; ++k) cycle();
+  for (const cdcr::hal::CanFrame& frame : sim::target_frames(target, protocol::TargetMode::pose, false, 7)) {
+    host.send(frame);
+  }
+  int cycles = 0;
+  do {
+    cycle();
+    ++cycles;
+  } while ((runtime.ik_running() || runtime.last_ik_report().sequence != 7) && cycles < 2 * fw::kMaxIkCycles);
+  const fw::IkReport& report = runtime.last_ik_report();
+  std::printf("single pose target to the circle's start (radius %.1f mm, every segment bent %.4f rad), from half "
+              "the bend, %u IK units per cycle:\n",
+              radius_mm, bend_rad, unsigned(runtime.ik_units_per_cycle()));
+  std::printf("  outcome %s (%s) after %d cycles, %d iterations; residual %.4f um, %.3g rad\n",
+              report.outcome == protocol::IkOutcome::converged ? "converged" : "not converged",
+              model::to_string(report.model_status), report.cycles, report.iterations,
+              1000.0 * double(report.position_error_mm), double(report.orientation_error_rad));
+  if (runtime.has_setpoints()) {
+    const fw::Joints bend = model::bend_from_joints(runtime.setpoint_joints());
+    const model::Pose<float> predicted =
+        model::exp(runtime.correction().predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
+    const model::Pose<double> at = predicted.cast<double>();
+    std::printf("  the compensated model at the setpoints: %.4f um, %.3g rad off the target\n",
+                1000.0 * (at.position_mm - target.position_mm).norm(),
+                Eigen::AngleAxis<double>(model::Mat3<double>(target.rotation * at.rotation.transpose())).angle());
+  }
+  {
+    // The compensated model at the bends that made the target (on the
+    // simulated robot): how far the model's own image is from it there.
+    const fw::Joints bend = model::bend_from_joints(joints_at(bend_rad, 0.0).cast<float>());
+    const model::Pose<double> at =
+        (model::exp(runtime.correction().predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry()))
+            .cast<double>();
+    std::printf("  the compensated model at the target's own bends: %.4f um, %.3g rad off the target\n",
+                1000.0 * (at.position_mm - target.position_mm).norm(),
+                Eigen::AngleAxis<double>(model::Mat3<double>(target.rotation * at.rotation.transpose())).angle());
+  }
+  // The same solve by the solver alone on the runtime's correction, with the
+  // runtime's per-cycle budget: its outer iterations, for a closer look.
+  {
+    fw::SolverCorrection correction(runtime.correction());
+    fw::Solver solver;
+    model::IkSolverOptions<float> options;
+    options.max_corrections = fw::kMaxIkCorrections;
+    options.max_iterations = fw::kMaxIkIterations;
+    solver.configure(runtime.geometry(), correction, options, fw::kIkWorkCosts);
+    solver.start(target.cast<float>(), model::IkTargetKind::pose, joints_at(0.5 * bend_rad, 0.0).cast<float>());
+    int solver_cycles = 0;
+    while (solver.state() == model::IkSolveState::running && solver_cycles < fw::kMaxIkCycles) {
+      solver.run(runtime.ik_units_per_cycle());
+      ++solver_cycles;
+    }
+    std::printf("  the solver alone: %s after %d cycles, %d corrections, %d iterations, %d restarts; residual %.4f um, "
+                "%.3g rad\n",
+                solver.state() == model::IkSolveState::converged ? "converged" : "not converged", solver_cycles,
+                solver.corrections(), solver.iterations(), solver.restarts(), 1000.0 * double(solver.best_position_error_mm()),
+                double(solver.best_orientation_error_rad()));
+  }
+  compensated_sets(runtime);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"IK convergence over fixed target sets, and the circle-start target on the runtime"};
+  int count = 2000;
+  unsigned seed = 26;
+  std::string image;
+  double radius_mm = 40.0;
+  app.add_option("--targets", count, "full-range targets (the other sets a quarter of this)")->check(CLI::Range(1, 1000000));
+  app.add_option("--seed", seed, "seed of the target sets");
+  app.add_option("--image", image, "model image for the circle-start target on the runtime")->check(CLI::ExistingFile);
+  app.add_option("--circle-radius", radius_mm, "radius of the circle (mm)")->check(CLI::Range(1.0, 100.0));
+  CLI11_PARSE(app, argc, argv);
+  try {
+    nominal_sets(count, seed);
+    if (!image.empty()) circle_start(image, radius_mm);
+  } catch (const std::exception& e) {
+    std::fprintf(stderr, "cdcr-bench-ik: %s\n", e.what());
+    return 1;
+  }
+  return 0;
+}
