@@ -52,6 +52,7 @@
 #include "sim/simulated_platform.hpp"
 #include "sim/simulated_robot.hpp"
 #include "sim/target_frames.hpp"
+#include "sim/uniform_bend.hpp"
 
 namespace {
 
@@ -243,21 +244,10 @@ void circle_start(const std::string& image_path, double radius_mm) {
   const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
   sim::SimulatedRobot robot(geometry, sim::SimulatorConfig{});
   const auto joints_at = [&](double bend_rad, double direction_rad) {
-    model::JointVector<double> joints(2 * geometry.segment_count);
-    for (int s = 0; s < geometry.segment_count; ++s) {
-      joints[2 * s] = direction_rad;
-      joints[2 * s + 1] = bend_rad;
-    }
-    return joints;
+    return sim::uniform_bend_joints(geometry, bend_rad, direction_rad);
   };
-  // The bend that puts the nominal tip radius_mm off the axis (as --circle).
-  double low = 0, high = geometry.segments[0].theta_max_rad;
-  for (int i = 0; i < 60; ++i) {
-    model::Pose<double> tip;
-    model::forward_kinematics(joints_at(0.5 * (low + high), 0.0), geometry, tip);
-    (tip.position_mm.head<2>().norm() < radius_mm ? low : high) = 0.5 * (low + high);
-  }
-  const double bend_rad = 0.5 * (low + high);
+  // The bend that puts the nominal tip radius_mm off the axis.
+  const double bend_rad = sim::uniform_bend_for_tip_radius(geometry, radius_mm);
   model::CableVector<double> target_cables, start_cables;
   model::cables_from_joints(joints_at(bend_rad, 0.0), geometry, target_cables);
   model::cables_from_joints(joints_at(0.5 * bend_rad, 0.0), geometry, start_cables);

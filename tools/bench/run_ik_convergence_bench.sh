@@ -11,21 +11,17 @@
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 
-build_dir=${BUILD_DIR:-build}
-work=$build_dir/ik_bench
+source tools/bench/bench_build.sh
 
-cmake -S . -B "$build_dir" -DCMAKE_BUILD_TYPE=Release -DCDCR_BUILD_TOOLS=ON -DCDCR_BUILD_BENCHMARKS=ON \
-  --log-level=WARNING >/dev/null
-cmake --build "$build_dir" -j"$(nproc)" --target cdcr cdcr-bench-ik >/dev/null
-
-mkdir -p "$work"
-"$build_dir/bin/cdcr" simulate --samples 700 --seed 1 --out "$work/train.csv.new" >/dev/null
-if [[ ! -f $work/model.img ]] || ! cmp -s "$work/train.csv.new" "$work/train.csv"; then
-  mv "$work/train.csv.new" "$work/train.csv"
-  echo "Training the 700-point image (log: $work/train.log)..."
-  "$build_dir/bin/cdcr" train --data "$work/train.csv" --out "$work/model.img.new" >"$work/train.log" 2>&1
-  mv "$work/model.img.new" "$work/model.img"
+bench_work ik_bench base "-DCDCR_BUILD_TOOLS=ON -DCDCR_BUILD_BENCHMARKS=ON" cdcr cdcr-bench-ik
+# Training takes seconds; keep an image whose data set has not changed.
+"$cdcr" simulate --samples 700 --seed 1 --out "$work_dir/train.csv.new" >/dev/null
+if [[ ! -f $work_dir/model.img ]] || ! cmp -s "$work_dir/train.csv.new" "$work_dir/train.csv"; then
+  mv "$work_dir/train.csv.new" "$work_dir/train.csv"
+  echo "Training the 700-point image (log: $work_dir/train.log)..."
+  "$cdcr" train --data "$work_dir/train.csv" --out "$work_dir/model.img.new" >"$work_dir/train.log" 2>&1
+  mv "$work_dir/model.img.new" "$work_dir/model.img"
 else
-  rm -f "$work/train.csv.new"
+  rm -f "$work_dir/train.csv.new"
 fi
-"$build_dir/bin/cdcr-bench-ik" --image "$work/model.img" "$@"
+"$build_dir/bin/cdcr-bench-ik" --image "$work_dir/model.img" "$@"

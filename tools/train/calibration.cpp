@@ -1,4 +1,5 @@
 #include "calibration.hpp"
+#include "least_squares_functor.hpp"
 
 #include <cmath>
 #include <stdexcept>
@@ -39,13 +40,7 @@ bool nominal_pose(const TrainingSet& set, int row, const model::RobotGeometry<do
   return true;
 }
 
-struct TwistResiduals {
-  using Scalar = double;
-  enum { InputsAtCompileTime = Eigen::Dynamic, ValuesAtCompileTime = Eigen::Dynamic };
-  using InputType = Eigen::VectorXd;
-  using ValueType = Eigen::VectorXd;
-  using JacobianType = Eigen::MatrixXd;
-
+struct TwistResiduals : DynamicSizeResiduals {
   const TrainingSet* set = nullptr;
   model::RobotGeometry<double> design;
   double rotation_weight_mm = 1.0;

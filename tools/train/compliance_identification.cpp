@@ -1,4 +1,5 @@
 #include "compliance_identification.hpp"
+#include "least_squares_functor.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -41,13 +42,7 @@ ComplianceModel compliance_at(const ComplianceStructure& s, int segments, const 
   return c;
 }
 
-struct SagResiduals {
-  using Scalar = double;
-  enum { InputsAtCompileTime = Eigen::Dynamic, ValuesAtCompileTime = Eigen::Dynamic };
-  using InputType = Eigen::VectorXd;
-  using ValueType = Eigen::VectorXd;
-  using JacobianType = Eigen::MatrixXd;
-
+struct SagResiduals : DynamicSizeResiduals {
   const TrainingSet* set = nullptr;
   model::RobotGeometry<double> geometry;
   ComplianceStructure structure;

@@ -53,6 +53,14 @@ dataset::Dataset recorded(sim::SimulatedRobot& robot, int samples, bool with_pay
   return data;
 }
 
+// The simulator's bending stiffness of a segment of the (uniform) prototype,
+// N mm/rad: the backbone's EI/L and the two cables' k r² of each plane.
+double simulator_segment_stiffness(const model::RobotGeometry<double>& design, const sim::SimulatorConfig& config) {
+  const double length = design.segments[0].backbone_length_mm, radius = design.segments[0].anchor_radius_mm;
+  return config.structure.backbone_bending_stiffness_n_mm2 / length +
+         2.0 * config.structure.cable_stiffness_n_per_mm * radius * radius;
+}
+
 TEST(ComplianceIdentification, FindsTheSimulatorsStiffnessPlatformMassAndGravity) {
   const auto design = model::RobotGeometry<double>::prototype();
   const sim::SimulatorConfig config = gravity_only();
@@ -64,10 +72,7 @@ TEST(ComplianceIdentification, FindsTheSimulatorsStiffnessPlatformMassAndGravity
   structure.unloaded_mass = true;
   const ComplianceModel c = identify_compliance(set, design, structure);
 
-  // The simulator's stiffness of the (uniform) prototype's segments.
-  const double length = design.segments[0].backbone_length_mm, radius = design.segments[0].anchor_radius_mm;
-  const double stiffness = config.structure.backbone_bending_stiffness_n_mm2 / length +
-                           2.0 * config.structure.cable_stiffness_n_per_mm * radius * radius;
+  const double stiffness = simulator_segment_stiffness(design, config);
   // Tolerances: 0.1 % on the compliance, 1 g on the platform, 0.05 deg on
   // the direction (the sag is the same formula; eight fixed-point steps
   // against the simulator's converged equilibrium).
@@ -105,9 +110,7 @@ TEST(ComplianceIdentification, AnErrorOfTheBendsAloneDoesNotMoveTheStiffness) {
   ComplianceStructure structure;
   structure.unloaded_mass = true;
   const ComplianceModel c = identify_compliance(set, design, structure);
-  const double length = design.segments[0].backbone_length_mm, radius = design.segments[0].anchor_radius_mm;
-  const double stiffness = config.structure.backbone_bending_stiffness_n_mm2 / length +
-                           2.0 * config.structure.cable_stiffness_n_per_mm * radius * radius;
+  const double stiffness = simulator_segment_stiffness(design, config);
   const double off_deg = std::acos(std::min(1.0, c.gravity_direction().dot(config.gravity.direction.normalized()))) *
                          180.0 / 3.141592653589793;
   // Tolerances as without the offset, but for the platform's mass, whose
