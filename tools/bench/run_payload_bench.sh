@@ -19,7 +19,7 @@ cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 source tools/bench/bench_build.sh
 
 seed=$(seed_option 7 "$@")
-bench_work payload_bench base "" cdcr cdcr-bench-compliance
+bench_work payload_bench base "-DCDCR_BUILD_BENCHMARKS=ON" cdcr cdcr-bench-compliance
 python=/usr/bin/python3
 payload_range=0,1
 
