@@ -34,9 +34,6 @@ void IkRequest::start(const Pose& target, const TargetRequest& request, const Po
   solution_retried_ = false;
   target_ = target;
   cycles_ = 0;
-  // A streamed target that takes over the work may still send the point
-  // already sent only once.
-  if (!retarget) published_best_bend_.resize(0);
   if (started != model::Status::ok) {
     report_ = IkReport{};
     report_.sequence = request.sequence;
@@ -117,26 +114,20 @@ std::uint32_t IkRequest::continue_slice(std::uint32_t units) {
   return spent;
 }
 
-// Streamed targets: the best point so far, when it is close and new;
-// between evaluations the linearised solve's point, when it is closer.
-// Returns whether setpoints went out.
+// Streamed targets: setpoints in every cycle of the request, the best point
+// so far or, between evaluations, the linearised solve's point when its
+// predicted residual is smaller. The best point is never farther from the
+// newest target than the setpoints in place (a streamed request starts from
+// the last one's best point), so sending it is never a step back; holding
+// the old setpoints instead left the drives a cycle or more behind a moving
+// target. Returns whether setpoints went out.
 bool IkRequest::publish_tracking_point(Solver& solver) {
   // A point not yet checked for extrapolation is not sent when the target
   // refuses extrapolating solutions.
   if (!solver.has_best() || refuses_extrapolation_) return false;
   const bool linearised =
       solver.has_linearised_point() && solver.linearised_position_error_mm() < solver.best_position_error_mm();
-  const Joints& bend = linearised ? solver.linearised_bend() : solver.best_bend();
-  const Scalar position_error = linearised ? solver.linearised_position_error_mm() : solver.best_position_error_mm();
-  const Scalar orientation_error =
-      linearised ? solver.linearised_orientation_error_rad() : solver.best_orientation_error_rad();
-  const bool close = position_error <= kTrackingPublishPositionErrorMm &&
-                     (mode_ == protocol::TargetMode::position ||
-                      orientation_error <= kTrackingPublishOrientationErrorRad);
-  const bool is_new = published_best_bend_.size() != bend.size() || published_best_bend_ != bend;
-  if (!close || !is_new) return false;
   if (!set_setpoints(linearised ? solver.linearised_joints() : solver.best_joints())) return false;
-  published_best_bend_ = bend;
   publish_setpoints();
   return true;
 }

@@ -113,15 +113,6 @@ namespace cdcr::firmware {
 inline constexpr float kIkAcceptedPositionErrorMm = 0.05f;
 inline constexpr float kIkAcceptedOrientationErrorRad = 1e-3f;
 
-// Streamed (TRACKING) targets: while a request runs, the best point found so
-// far is sent as setpoints whenever it improves and is within these of the
-// newest target; the final answer follows on convergence. A planner streams
-// points a fraction of a millimetre apart (0.1 mm per cycle at 100 mm/s and
-// 1 kHz): a point a few targets behind is still worth sending, one far off
-// the path is not.
-inline constexpr float kTrackingPublishPositionErrorMm = 1.0f;
-inline constexpr float kTrackingPublishOrientationErrorRad = 0.01f;
-
 }  // namespace cdcr::firmware
 
 namespace cdcr::firmware {

@@ -113,7 +113,6 @@ class IkRequest {
   int cycles_ = 0;
   // How the solver ended, when its end did not fit in that cycle's slice.
   model::IkSolveState end_ = model::IkSolveState::running;
-  Joints published_best_bend_;
 
   std::uint32_t setpoints_published_ = 0;
   bool has_setpoints_ = false;

@@ -675,19 +675,21 @@ class IkSolver {
   }
 
   // A streamed target's step on the linearisation in hand; returns the
-  // units spent. New rows when the slice also holds the step, or when the
+  // units spent. New rows when the slice also holds the step (and an outer
+  // step waiting for its turn: a cycle whose new rows crowded out the step
+  // sent the last target's point again), or when the
   // old ones have served long enough (that cycle's step then waits a
   // cycle). An outer step waiting for its turn goes first when the slice
   // cannot hold both: the stream's steps must not starve the evaluations.
   std::uint32_t track_step(std::uint32_t budget) {
     std::uint32_t spent = 0;
-    const bool renew_rows = !rows_current_ && (budget >= costs_.nominal_jacobian + costs_.nominal_step ||
+    const std::uint32_t waiting = phase_ == Phase::outer_step ? costs_.outer_step : 0;
+    const bool renew_rows = !rows_current_ && (budget >= costs_.nominal_jacobian + costs_.nominal_step + waiting ||
                                                stale_row_steps_ >= kMaxStaleRowSteps);
     if (renew_rows && budget >= costs_.nominal_jacobian) {
       spent += costs_.nominal_jacobian;
       update_rows();
     }
-    const std::uint32_t waiting = phase_ == Phase::outer_step ? costs_.outer_step : 0;
     if (budget - spent < costs_.nominal_step + waiting) return spent;
     spent += costs_.nominal_step;
     if (phase_ == Phase::inner) {
