@@ -64,8 +64,9 @@ TEST_F(IkCyclesTest, PosePublishedEveryCycleWhileSolving) {
 }
 
 // A planner streams a TRACKING target every cycle along a circle at 100 mm/s
-// (0.1 mm a cycle): the setpoints the drives hold must stay within 3 cycles
-// of path behind the newest target, at the 99th percentile. The circle lies
+// (0.1 mm a cycle): every cycle after the first 3 sends setpoints, and the
+// setpoints the drives hold stay within 3 cycles of path behind the newest
+// target, every time. The circle lies
 // inside the workspace (a target the robot cannot reach is not followed,
 // by the policy), which a cold solve checks on the way.
 TEST_F(IkCyclesTest, StreamedTargetsAreFollowedWithinThreeCycles) {
@@ -120,15 +121,17 @@ TEST_F(IkCyclesTest, StreamedTargetsAreFollowedWithinThreeCycles) {
                                          static_cast<std::uint8_t>(step)});
     const std::uint32_t before = runtime->setpoints_published();
     cycles(1);
-    if (runtime->setpoints_published() != before) held = tip_of(runtime->setpoint_joints());
+    const bool sent = runtime->setpoints_published() != before;
+    if (sent) held = tip_of(runtime->setpoint_joints());
+    if (step > 3) EXPECT_TRUE(sent) << "no setpoints in the cycle of streamed target " << step;
     if (step > 20) lag_cycles.push_back((held - target).norm() / kPathPerCycleMm);
   }
-  EXPECT_GT(runtime->setpoints_published() - setpoints_before, unsigned(kSteps) * 9 / 10);
+  EXPECT_GE(runtime->setpoints_published() - setpoints_before, unsigned(kSteps) - 3);
   std::sort(lag_cycles.begin(), lag_cycles.end());
   const double p99 = lag_cycles[lag_cycles.size() * 99 / 100];
   std::printf("streamed lag: p50 %.2f p99 %.2f max %.2f cycles of path\n", lag_cycles[lag_cycles.size() / 2], p99,
               lag_cycles.back());
-  EXPECT_LE(p99, 3.0);
+  EXPECT_LE(lag_cycles.back(), 3.0);
 }
 
 TEST_F(IkCyclesTest, NewerTargetSupersedesTheRunningOne) {
