@@ -29,6 +29,15 @@ static_assert(zynqmp::bitrate(kCanTiming, zynqmp::kCanReferenceClockHz) == kCanB
 inline constexpr std::size_t kCanRxQueueDepth = 32;
 static_assert(firmware::kMaxCanFilters <= zynqmp::kXilinxCanFilters,
               "the controller holds every acceptance filter the runtime sets");
+// The instructions a cycle may take (Runtime::run_cycle, counted under
+// QEMU -icount shift=0 by zynqmp.workload): a 1 ms period of an R5F at
+// 500 MHz (the ZynqMP's RPU runs at 500 to 600 MHz by speed grade) at half
+// an instruction a clock, which its single-issue VFPv3 (no fused
+// multiply-add) and a DDR behind 32 KiB caches allow for the GP loops; the
+// Cortex-M boards' 80,000 and 120,000 are the same kind of figure for them.
+// The runtime spreads IK over cycles with the portable work costs
+// (model/arch/portable), not yet measured on this core.
+inline constexpr std::uint32_t kCycleBudgetInstructions = 250'000;
 // Five periods: a cycle late by up to two periods is survived (it, the wait
 // for the next release and the next cycle fit; the runtime counts the
 // missed releases); a cycle that has not come back after five periods, or

@@ -102,7 +102,7 @@ firmware::UpdateSender* sender = nullptr;
 
 // The ideal drives, and the runtime's reports to the sender.
 void exchange() {
-  drives.exchange(board, [](const cdcr::hal::CanFrame& frame) {
+  drives.exchange(board.can, [](const cdcr::hal::CanFrame& frame) {
     if (sender != nullptr && protocol::update_report::kMessage.carries(frame.id)) {
       sender->on_report(frame, cycles_run, host);
     }
@@ -114,7 +114,7 @@ std::uint8_t next_sequence = 0;
 void deliver_target() {
   const model::Pose<float> target =
       cdcr::qemu_programs::reachable_target(random_numbers, correction, runtime.geometry(), 0.2f);
-  cdcr::qemu_programs::deliver_target(board, target, protocol::TargetMode::pose, false, next_sequence++);
+  cdcr::qemu_programs::deliver_target(board.can, target, protocol::TargetMode::pose, false, next_sequence++);
 }
 
 enum Phase { kTransfer, kCommit, kSwitch, kOther, kPhases };
