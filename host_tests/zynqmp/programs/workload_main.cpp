@@ -296,7 +296,7 @@ int main() {
   for (int i = 0; i < 20; ++i) cycle();
   print("bad frames: rejected ", runtime.statistics().rejected_frames, "; state ",
         firmware::to_string(runtime.state()), "\n");
-  check_equal(runtime.statistics().rejected_frames, 1, "the short cable frame is rejected, the foreign one filtered");
+  check_equal(runtime.statistics().rejected_frames, 1, "the short cable frame is rejected and counted, the foreign identifier has no effect");
   check(runtime.state() == RuntimeState::run, "bad frames leave the runtime in RUN");
 
   // A flood: more frames in one period than the controller's RX FIFO and
