@@ -8,9 +8,11 @@
 
 #include <algorithm>
 #include <cstdint>
+#include <cstring>
 
 #include <cdcr/firmware/protocol.hpp>
 #include <cdcr/firmware/runtime.hpp>
+#include <cdcr/model/crc32.hpp>
 
 namespace cdcr::qemu_programs {
 
@@ -115,6 +117,18 @@ bool bind_board_image(Board& board, firmware::Correction& correction, model::Ima
   const hal::MemoryRegion region = board.model_storage.model_region();
   return model::parse_image(region.data, region.size_bytes, image, model::ImageCapacity{}) == model::ImageStatus::ok &&
          correction.bind(image) == model::Status::ok;
+}
+
+// `image` with another creation time, and its CRC trailer made again, into
+// `other` (room for `size` bytes): the same model under another digest, for
+// a model update that must be told apart from the image it replaces.
+inline void copy_with_other_creation_time(const std::uint8_t* image, std::uint32_t size, std::uint8_t* other) {
+  std::memcpy(other, image, size);
+  std::uint32_t metadata = 0;
+  std::memcpy(&metadata, other + model::image_field::metadata_offset, 4);
+  other[metadata + model::image_metadata_field::created_unix_s] ^= 0x01;
+  const std::uint32_t crc = model::crc32(other, size - model::kImageTrailerSize);
+  std::memcpy(other + size - model::kImageTrailerSize, &crc, 4);
 }
 
 // The instructions of one Runtime::run_cycle, called through a function the

@@ -11,7 +11,13 @@
 //      in between; every IK_REPORT on the bus the runtime's, converged
 //      targets' setpoints arriving at the drives and the pose reaching the
 //      target.
-//   3. Bus faults: frames with a foreign identifier (the acceptance filters
+//   3. A model update over CAN into the flash region (a RAM flash of two
+//      slots, as on the MPS2 boards: QEMU emulates no flash the RPU can
+//      write): the same model under another digest, sent by the update
+//      sender the `cdcr deploy` tool uses, while the drives and targets go
+//      on; it commits, the runtime switches to slot A, and its poses stay
+//      the host's.
+//   4. Bus faults: frames with a foreign identifier (the acceptance filters
 //      keep them out) or a bad length (rejected, counted), a flood past the
 //      RX FIFO (the overflow counted, no release missed, poses go on), the
 //      drives going silent (STATUS FAULT, stale input) and coming back (RUN).
@@ -24,7 +30,9 @@
 #include <cstdint>
 
 #include <cdcr/firmware/protocol.hpp>
+#include <cdcr/baremetal/ram_flash.hpp>
 #include <cdcr/firmware/runtime.hpp>
+#include <cdcr/firmware/update/update_sender.hpp>
 #include <cdcr/zynqmp/console.hpp>
 #include <cdcr/zynqmp/xilinx_can_controller.hpp>
 
@@ -52,20 +60,50 @@ using firmware::RuntimeState;
 constexpr double kReplayPositionToleranceMm = 0.02;
 constexpr double kReplayOrientationToleranceRad = 1e-4;
 
+// Two slots, each a metadata sector and 16 image sectors of 4 KiB: room for
+// a 64 KiB image (the golden one is about 57 KiB), as update_budget_main
+// has on the MPS2 boards.
+constexpr std::uint32_t kSectorBytes = 4096;
+constexpr std::uint32_t kSlotSectors = 1 + 16;
+cdcr::baremetal::RamFlash<kSectorBytes, 2 * kSlotSectors> flash;
+
 r5f::Board board;
-firmware::Runtime runtime(board.hal(), cdcr::boards::mps2::golden_geometry());
+cdcr::hal::Hal hal_with_flash() {
+  cdcr::hal::Hal hal = board.hal();
+  hal.flash = &flash;
+  return hal;
+}
+firmware::Runtime runtime(hal_with_flash(), cdcr::boards::mps2::golden_geometry());
 firmware::Correction correction;
 
-// can1 as the peer's end of the bus (peer_workload.hpp's PeerBus).
-struct ControllerPeer {
+// can1 as the peer's end of the bus: peer_workload.hpp's PeerBus for the
+// drives and the planner, a hal::CanBus for the update sender.
+class ControllerPeer final : public cdcr::hal::CanBus {
+ public:
   zynqmp::XilinxCanController controller{zynqmp::kCan1Base};
   int refused = 0;  // frames can1's TX FIFO did not take
-  void deliver(const CanFrame& frame) {
-    if (controller.transmit(frame) != CanStatus::ok) refused += 1;
-  }
+
+  void deliver(const CanFrame& frame) { send(frame); }
   bool take_transmitted(CanFrame& frame) { return controller.receive(frame); }
+
+  CanStatus send(const CanFrame& frame) override {
+    const CanStatus status = controller.transmit(frame);
+    if (status != CanStatus::ok) refused += 1;
+    return status;
+  }
+  CanStatus receive(CanFrame& frame) override {
+    return controller.receive(frame) ? CanStatus::ok : CanStatus::empty;
+  }
+  bool set_filters(const cdcr::hal::CanFilter* filters, std::size_t count) override {
+    return controller.set_filters(filters, count);
+  }
+  cdcr::hal::CanErrorCounters error_counters() const override { return {}; }
 };
 ControllerPeer peer;
+// The model update under way, if any; its frames share a cycle's room on
+// the bus with the drives' and a target's (as update_budget_main).
+firmware::UpdateSender* sender = nullptr;
+constexpr std::uint32_t kUpdateFramesPerCycle = 25;
 
 BusView bus;
 IdealDrives drives;
@@ -75,8 +113,16 @@ bool drives_report = true;  // false: the drives keep the setpoints they get, an
 // Every frame the runtime sent since the last look, decoded: setpoints move
 // the drives, the rest goes to the bus view. Then, unless silent, the
 // drives report.
+int cycles_run = 0;
+
 void exchange_with_drives() {
-  const auto record = [](const CanFrame& frame) { cdcr::board_tests::record(bus, frame); };
+  const auto record = [](const CanFrame& frame) {
+    if (sender != nullptr && protocol::update_report::kMessage.carries(frame.id)) {
+      sender->on_report(frame, cycles_run, peer);
+      return;
+    }
+    cdcr::board_tests::record(bus, frame);
+  };
   if (drives_report) {
     drives.exchange(peer, record);
     return;
@@ -87,7 +133,6 @@ void exchange_with_drives() {
 
 std::uint64_t counting_overhead = 0;
 std::uint64_t worst_cycle = 0;
-int cycles_run = 0;
 int over_budget = 0;
 
 // Instructions of one Runtime::run_cycle (none with run false: the
@@ -108,6 +153,7 @@ std::uint64_t counted(const cdcr::hal::TimerTick& tick, bool run) {
 void cycle() {
   board.run_guarded([](const cdcr::hal::TimerTick& tick) {
     exchange_with_drives();
+    if (sender != nullptr) sender->pump(cycles_run, peer, kUpdateFramesPerCycle);
     const std::uint64_t instructions = counted(tick, true);
     if (instructions > worst_cycle) worst_cycle = instructions;
     if (instructions > r5f::kCycleBudgetInstructions && ++over_budget <= 5) {
@@ -129,10 +175,10 @@ cdcr::model::PoseError<double> bus_pose_error(int c) {
   return cdcr::model::pose_error(on_bus, expected);
 }
 
-void replay_golden_cases() {
+void replay_golden_cases(int rounds) {
   double worst_position_mm = 0;
   double worst_orientation_rad = 0;
-  for (int round = 0; round < 4; ++round) {
+  for (int round = 0; round < rounds; ++round) {
     for (int c = 0; c < golden::kCases; ++c) {
       board.run_guarded([c](const cdcr::hal::TimerTick& tick) {
         CanFrame frame;
@@ -152,7 +198,7 @@ void replay_golden_cases() {
       if (!(error.orientation_rad <= worst_orientation_rad)) worst_orientation_rad = error.orientation_rad;
     }
   }
-  print("golden replay: ", 4 * golden::kCases, " cycles; largest difference bus - host (double): ");
+  print("golden replay: ", rounds * golden::kCases, " cycles; largest difference bus - host (double): ");
   zynqmp::console_write_fixed(worst_position_mm, 4);
   zynqmp::console_write(" mm, ");
   zynqmp::console_write_fixed(worst_orientation_rad * 1e6, 1);
@@ -162,6 +208,7 @@ void replay_golden_cases() {
 }
 
 std::uint8_t next_sequence = 0;
+alignas(8) std::uint8_t updated_image[64 * 1024];
 int targets_sent = 0;
 int targets_converged = 0;
 int reports_matching = 0;
@@ -224,12 +271,22 @@ int main() {
   if (failures != 0) return verdict();
   drives.segments = runtime.geometry().segment_count;
 
+  // The update's image and its digest, made before the cycles start: the
+  // peer's own work, which would otherwise take the board's periods.
+  const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
+  const std::uint32_t image_size = static_cast<std::uint32_t>(region.size_bytes);
+  check(runtime.model_update().enabled(), "model updates are enabled with the flash region");
+  check(image_size <= sizeof(updated_image), "the image fits the update's buffer");
+  if (failures != 0) return verdict();
+  copy_with_other_creation_time(region.data, image_size, updated_image);
+  firmware::UpdateSender update(updated_image, image_size);
+
   board.start_cycles();
   const cdcr::hal::TimerTick no_tick{};
   counting_overhead = counted(no_tick, false);
 
   // 1. The host's cable sets, one a cycle, four rounds.
-  replay_golden_cases();
+  replay_golden_cases(4);
   const int uncertainty_after_replay = bus.uncertainty_frames;
 
   // 2. The drives start where golden case 0 has them; forward-only cycles.
@@ -283,7 +340,37 @@ int main() {
   check(bus.uncertainty_frames > uncertainty_forward, "POSE_UNCERTAINTY while targets come and go");
   check_equal(runtime.statistics().rejected_frames, 0, "no frame rejected before the faults");
 
-  // 3. Bus faults. A foreign identifier the acceptance filters keep out,
+  // 3. A model update over CAN, targets going on meanwhile.
+  const int update_start_cycle = cycles_run;
+  std::uint64_t worst_before_update = worst_cycle;
+  worst_cycle = 0;
+  {
+    update.resend_after = 199;
+    sender = &update;
+    update.start(peer, cycles_run);
+    for (int i = 0; i < 20'000 && update.outcome() == firmware::UpdateSender::Outcome::running; ++i) {
+      if (i % 40 == 0) {
+        deliver_target(peer, reachable_target(random_numbers, correction, runtime.geometry(), 0.2f),
+                       protocol::TargetMode::pose, false, next_sequence++);
+      }
+      cycle();
+    }
+    for (int i = 0; i < 20; ++i) cycle();
+    sender = nullptr;
+    print("model update: ", update.total_blocks(), " blocks, ", update.frames_sent(), " frames, ", update.rewinds(),
+          " rewinds, ", update.restarts(), " restarts over ", cycles_run - update_start_cycle,
+          " cycles; outcome ", update.outcome() == firmware::UpdateSender::Outcome::committed ? "committed" : "not committed",
+          ", active slot ", runtime.model_update().active_slot(), ", state ", firmware::to_string(runtime.state()),
+          "; worst cycle meanwhile ", worst_cycle, " instructions\n");
+    check(update.outcome() == firmware::UpdateSender::Outcome::committed, "the model update commits");
+  }
+  check(runtime.model_update().active_slot() == 0, "the runtime switches to the new model in slot A");
+  check(runtime.state() == RuntimeState::run, "the runtime runs the new model");
+  if (worst_before_update > worst_cycle) worst_cycle = worst_before_update;
+  // The new model's poses: the host's, as before the update.
+  replay_golden_cases(1);
+
+  // 4. Bus faults. A foreign identifier the acceptance filters keep out,
   // and a cable frame of the wrong length: rejected, counted, nothing else.
   CanFrame foreign;
   foreign.id = 0x7F0;
