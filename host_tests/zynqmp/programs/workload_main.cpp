@@ -348,7 +348,7 @@ int main() {
     update.resend_after = 199;
     sender = &update;
     update.start(peer, cycles_run);
-    for (int i = 0; i < 20'000 && update.outcome() == firmware::UpdateSender::Outcome::running; ++i) {
+    for (int i = 0; i < 8'000 && update.outcome() == firmware::UpdateSender::Outcome::running; ++i) {
       if (i % 40 == 0) {
         deliver_target(peer, reachable_target(random_numbers, correction, runtime.geometry(), 0.2f),
                        protocol::TargetMode::pose, false, next_sequence++);
