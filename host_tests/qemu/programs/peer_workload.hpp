@@ -10,6 +10,7 @@
 #include <cstdint>
 #include <cstring>
 
+#include <cdcr/baremetal/ram_flash.hpp>
 #include <cdcr/firmware/protocol.hpp>
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/model/crc32.hpp>
@@ -117,6 +118,20 @@ bool bind_board_image(Board& board, firmware::Correction& correction, model::Ima
   const hal::MemoryRegion region = board.model_storage.model_region();
   return model::parse_image(region.data, region.size_bytes, image, model::ImageCapacity{}) == model::ImageStatus::ok &&
          correction.bind(image) == model::Status::ok;
+}
+
+// The flash the programs that update the model give the runtime: two slots,
+// each a metadata sector and 16 image sectors of 4 KiB, room for a 64 KiB
+// image (the golden one is about 57 KiB), in 136 KiB of the board's RAM.
+// A board with a flash controller has its flash instead.
+using UpdateFlash = baremetal::RamFlash<4096, 2 * (1 + 16)>;
+
+// The board's Hal with `flash` for model updates.
+template <typename Board>
+hal::Hal hal_with_flash(Board& board, hal::Flash& flash) {
+  hal::Hal hal = board.hal();
+  hal.flash = &flash;
+  return hal;
 }
 
 // `image` with another creation time, and its CRC trailer made again, into

@@ -16,7 +16,6 @@
 
 #include <algorithm>
 
-#include <cdcr/cortexm/ram_flash.hpp>
 #include <cdcr/cortexm/semihosting.hpp>
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/firmware/sha256.hpp>
@@ -34,20 +33,10 @@ using namespace cdcr::qemu_programs;  // the workload, and its model, firmware a
 
 constexpr std::uint32_t kBudgetInstructions = cdcr::boards::mps2::kCycleBudgetInstructions;
 
-// Two slots, each a metadata sector and 16 image sectors of 4 KiB: room for
-// a 64 KiB image (the golden one is about 57 KiB). 136 KiB of the board's
-// 4 MiB of RAM; a board with a flash controller has its flash instead.
-constexpr std::uint32_t kSectorBytes = 4096;
-constexpr std::uint32_t kSlotSectors = 1 + 16;
-cdcr::cortexm::RamFlash<kSectorBytes, 2 * kSlotSectors> flash;
-
+// A RAM flash of two slots (peer_workload.hpp).
+cdcr::qemu_programs::UpdateFlash flash;
 cdcr::boards::mps2::Board board;
-cdcr::hal::Hal hal_with_flash() {
-  cdcr::hal::Hal hal = board.hal();
-  hal.flash = &flash;
-  return hal;
-}
-firmware::Runtime runtime(hal_with_flash(), cdcr::boards::mps2::golden_geometry());
+firmware::Runtime runtime(cdcr::qemu_programs::hal_with_flash(board, flash), cdcr::boards::mps2::golden_geometry());
 firmware::Correction correction;
 
 cdcr::boards::mps2::InstructionCounter counter{board.timer};

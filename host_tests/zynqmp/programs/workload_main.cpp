@@ -30,7 +30,6 @@
 #include <cstdint>
 
 #include <cdcr/firmware/protocol.hpp>
-#include <cdcr/baremetal/ram_flash.hpp>
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/firmware/update/update_sender.hpp>
 #include <cdcr/zynqmp/console.hpp>
@@ -60,20 +59,11 @@ using firmware::RuntimeState;
 constexpr double kReplayPositionToleranceMm = 0.02;
 constexpr double kReplayOrientationToleranceRad = 1e-4;
 
-// Two slots, each a metadata sector and 16 image sectors of 4 KiB: room for
-// a 64 KiB image (the golden one is about 57 KiB), as update_budget_main
-// has on the MPS2 boards.
-constexpr std::uint32_t kSectorBytes = 4096;
-constexpr std::uint32_t kSlotSectors = 1 + 16;
-cdcr::baremetal::RamFlash<kSectorBytes, 2 * kSlotSectors> flash;
-
+// A RAM flash of two slots (peer_workload.hpp), as the MPS2 boards'
+// update budget has.
+UpdateFlash flash;
 r5f::Board board;
-cdcr::hal::Hal hal_with_flash() {
-  cdcr::hal::Hal hal = board.hal();
-  hal.flash = &flash;
-  return hal;
-}
-firmware::Runtime runtime(hal_with_flash(), cdcr::boards::mps2::golden_geometry());
+firmware::Runtime runtime(hal_with_flash(board, flash), cdcr::boards::mps2::golden_geometry());
 firmware::Correction correction;
 
 // can1 as the peer's end of the bus: peer_workload.hpp's PeerBus for the
