@@ -1,13 +1,16 @@
 #pragma once
 // The Cortex-R5F of QEMU's xlnx-zcu102 as the runtime sees it: the cycle
 // counter as clock and timer, can0 through the Xilinx CAN driver at
-// 1 Mbit/s, the model image in .cdcr_model, and the console on uart0.
+// 1 Mbit/s, the model image in .cdcr_model, and the console on uart0; and,
+// around the runtime, the cycle loop's watchdog on TTC0.
 
 #include <cdcr/firmware/capacity.hpp>
 #include <cdcr/hal/hal.hpp>
 #include <cdcr/zynqmp/can_bit_timing.hpp>
+#include <cdcr/zynqmp/console.hpp>
 #include <cdcr/zynqmp/cycle_counter_timer.hpp>
 #include <cdcr/zynqmp/section_model_storage.hpp>
+#include <cdcr/zynqmp/ttc_watchdog.hpp>
 #include <cdcr/zynqmp/uart_console.hpp>
 #include <cdcr/zynqmp/xilinx_can.hpp>
 #include <cdcr/zynqmp/zcu102.hpp>
@@ -26,16 +29,69 @@ static_assert(zynqmp::bitrate(kCanTiming, zynqmp::kCanReferenceClockHz) == kCanB
 inline constexpr std::size_t kCanRxQueueDepth = 32;
 static_assert(firmware::kMaxCanFilters <= zynqmp::kXilinxCanFilters,
               "the controller holds every acceptance filter the runtime sets");
+// The instructions a cycle may take (Runtime::run_cycle, counted under
+// QEMU -icount shift=0 by zynqmp.workload): a 1 ms period of an R5F at
+// 500 MHz (the ZynqMP's RPU runs at 500 to 600 MHz by speed grade) at half
+// an instruction a clock, which its single-issue VFPv3 (no fused
+// multiply-add) and a DDR behind 32 KiB caches allow for the GP loops; the
+// Cortex-M boards' 80,000 and 120,000 are the same kind of figure for them.
+// The runtime spreads IK over cycles with the portable work costs
+// (model/arch/portable), not yet measured on this core.
+inline constexpr std::uint32_t kCycleBudgetInstructions = 250'000;
+// Five periods: a cycle late by up to two periods is survived (it, the wait
+// for the next release and the next cycle fit; the runtime counts the
+// missed releases); a cycle that has not come back after five periods, or
+// cycles that keep running late, end the program.
+inline constexpr std::int64_t kWatchdogTimeoutNs = 5 * kCyclePeriodNs;
+
+// What the board does when its watchdog expires. QEMU 7.2 emulates no reset
+// the RPU could ask for (no CRL_APB, no system watchdog: ttc_watchdog.hpp),
+// so the board reports on the UART and ends with ExitCode::watchdog_expired;
+// on silicon this is where the RPU resets itself (CRL_APB RST_LPD_TOP).
+[[noreturn]] inline void watchdog_reset(const hal::TimerTick& tick, std::int64_t now_ns) {
+  zynqmp::console_write("WATCHDOG: no cycle completed in time for ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(kWatchdogTimeoutNs / 1000));
+  zynqmp::console_write(" us; the cycle released at ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(tick.release_ns / 1000));
+  zynqmp::console_write(" us ended at ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(now_ns / 1000));
+  zynqmp::console_write(" us: reset\n");
+  zynqmp::exit(zynqmp::ExitCode::watchdog_expired);
+}
 
 struct Board {
   zynqmp::CycleCounterTimer timer{zynqmp::kQemuCycleCounterHz};
   zynqmp::XilinxCan<kCanRxQueueDepth> can{zynqmp::kCan0Base};
   zynqmp::SectionModelStorage model_storage;
   zynqmp::UartConsole console;
+  zynqmp::TtcWatchdog watchdog{zynqmp::kTtc0Base, zynqmp::kTtcClockHz};
 
   // Brings can0 onto the bus; false if the controller does not come up.
   bool start_can() { return can.start(kCanTiming); }
   hal::Hal hal() { return hal::Hal{timer, timer, can, model_storage, console}; }
+
+  // The 1 kHz releases and the watchdog, started together.
+  void start_cycles() {
+    timer.start(kCyclePeriodNs);
+    watchdog.start(kWatchdogTimeoutNs);
+  }
+
+  // One cycle under the watchdog: waits for the release, runs cycle(tick),
+  // then guard(tick).
+  template <typename Cycle>
+  void run_guarded(Cycle&& cycle) {
+    const hal::TimerTick tick = timer.wait_next();
+    cycle(tick);
+    guard(tick);
+  }
+
+  // After the cycle released at tick: an expired watchdog resets the board;
+  // otherwise the cycle kicks it if it completed within its period.
+  void guard(const hal::TimerTick& tick) {
+    const std::int64_t now_ns = timer.now_ns();
+    if (watchdog.expired()) watchdog_reset(tick, now_ns);
+    if (now_ns - tick.release_ns <= kCyclePeriodNs) watchdog.kick();
+  }
 };
 
 }  // namespace cdcr::boards::zcu102_r5f

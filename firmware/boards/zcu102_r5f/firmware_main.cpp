@@ -1,6 +1,6 @@
 // The runtime as the R5F board runs it: can0 onto the bus at 1 Mbit/s, boot
 // (validate the image in .cdcr_model), then one cycle per 1 ms of the cycle
-// counter, forever. Fallback geometry is the robot's design geometry. Under
+// counter, forever, under the watchdog (board.hpp). Fallback geometry is the robot's design geometry. Under
 // QEMU nothing sends cable frames, so the UART shows the boot state and
 // then FAULT (stale input) after kStaleInputCycles.
 
@@ -20,6 +20,6 @@ int main() {
   // runs on and reports stale input, as with drives that never speak.
   if (!board.start_can()) board.console.write_line("can0 did not start");
   runtime.init();
-  board.timer.start(cdcr::boards::zcu102_r5f::kCyclePeriodNs);
-  for (;;) runtime.run_cycle(board.timer.wait_next());
+  board.start_cycles();
+  for (;;) board.run_guarded([](const cdcr::hal::TimerTick& tick) { runtime.run_cycle(tick); });
 }

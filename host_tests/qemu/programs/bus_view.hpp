@@ -1,6 +1,6 @@
 #pragma once
-// The runtime's frames as a peer on the bus sees them: the latest pose,
-// STATUS and STATS, decoded with the one codec. Shared by the board programs
+// The runtime's frames as a peer on the bus sees them: the latest pose, its
+// uncertainty, STATUS, STATS and IK_REPORT, decoded with the one codec. Shared by the board programs
 // that check what the runtime sent (replay_main.cpp on the Cortex-M boards'
 // mailbox bus, host_tests/zynqmp/programs/forward_path_main.cpp on the R5F's
 // CAN controller).
@@ -21,6 +21,11 @@ struct BusView {
   int reported_state = -1;
   int reported_fault = -1;
   firmware::FaultDetail reported_detail;
+  int uncertainty_frames = 0;
+  firmware::protocol::PoseUncertainty uncertainty;
+  int ik_reports = 0;  // final ones; in-progress reports are counted apart
+  int ik_progress_reports = 0;
+  firmware::protocol::IkReport ik_report;  // the latest final one
 };
 
 // One frame the runtime sent; STATS follows the STATUS whose FAULT types its
@@ -32,6 +37,8 @@ inline void record(BusView& bus, const hal::CanFrame& frame) {
   protocol::PoseOrientation orientation;
   protocol::Status status;
   protocol::Stats stats;
+  protocol::PoseUncertainty uncertainty;
+  protocol::IkReport ik_report;
   constexpr protocol::DecodeStatus ok = protocol::DecodeStatus::ok;
   if (protocol::decode(frame, xy) == ok) {
     bus.position_mm[0] = xy.x_mm;
@@ -51,6 +58,16 @@ inline void record(BusView& bus, const hal::CanFrame& frame) {
     bus.reported_state = static_cast<int>(status.state);
     bus.reported_fault = static_cast<int>(status.fault);
     bus.status_frames += 1;
+  } else if (protocol::decode(frame, uncertainty) == ok) {
+    bus.uncertainty = uncertainty;
+    bus.uncertainty_frames += 1;
+  } else if (protocol::decode(frame, ik_report) == ok) {
+    if (ik_report.outcome == protocol::IkOutcome::in_progress) {
+      bus.ik_progress_reports += 1;
+    } else {
+      bus.ik_report = ik_report;
+      bus.ik_reports += 1;
+    }
   } else if (protocol::decode(frame, static_cast<firmware::FaultCode>(bus.reported_fault), stats) == ok) {
     bus.reported_detail = stats.fault_detail;
   }

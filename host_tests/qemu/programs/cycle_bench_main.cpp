@@ -95,7 +95,7 @@ model::Pose<float> golden_pose(int c) {
 
 // The three target frames of a pose target, as a planner sends them.
 void deliver_pose_target(const model::Pose<float>& target, std::uint8_t sequence) {
-  cdcr::qemu_programs::deliver_target(board, target, cdcr::firmware::protocol::TargetMode::pose, false, sequence);
+  cdcr::qemu_programs::deliver_target(board.can, target, cdcr::firmware::protocol::TargetMode::pose, false, sequence);
 }
 
 void drain_transmitted() {

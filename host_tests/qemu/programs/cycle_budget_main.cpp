@@ -53,11 +53,11 @@ cdcr::qemu_programs::IdealDrives drives;
 int& segments = drives.segments;
 int& silent_segment = drives.silent_segment;
 
-void exchange_with_drives() { drives.exchange(board); }
+void exchange_with_drives() { drives.exchange(board.can); }
 
 void deliver_target(const model::Pose<float>& target, protocol::TargetMode mode, bool tracking,
                     std::uint8_t sequence, bool refuse_extrapolating = false) {
-  cdcr::qemu_programs::deliver_target(board, target, mode, tracking, sequence, refuse_extrapolating);
+  cdcr::qemu_programs::deliver_target(board.can, target, mode, tracking, sequence, refuse_extrapolating);
 }
 
 model::Pose<float> compensated_tip(const model::JointVector<float>& joints) {

@@ -15,14 +15,11 @@
 // should.
 
 #include <algorithm>
-#include <cstring>
 
-#include <cdcr/cortexm/ram_flash.hpp>
 #include <cdcr/cortexm/semihosting.hpp>
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/firmware/sha256.hpp>
 #include <cdcr/firmware/update/update_sender.hpp>
-#include <cdcr/model/crc32.hpp>
 
 #include "board.hpp"
 #include "golden_check.hpp"
@@ -36,20 +33,10 @@ using namespace cdcr::qemu_programs;  // the workload, and its model, firmware a
 
 constexpr std::uint32_t kBudgetInstructions = cdcr::boards::mps2::kCycleBudgetInstructions;
 
-// Two slots, each a metadata sector and 16 image sectors of 4 KiB: room for
-// a 64 KiB image (the golden one is about 57 KiB). 136 KiB of the board's
-// 4 MiB of RAM; a board with a flash controller has its flash instead.
-constexpr std::uint32_t kSectorBytes = 4096;
-constexpr std::uint32_t kSlotSectors = 1 + 16;
-cdcr::cortexm::RamFlash<kSectorBytes, 2 * kSlotSectors> flash;
-
+// A RAM flash of two slots (peer_workload.hpp).
+cdcr::qemu_programs::UpdateFlash flash;
 cdcr::boards::mps2::Board board;
-cdcr::hal::Hal hal_with_flash() {
-  cdcr::hal::Hal hal = board.hal();
-  hal.flash = &flash;
-  return hal;
-}
-firmware::Runtime runtime(hal_with_flash(), cdcr::boards::mps2::golden_geometry());
+firmware::Runtime runtime(cdcr::qemu_programs::hal_with_flash(board, flash), cdcr::boards::mps2::golden_geometry());
 firmware::Correction correction;
 
 cdcr::boards::mps2::InstructionCounter counter{board.timer};
@@ -102,7 +89,7 @@ firmware::UpdateSender* sender = nullptr;
 
 // The ideal drives, and the runtime's reports to the sender.
 void exchange() {
-  drives.exchange(board, [](const cdcr::hal::CanFrame& frame) {
+  drives.exchange(board.can, [](const cdcr::hal::CanFrame& frame) {
     if (sender != nullptr && protocol::update_report::kMessage.carries(frame.id)) {
       sender->on_report(frame, cycles_run, host);
     }
@@ -114,7 +101,7 @@ std::uint8_t next_sequence = 0;
 void deliver_target() {
   const model::Pose<float> target =
       cdcr::qemu_programs::reachable_target(random_numbers, correction, runtime.geometry(), 0.2f);
-  cdcr::qemu_programs::deliver_target(board, target, protocol::TargetMode::pose, false, next_sequence++);
+  cdcr::qemu_programs::deliver_target(board.can, target, protocol::TargetMode::pose, false, next_sequence++);
 }
 
 enum Phase { kTransfer, kCommit, kSwitch, kOther, kPhases };
@@ -189,8 +176,8 @@ bool transfer(const std::uint8_t* image, std::uint32_t size, int expected_slot) 
   return ok;
 }
 
-// The second image: the golden one with another creation time (and its CRC
-// trailer made again), so that its digest differs.
+// The second image: the golden one with another creation time, so that its
+// digest differs.
 alignas(8) std::uint8_t second_image[64 * 1024];
 
 }  // namespace
@@ -217,12 +204,7 @@ int main() {
 
   report_update_costs(region.data, size);
 
-  std::memcpy(second_image, region.data, size);
-  std::uint32_t metadata = 0;
-  std::memcpy(&metadata, second_image + model::image_field::metadata_offset, 4);
-  second_image[metadata + model::image_metadata_field::created_unix_s] ^= 0x01;
-  const std::uint32_t crc = model::crc32(second_image, size - model::kImageTrailerSize);
-  std::memcpy(second_image + size - model::kImageTrailerSize, &crc, 4);
+  cdcr::qemu_programs::copy_with_other_creation_time(region.data, size, second_image);
 
   for (int i = 0; i < 100; ++i) cycle();
   bool ok = transfer(region.data, size, 0);

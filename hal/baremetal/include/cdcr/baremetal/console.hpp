@@ -14,6 +14,7 @@ enum class ExitCode : int {
   hard_fault = 3,
   assertion_failed = 4,
   heap_used = 5,
+  watchdog_expired = 6,  // a board's watchdog ended the program (no reset to emulate)
 };
 
 // Defined by the board.
