@@ -56,6 +56,7 @@
 #include "sim/simulated_robot.hpp"
 #include "sim/target_frames.hpp"
 #include "sim/uniform_bend.hpp"
+#include "train/least_squares_functor.hpp"
 
 namespace {
 
@@ -245,12 +246,7 @@ void compensated_sets(const fw::Runtime& runtime) {
 // the solver's tolerances (2 um, 2e-5 rad) weigh the same. A best residual
 // far above those tolerances means the target is outside the model's image,
 // whatever the board's solver does.
-struct PoseResidual {
-  using Scalar = double;
-  enum { InputsAtCompileTime = Eigen::Dynamic, ValuesAtCompileTime = Eigen::Dynamic };
-  using InputType = Eigen::VectorXd;
-  using ValueType = Eigen::VectorXd;
-  using JacobianType = Eigen::MatrixXd;
+struct PoseResidual : cdcr::training::DynamicSizeResiduals {
   static constexpr double kRadAsMm = 100.0;
 
   const model::RobotGeometry<double>* geometry;
@@ -288,7 +284,7 @@ BestReachable best_reachable(const std::vector<std::uint8_t>& image, const model
   if (model::geometry_from_image(view, geometry) != model::Status::ok || correction.bind(view) != model::Status::ok) {
     throw std::runtime_error("the image's model does not bind in double");
   }
-  Eigen::NumericalDiff<PoseResidual> functor(PoseResidual{&geometry, &correction, target}, 1e-7);
+  Eigen::NumericalDiff<PoseResidual> functor(PoseResidual{{}, &geometry, &correction, target}, 1e-7);
   std::mt19937 rng(27);
   std::uniform_real_distribution<double> offset(-0.1, 0.1);
   BestReachable best;
