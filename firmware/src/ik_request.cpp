@@ -1,5 +1,7 @@
 #include "cdcr/firmware/ik_request.hpp"
 
+#include "cdcr/firmware/ik_settings.hpp"
+
 namespace cdcr::firmware {
 
 void IkRequest::start(const Pose& target, const TargetRequest& request, const PoseEstimate* latest_pose) {
@@ -51,6 +53,7 @@ void IkRequest::configure() {
   model::IkSolverOptions<Scalar> options;
   options.max_corrections = kMaxIkCorrections;
   options.max_iterations = kMaxIkIterations;
+  options.max_restarts = kMaxIkRestarts;
   // In DEGRADED the same solver solves the nominal model.
   solver_.configure(model_.geometry, model_.compensated ? &solver_correction_ : nullptr, options, kIkWorkCosts);
 }
@@ -64,11 +67,7 @@ void IkRequest::refuse(std::uint8_t sequence, protocol::IkOutcome outcome) {
 
 // A slight bend keeps the first Jacobian away from the straight pose.
 void IkRequest::straight_start(Joints& joints) const {
-  joints.resize(2 * model_.geometry.segment_count);
-  for (int s = 0; s < model_.geometry.segment_count; ++s) {
-    joints[2 * s] = Scalar(0);
-    joints[2 * s + 1] = Scalar(0.1);
-  }
+  joints = ik_straight_start(model_.geometry);
 }
 
 // A cycle's IK slice: solver steps within `units`, and the request's end

@@ -365,7 +365,7 @@ TEST(RuntimeClosedLoop, FollowsAStreamedCircle) {
   ASSERT_EQ(std::system(command.c_str()), 0) << command;
   const std::string text = read_text(dir / "out.txt");
   double tip_mean = -1, tip_max = -1, following_mean = -1, following_max = -1;
-  long sent = -1, streamed = -1, cycles = -1, missing = -1;
+  long sent = -1, streamed = -1, without = -1, cycles = -1, missing = -1;
   unsigned overruns = 1;
   const std::size_t tip_at = text.find("tip vs streamed target");
   ASSERT_NE(tip_at, std::string::npos) << text;
@@ -380,12 +380,14 @@ TEST(RuntimeClosedLoop, FollowsAStreamedCircle) {
   const std::size_t sent_at = text.find("setpoints sent in");
   ASSERT_NE(sent_at, std::string::npos) << text;
   ASSERT_EQ(std::sscanf(text.c_str() + sent_at,
-                        "setpoints sent in %ld of %ld streamed cycles; cycles %ld, poses missing %ld, overruns %u",
-                        &sent, &streamed, &cycles, &missing, &overruns),
-            5)
+                        "setpoints sent in %ld of %ld streamed cycles (none in %ld after the first 3); cycles %ld, "
+                        "poses missing %ld, overruns %u",
+                        &sent, &streamed, &without, &cycles, &missing, &overruns),
+            6)
       << text;
   EXPECT_GT(streamed, 1000);
   EXPECT_EQ(sent, streamed);
+  EXPECT_EQ(without, 0);
   EXPECT_EQ(missing, 0);
   EXPECT_EQ(overruns, 0u);
   EXPECT_LT(following_mean, 0.05) << text;

@@ -3,11 +3,11 @@
 // the demo's streamed circle costs the runtime.
 //
 // Part 1, the nominal model (no correction), each set from a straight start:
-//   * "board": the resumable solver in float with the runtime's bounds
-//     (kMaxIkCorrections, kMaxIkIterations) from the runtime's straight
-//     start (alpha 0, theta 0.1 on every segment);
-//   * "cdcr ik": solve_ik in double with the options and the start
-//     (alpha 0, theta 0.05) that `cdcr ik --pose` uses.
+//   * "board": the resumable solver in float with the runtime's bounds and
+//     restarts (firmware/capacity.hpp) from the runtime's straight start
+//     (alpha 0, theta 0.1 on every segment);
+//   * "cdcr ik": solve_ik in double with the runtime's settings and start
+//     (firmware/ik_settings.hpp), as `cdcr ik --pose` runs it.
 // A target counts as converged when forward kinematics (in double) of the
 // cables the solver returned, read back into joints, is within 0.01 mm and
 // 0.01 deg of the target; the solver's own verdict is counted beside it.
@@ -44,6 +44,7 @@
 #include <unsupported/Eigen/NumericalDiff>
 
 #include <cdcr/firmware/capacity.hpp>
+#include <cdcr/firmware/ik_settings.hpp>
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/model/compensation.hpp>
 #include <cdcr/model/gp_correction.hpp>
@@ -141,28 +142,16 @@ struct Tally {
   }
 };
 
-model::JointVector<float> board_straight_start(int segments) {
-  model::JointVector<float> joints(2 * segments);
-  for (int i = 0; i < segments; ++i) {
-    joints[2 * i] = 0.0f;
-    joints[2 * i + 1] = 0.1f;
-  }
-  return joints;
-}
-
 void nominal_sets(int count, unsigned seed) {
   const model::RobotGeometry<double> geometry = model::RobotGeometry<double>::prototype();
   const model::RobotGeometry<float> geometry_f = geometry.cast<float>();
   model::IkSolverOptions<float> board_options;
   board_options.max_corrections = fw::kMaxIkCorrections;
   board_options.max_iterations = fw::kMaxIkIterations;
+  board_options.max_restarts = fw::kMaxIkRestarts;
   model::IkSolver<float, model::kMaxSegments> board;
   board.configure(geometry_f, nullptr, board_options);
-  model::JointVector<double> cli_start(2 * geometry.segment_count);
-  for (int i = 0; i < geometry.segment_count; ++i) {
-    cli_start[2 * i] = 0.0;
-    cli_start[2 * i + 1] = 0.05;
-  }
+  const model::JointVector<double> cli_start = fw::ik_straight_start(geometry);
   for (const TargetSet set : {TargetSet::paper, TargetSet::full_range, TargetSet::near_straight, TargetSet::at_limit}) {
     const int n = set == TargetSet::full_range ? count : std::max(1, count / 4);
     Tally on_board, on_cli;
@@ -172,7 +161,7 @@ void nominal_sets(int count, unsigned seed) {
       double position_mm = 0, orientation_rad = 0;
 
       ++on_board.targets;
-      board.start(target.cast<float>(), model::IkTargetKind::pose, board_straight_start(geometry.segment_count));
+      board.start(target.cast<float>(), model::IkTargetKind::pose, fw::ik_straight_start(geometry_f));
       board.run_to_end();
       on_board.solver_says += board.state() == model::IkSolveState::converged;
       if (reaches(board.best_joints(), geometry, target, position_mm, orientation_rad)) {
@@ -181,7 +170,7 @@ void nominal_sets(int count, unsigned seed) {
       }
 
       ++on_cli.targets;
-      const model::IkResult<double> result = model::solve_ik(target, geometry, cli_start);
+      const model::IkResult<double> result = fw::solve_ik_as_on_the_board(target, model::IkTargetKind::pose, geometry, cli_start);
       on_cli.solver_says += result.converged();
       if (reaches(result.joints, geometry, target, position_mm, orientation_rad)) {
         ++on_cli.checked;
@@ -192,6 +181,56 @@ void nominal_sets(int count, unsigned seed) {
     on_board.print("board");
     on_cli.print("cdcr ik");
   }
+}
+
+// Random paths over the full design range, as a planner sends them: each
+// target a random step (up to `step_rad` on every joint, kept within the
+// limits) from the last, solved by the board's solver from the previous
+// target's answer. A path starts at a random configuration, solved from
+// there.
+void nominal_paths(int paths, int steps, double step_rad, unsigned seed) {
+  const model::RobotGeometry<double> geometry = model::RobotGeometry<double>::prototype();
+  const model::RobotGeometry<float> geometry_f = geometry.cast<float>();
+  model::IkSolverOptions<float> options;
+  options.max_corrections = fw::kMaxIkCorrections;
+  options.max_iterations = fw::kMaxIkIterations;
+  options.max_restarts = fw::kMaxIkRestarts;
+  model::IkSolver<float, model::kMaxSegments> board;
+  board.configure(geometry_f, nullptr, options);
+  std::mt19937 rng(seed + 5000u);
+  const auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
+  Tally tally;
+  for (int p = 0; p < paths; ++p) {
+    model::JointVector<double> joints(2 * geometry.segment_count);
+    for (int i = 0; i < geometry.segment_count; ++i) {
+      joints[2 * i] = uniform(-kPi, kPi);
+      joints[2 * i + 1] = uniform(0, geometry.segments[i].theta_max_rad);
+    }
+    model::JointVector<float> previous = joints.cast<float>();
+    for (int k = 0; k < steps; ++k) {
+      for (int i = 0; i < geometry.segment_count; ++i) {
+        joints[2 * i] += uniform(-step_rad, step_rad);
+        joints[2 * i + 1] =
+            std::clamp(joints[2 * i + 1] + uniform(-step_rad, step_rad), 0.0, geometry.segments[i].theta_max_rad);
+      }
+      model::Pose<double> target;
+      model::forward_kinematics(joints, geometry, target);
+      ++tally.targets;
+      board.start(target.cast<float>(), model::IkTargetKind::pose, previous);
+      board.run_to_end();
+      tally.solver_says += board.state() == model::IkSolveState::converged;
+      double position_mm = 0, orientation_rad = 0;
+      if (reaches(board.best_joints(), geometry, target, position_mm, orientation_rad)) {
+        ++tally.checked;
+        tally.iterations.push_back(board.iterations());
+      }
+      if (board.has_best()) previous = board.best_joints();
+    }
+  }
+  std::printf("full range along %d random paths of %d targets (steps up to %.2f rad a joint), each from the last "
+              "answer:\n",
+              paths, steps, step_rad);
+  tally.print("board");
 }
 
 // Targets the compensated model reaches by construction: its own poses at
@@ -218,7 +257,7 @@ void compensated_sets(const fw::Runtime& runtime) {
       const fw::Joints bend = model::bend_from_joints(model::JointVector<float, model::kMaxSegments>(joints.cast<float>()));
       const model::Pose<float> target =
           model::exp(runtime.correction().predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
-      solver.start(target, model::IkTargetKind::pose, board_straight_start(geometry.segment_count));
+      solver.start(target, model::IkTargetKind::pose, fw::ik_straight_start(runtime.geometry()));
       int cycles = 0;
       while (solver.state() == model::IkSolveState::running && cycles < fw::kMaxIkCycles) {
         solver.run(runtime.ik_units_per_cycle());
@@ -435,6 +474,7 @@ int main(int argc, char** argv) {
   CLI11_PARSE(app, argc, argv);
   try {
     nominal_sets(count, seed);
+    nominal_paths(20, std::max(1, count / 20), 0.05, seed);
     if (!image.empty()) circle_start(image, radius_mm);
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cdcr-bench-ik: %s\n", e.what());

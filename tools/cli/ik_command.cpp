@@ -7,6 +7,7 @@
 #include <CLI/CLI.hpp>
 #include <fmt/format.h>
 
+#include <cdcr/firmware/ik_settings.hpp>
 #include <cdcr/model/inverse_kinematics.hpp>
 #include <cdcr/model/units.hpp>
 
@@ -54,14 +55,8 @@ Target read_target(const IkCommandOptions& options) {
 
 model::JointVector<double> read_initial_joints(const std::optional<std::vector<double>>& values,
                                                const model::RobotGeometry<double>& geometry) {
+  if (!values) return firmware::ik_straight_start(geometry);
   model::JointVector<double> joints(2 * geometry.segment_count);
-  if (!values) {
-    for (int i = 0; i < geometry.segment_count; ++i) {
-      joints[2 * i] = 0.0;
-      joints[2 * i + 1] = std::min(kDefaultInitialThetaRad, geometry.segments[i].theta_max_rad);
-    }
-    return joints;
-  }
   require_count(*values, static_cast<std::size_t>(2 * geometry.segment_count), "--initial",
                 fmt::format("alpha,theta for each of {} segments", geometry.segment_count));
   require_finite(*values, "--initial");
@@ -119,11 +114,13 @@ void register_ik_command(CLI::App& app, CommandOutput& output) {
       ->excludes(position);
   add_geometry_options(*command, options->geometry, fmt::format("Number of segments (default: {})",
                                                                 kDefaultIkSegmentCount));
-  command->add_option("--max-iterations", options->max_iterations, "Iteration budget of the solver")
-      ->capture_default_str();
+  command->add_option("--max-iterations", options->max_iterations,
+                      fmt::format("Iteration budget of the solver (default: the runtime's, {})",
+                                  firmware::kMaxIkIterations));
   command->add_option("--initial", options->initial_joints,
-                      fmt::format("Initial joints in rad (default: alpha 0, theta {} for every segment)",
-                                  kDefaultInitialThetaRad))
+                      fmt::format("Initial joints in rad (default: the runtime's start, alpha 0, theta {} for every "
+                                  "segment)",
+                                  firmware::kIkStraightStartThetaRad))
       ->type_name("A1,T1,A2,T2,...");
   command->add_flag("--json", options->json, "Print one JSON object instead of tables");
   command->callback([options, &output] { output = run_ik(*options); });
@@ -134,20 +131,19 @@ CommandOutput run_ik(const IkCommandOptions& options) {
   if (options.initial_joints) initial_values = parse_number_list(*options.initial_joints, "--initial");
   const Target target = read_target(options);
 
-  if (options.max_iterations < 0) {
-    throw InputError(fmt::format("--max-iterations must not be negative (got {})", options.max_iterations));
+  const int max_iterations = options.max_iterations.value_or(firmware::kMaxIkIterations);
+  if (max_iterations < 0) {
+    throw InputError(fmt::format("--max-iterations must not be negative (got {})", max_iterations));
   }
   const model::RobotGeometry<double> geometry =
       make_geometry(options.geometry, options.geometry.segment_count.value_or(kDefaultIkSegmentCount));
   const model::JointVector<double> initial_joints = read_initial_joints(initial_values, geometry);
 
-  model::IkOptions<double> solver_options;
-  solver_options.max_iterations = options.max_iterations;
-  const model::IkResult<double> result =
-      target.orientation_given
-          ? model::solve_ik(target.pose, geometry, initial_joints, solver_options)
-          : model::solve_ik_position(model::Vec3<double>(target.pose.position_mm), geometry, initial_joints,
-                                     solver_options);
+  // The board's solver with the runtime's settings, then polished in
+  // double: what a user tries here is what the board does.
+  const model::IkResult<double> result = firmware::solve_ik_as_on_the_board(
+      target.pose, target.orientation_given ? model::IkTargetKind::pose : model::IkTargetKind::position, geometry,
+      initial_joints, max_iterations);
   if (result.status != model::Status::ok && result.status != model::Status::ik_not_converged) {
     // The solver stays within the joint limits, so the only way here is a
     // geometry whose cables cannot reach the solved bend; name the segment.

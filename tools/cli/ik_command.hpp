@@ -16,10 +16,6 @@ namespace cdcr::cli {
 
 // Unlike fk, ik has nothing to infer the segment count from.
 inline constexpr int kDefaultIkSegmentCount = model::kPrototypeSegmentCount;
-// The straight robot is a singular configuration (the alpha columns of the
-// Jacobian vanish), so the default start is slightly bent.
-inline constexpr double kDefaultInitialThetaRad = 0.05;
-
 // The number lists stay text until run_ik parses them; unset means the flag
 // was not given.
 struct IkCommandOptions {
@@ -28,7 +24,7 @@ struct IkCommandOptions {
   std::optional<std::string> quaternion;      // QW,QX,QY,QZ, only with position_mm
   std::optional<std::string> pose;            // 12 or 16 row-major values, instead of the two above
   std::optional<std::string> initial_joints;  // alpha_1,theta_1,alpha_2,theta_2,... in rad
-  int max_iterations = 100;
+  std::optional<int> max_iterations;  // unset: the runtime's bound
   bool json = false;
 };
 

@@ -35,6 +35,8 @@ struct IkOptions {
   // both parts; zero means the mean backbone length.
   S orientation_weight_mm_per_rad = S(0);
   S initial_damping = S(1e-3);
+  // Starts after the first one when a start stalls (IkSolverOptions).
+  int max_restarts = 3;
 };
 
 template <typename S, int Max = kMaxSegments>
@@ -67,6 +69,7 @@ IkResult<S, Max> solve_to_end(const Pose<S>& target, IkTargetKind kind, const Ro
   solver_options.orientation_weight_mm_per_rad = options.orientation_weight_mm_per_rad;
   solver_options.initial_damping = options.initial_damping;
   solver_options.max_iterations = options.max_iterations;
+  solver_options.max_restarts = options.max_restarts;
   IkSolver<S, Max, Correction> solver;
   solver.configure(geometry, correction, solver_options);
   if (const Status s = solver.start(target, kind, initial_joints); s != Status::ok) {
