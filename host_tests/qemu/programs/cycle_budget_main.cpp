@@ -147,9 +147,11 @@ void cycle() {
 }
 
 std::uint8_t next_sequence = 0;
-std::int32_t refusing_targets = 0;
-std::int32_t refusing_converged = 0;
-std::int32_t refusing_refused = 0;
+// Targets refusing extrapolation, [0] made inside the training data's range,
+// [1] beyond it.
+std::int32_t refusing_targets[2] = {};
+std::int32_t refusing_converged[2] = {};
+std::int32_t refusing_refused[2] = {};
 
 // A target, then cycles until its request ends; returns the cycles spent.
 int solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies* latencies,
@@ -345,11 +347,12 @@ int main() {
   // range and beyond it (bends to 0.45 rad): the solution's check (range,
   // then the variance in IK's slices) within the same budget.
   for (int t = 0; t < 40; ++t) {
-    solve(reachable_target(t % 2 ? 0.45f : 0.15f), protocol::TargetMode::pose, nullptr, true);
-    ++refusing_targets;
+    const int beyond = t % 2;
+    solve(reachable_target(beyond ? 0.45f : 0.15f), protocol::TargetMode::pose, nullptr, true);
+    ++refusing_targets[beyond];
     const protocol::IkOutcome outcome = runtime.last_ik_report().outcome;
-    refusing_converged += outcome == protocol::IkOutcome::converged ? 1 : 0;
-    refusing_refused += outcome == protocol::IkOutcome::refused_extrapolating ? 1 : 0;
+    refusing_converged[beyond] += outcome == protocol::IkOutcome::converged ? 1 : 0;
+    refusing_refused[beyond] += outcome == protocol::IkOutcome::refused_extrapolating ? 1 : 0;
   }
 
   // A streamed circle, 40 mm radius at 100 mm/s: a TRACKING position target
@@ -420,13 +423,16 @@ int main() {
   paper_position.report();
   full_range_pose.report();
   streamed.report();
-  console::console_write("targets refusing extrapolation: n ");
-  console::console_write_int(refusing_targets);
-  console::console_write(" converged ");
-  console::console_write_int(refusing_converged);
-  console::console_write(" refused ");
-  console::console_write_int(refusing_refused);
-  console::console_write("\n");
+  for (int beyond = 0; beyond < 2; ++beyond) {
+    console::console_write(beyond ? "targets refusing extrapolation, made beyond the data: n "
+                                  : "targets refusing extrapolation, made inside the data: n ");
+    console::console_write_int(refusing_targets[beyond]);
+    console::console_write(" converged ");
+    console::console_write_int(refusing_converged[beyond]);
+    console::console_write(" refused ");
+    console::console_write_int(refusing_refused[beyond]);
+    console::console_write("\n");
+  }
   console::console_write("cycle overhead (beyond the units spent): at most ");
   console::console_write_int(worst_unaccounted);
   console::console_write(" instructions\n");
@@ -446,8 +452,17 @@ int main() {
     console::console_write("FAIL: the silent drive did not fault the runtime, or its return did not recover it\n");
     ok = false;
   }
-  if (refusing_converged == 0 || refusing_refused == 0) {
-    console::console_write("FAIL: targets refusing extrapolation were all accepted or all refused\n");
+  // A target made inside the data has a solution there, which the search
+  // should find: one of the 20 is still refused on both boards (the goal is
+  // none; with a single retry from the straight start, 4 on the M7 and 9 on
+  // the M4F were). One made beyond it may have one too (the robot is
+  // redundant), but not all of them do.
+  if (refusing_refused[0] > 1) {
+    console::console_write("FAIL: targets made inside the data were refused as extrapolating\n");
+    ok = false;
+  }
+  if (refusing_refused[1] == 0) {
+    console::console_write("FAIL: no target made beyond the data was refused\n");
     ok = false;
   }
   if (with_hysteresis && !runtime.hysteresis().known()) {

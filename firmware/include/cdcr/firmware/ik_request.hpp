@@ -80,7 +80,7 @@ class IkRequest {
   void finish(model::IkSolveState end);
   bool begin_solution_check(const Joints& joints);
   std::uint32_t continue_solution_check(std::uint32_t units);
-  void retry_or_refuse();
+  void retry_or_refuse(const Joints& refused);
   void straight_start(Joints& joints) const;
   void conclude(bool reached, const Joints& joints);
   bool set_setpoints(const Joints& joints);
@@ -104,7 +104,7 @@ class IkRequest {
   bool checking_solution_ = false;
   // A refused solution is looked for once more from the slightly bent
   // straight start, near the middle of any training data.
-  bool solution_retried_ = false;
+  int solution_retries_ = 0;
   Pose target_;
   Uncertainty::Evaluation solution_check_;
   Joints checked_joints_;
