@@ -74,7 +74,7 @@ TEST(ComplianceIdentification, FindsTheSimulatorsStiffnessPlatformMassAndGravity
 
   const double stiffness = simulator_segment_stiffness(design, config);
   // Tolerances: 0.1 % on the compliance, 1 g on the platform, 0.05 deg on
-  // the direction (the sag is the same formula; eight fixed-point steps
+  // the direction (the sag is the same formula; the model library's Newton steps
   // against the simulator's converged equilibrium).
   for (int s = 0; s < design.segment_count; ++s) {
     EXPECT_NEAR(c.compliance_rad_per_n_mm(s) * stiffness, 1.0, 1e-3) << s;
