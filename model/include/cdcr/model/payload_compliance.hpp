@@ -57,10 +57,6 @@ inline constexpr int kSagNewtonSteps = 3;
 template <typename S, int MaxSegments>
 using SagJacobian = Eigen::Matrix<S, Eigen::Dynamic, Eigen::Dynamic, Eigen::ColMajor, 2 * MaxSegments, 2 * MaxSegments>;
 
-// A softening s is plausible while 1 + s |b| stays positive for bends up to
-// this (a quarter turn, beyond any segment's design limit here).
-inline constexpr double kComplianceLargestBendRad = 1.5707963267948966;
-
 template <typename S, int MaxSegments = kMaxSegments>
 struct PayloadCompliance {
   int segments = 0;  // the robot's segment count; 0: no compliance model
