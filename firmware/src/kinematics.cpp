@@ -16,7 +16,8 @@ model::Status estimate_pose(const RobotModel& model, const Cables& cables_mm, Po
   if (model.compensated) {
     model::ForwardResult<Scalar, kMaxSegments> result;
     if (const model::Status s =
-            model::compensated_forward(cables_mm, model.geometry, model.correction, result, kCableResolutionMm);
+            model::compensated_forward(cables_mm, model.geometry, model.correction, model.compliance, result,
+                                       kCableResolutionMm);
         s != model::Status::ok) {
       return s;
     }
@@ -62,7 +63,15 @@ bool PoseVariance::continue_slice(const Uncertainty& uncertainty) {
 
 model::Status SolverCorrection::begin_evaluation(const Joints& bend, Evaluation& evaluation,
                                                  bool with_gradient) const {
-  return correction_->begin_evaluation(bend, evaluation, with_gradient);
+  if (compliance_ == nullptr || compliance_->empty()) return correction_->begin_evaluation(bend, evaluation, with_gradient);
+  return correction_->begin_evaluation(
+      model::commanded_bends(bend, *geometry_, correction_->payload_kg(), *compliance_), evaluation, with_gradient);
+}
+
+Joints commanded_joints(const RobotModel& model, const Joints& solver_joints) {
+  if (!model.compensated || model.compliance.empty()) return solver_joints;
+  return model::joints_from_bend(model::commanded_bends(model::bend_from_joints(solver_joints), model.geometry,
+                                                         model.correction.payload_kg(), model.compliance));
 }
 
 std::uint32_t SolverCorrection::continue_evaluation(Evaluation& evaluation, std::uint32_t max_units) const {

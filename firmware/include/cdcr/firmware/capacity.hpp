@@ -77,6 +77,13 @@ inline constexpr int kMaxVarianceRank = static_cast<int>(model::kMaxVarianceRank
 inline constexpr std::uint32_t kHysteresisUnitsPerOperator = 1;
 inline constexpr std::uint32_t kHysteresisWideningUnits = 110;
 
+// Work units the payload's sag takes from a cycle, with an image that has a
+// compliance block (model::sagged_bends in the forward path: kSagNewtonSteps
+// passes of the chain with its twists and an 8 x 8 solve each), charged as
+// part of the forward path. Measured under QEMU by
+// qemu.cycle_budget_compliance_<board>.
+inline constexpr std::uint32_t kComplianceUnits = 300;
+
 // Bounds of one IK request: correction evaluations and nominal LM
 // iterations (see model::IkSolverOptions), and the cycles it may span
 // before it is reported unreachable.
