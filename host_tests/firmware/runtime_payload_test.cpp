@@ -82,6 +82,17 @@ class RuntimePayloadTest : public RuntimeTest {
     send(frame);
   }
 
+  // A position target solved to its end: converged, with setpoints; the
+  // report in `report`.
+  ::testing::AssertionResult solved(const model::Vec3<double>& target, protocol::IkReport& report) {
+    send_position_target(target.x(), target.y(), target.z(), 7);
+    cycles_until_ik_done();
+    if (!last_ik_report(report)) return ::testing::AssertionFailure() << "no IK_REPORT";
+    if (report.outcome != protocol::IkOutcome::converged) return ::testing::AssertionFailure() << "not converged";
+    if (!runtime->has_setpoints()) return ::testing::AssertionFailure() << "no setpoints";
+    return ::testing::AssertionSuccess();
+  }
+
   std::vector<std::uint8_t> image;
   model::ImageView view{};
 };
@@ -180,12 +191,8 @@ TEST_F(RuntimePayloadTest, InverseKinematicsUsesTheCurrentPayload) {
   ASSERT_EQ(runtime->payload_kg(), 0.9f);
   const model::Vec3<double> target = runtime->latest_pose().pose.position_mm.cast<double>() +
                                      model::Vec3<double>(3.0, -2.0, 0.0);
-  send_position_target(target.x(), target.y(), target.z(), 7);
-  cycles_until_ik_done();
   protocol::IkReport report;
-  ASSERT_TRUE(last_ik_report(report));
-  ASSERT_EQ(report.outcome, protocol::IkOutcome::converged);
-  ASSERT_TRUE(runtime->has_setpoints());
+  ASSERT_TRUE(solved(target, report));
   const Cables setpoints = runtime->setpoints_mm();
   const double at_payload = (expected_pose(setpoints, 0.9).position_mm - target).norm();
   const double at_default = (expected_pose(setpoints, 0.375).position_mm - target).norm();
@@ -246,15 +253,12 @@ TEST_F(RuntimeComplianceTest, InverseKinematicsReachesTheTargetOfTheSaggedModel)
   ASSERT_EQ(runtime->payload_kg(), 0.9f);
   for (const model::Vec3<double> offset : {model::Vec3<double>(3.0, -2.0, 0.0), model::Vec3<double>(-6.0, 4.0, -1.0)}) {
     const model::Vec3<double> target = runtime->latest_pose().pose.position_mm.cast<double>() + offset;
-    send_position_target(target.x(), target.y(), target.z(), 7);
-    const int spent = cycles_until_ik_done();
     protocol::IkReport report;
-    ASSERT_TRUE(last_ik_report(report));
-    ASSERT_EQ(report.outcome, protocol::IkOutcome::converged);
-    ASSERT_TRUE(runtime->has_setpoints());
+    ASSERT_TRUE(solved(target, report));
     const Cables setpoints = runtime->setpoints_mm();
     const double residual = (reference_pose(setpoints, 0.9).position_mm - target).norm();
-    std::printf("IK with the sag: %d cycles, %d iterations, residual %.4f mm\n", spent, report.iterations, residual);
+    std::printf("IK with the sag: %d cycles, %d iterations, residual %.4f mm\n", report.cycles, report.iterations,
+                residual);
     // 0.006 mm here; the correction evaluated at the sagged bends instead of
     // the commanded ones misses by 0.03 mm, the commanded bends' sag left
     // out of the setpoints by 9 mm.

@@ -41,14 +41,20 @@ const char* sharing_key(training::HysteresisSharing sharing) {
   return "?";
 }
 
+// What an identification before the GP did: tried, or why not; kept.
+Json identification_json(bool attempted, const std::string& skipped_reason, bool used) {
+  Json j;
+  j["identified"] = attempted;
+  j["skipped_reason"] = attempted ? Json(nullptr) : Json(skipped_reason);
+  j["used"] = used;
+  return j;
+}
+
 Json hysteresis_json(const TrainRun& run) {
   if (run.sequence == nullptr) return nullptr;
   const training::SequenceExport& s = *run.sequence;
   const training::HysteresisIdentification& id = s.identification;
-  Json j;
-  j["identified"] = id.attempted;
-  j["skipped_reason"] = id.attempted ? Json(nullptr) : Json(id.skipped_reason);
-  j["used"] = s.uses_hysteresis();
+  Json j = identification_json(id.attempted, id.skipped_reason, s.uses_hysteresis());
   j["structure"] = sharing_key(id.sharing);
   j["operators"] = id.model.operators;
   const model::HysteresisModel<double>& m = s.result.model.hysteresis;
@@ -142,25 +148,20 @@ Json compliance_structure_json(const training::ComplianceCandidate& c) {
 
 Json compliance_model_json(const training::ComplianceModel& m) {
   if (m.empty()) return nullptr;
-  Json j;
-  j["weighted_gravity"] = std::vector<double>(m.weighted_gravity.data(), m.weighted_gravity.data() + 3);
-  j["gravity_direction"] = std::vector<double>{m.gravity_direction()[0], m.gravity_direction()[1],
-                                               m.gravity_direction()[2]};
-  j["compliance_rad_per_n_mm"] = m.compliance_rad_per_n_mm(0);
-  j["ratios"] = m.ratio;
-  j["softening_per_rad"] = m.softening_per_rad;
-  j["unloaded_mass_kg"] = m.unloaded_mass_kg;
-  return j;
+  const Eigen::Vector3d direction = m.gravity_direction();
+  return Json{{"weighted_gravity", std::vector<double>(m.weighted_gravity.data(), m.weighted_gravity.data() + 3)},
+              {"gravity_direction", std::vector<double>(direction.data(), direction.data() + 3)},
+              {"compliance_rad_per_n_mm", m.compliance_rad_per_n_mm(0)},
+              {"ratios", m.ratio},
+              {"softening_per_rad", m.softening_per_rad},
+              {"unloaded_mass_kg", m.unloaded_mass_kg}};
 }
 
 Json compliance_json(const TrainRun& run) {
   if (run.payload == nullptr) return nullptr;
   const training::PayloadExport& p = *run.payload;
   const training::ComplianceChoice& choice = p.choice;
-  Json j;
-  j["identified"] = choice.attempted;
-  j["skipped_reason"] = choice.attempted ? Json(nullptr) : Json(choice.skipped_reason);
-  j["used"] = p.uses_compliance();
+  Json j = identification_json(choice.attempted, choice.skipped_reason, p.uses_compliance());
   j["structure"] = p.uses_compliance() ? Json(choice.structure.name()) : Json("none");
   j["model"] = compliance_model_json(choice.model);
   Json candidates = Json::array();

@@ -61,6 +61,9 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   // on; the search's model on fewer rows is of the same kind.
   BoardLimits limits = options.board;
   limits.variance_rank = static_cast<std::uint32_t>(std::clamp(options.variance_rank, 0, fitted_set.size()));
+  // The payload's sag runs in every forward cycle beside the GP's points.
+  const std::uint32_t sag_instructions = compliance.empty() ? 0 : limits.forward_cycle.compliance_sag;
+  limits.forward_cycle_instructions -= std::min(limits.forward_cycle_instructions, sag_instructions);
   const ModelSelection shipped =
       select_model(fitted_set.size(), static_cast<int>(fitted_set.inputs.cols()), geometry.segment_count,
                    options.model, options.inducing_points, limits);
@@ -72,6 +75,7 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   searched.hysteresis = hysteresis;
   searched.compliance = compliance;
   r.report.selection = shipped;
+  r.report.selection.forward_cycle_instructions += sag_instructions;
   const auto add_variance = [&](TrainedModel& m, const TrainingSet& rows) {
     if (options.variance_rank <= 0) return;
     const int rank = std::min(options.variance_rank, rows.size());

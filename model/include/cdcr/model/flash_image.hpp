@@ -891,19 +891,14 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
       reinterpret_cast<const std::uint8_t*>(block(offsets[4], kImageMetadataSize / sizeof(float)));
   const std::uint64_t variance_floats = image_variance_floats(rank, d);
   const float* variance = rank > 0 ? block(offsets[5], variance_floats) : nullptr;
-  // The hysteresis block lies where the dims put it (no offset field).
+  // The hysteresis and compliance blocks lie where the dims put them (no
+  // offset fields).
+  const ImageLayout implied = image_layout(n, d, segments, major, rank, extra, hysteresis_floats, compliance_floats);
+  const bool blocks_fit = array_bytes <= declared_total;
   const float* hysteresis =
-      hysteresis_floats > 0 && array_bytes <= declared_total
-          ? block(image_layout(n, d, segments, major, rank, extra, hysteresis_floats, compliance_floats)
-                      .hysteresis_offset,
-                  hysteresis_floats)
-          : nullptr;
+      hysteresis_floats > 0 && blocks_fit ? block(implied.hysteresis_offset, hysteresis_floats) : nullptr;
   const float* compliance =
-      compliance_floats > 0 && array_bytes <= declared_total
-          ? block(image_layout(n, d, segments, major, rank, extra, hysteresis_floats, compliance_floats)
-                      .compliance_offset,
-                  compliance_floats)
-          : nullptr;
+      compliance_floats > 0 && blocks_fit ? block(implied.compliance_offset, compliance_floats) : nullptr;
 
   const struct {
     const char* name;

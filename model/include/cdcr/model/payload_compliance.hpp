@@ -24,8 +24,7 @@
 
 #include <array>
 #include <cmath>
-
-#include <Eigen/LU>
+#include <utility>
 
 #include "cdcr/model/chain.hpp"
 #include "cdcr/model/geometry.hpp"
@@ -145,6 +144,37 @@ void sag_on_shape(const JointVector<S, Max>& shape, const RobotGeometry<S, Max>&
   }
 }
 
+// Solves a x = b for x, in place in b, by Gaussian elimination with partial
+// pivoting. Eigen's LU is blocked for matrices of run-time size and takes
+// its workspace from the heap; the system here is at most 2 kMaxSegments
+// wide and close to the identity (I less the sag's derivative).
+template <typename Matrix, typename Vector>
+void solve_in_place(Matrix& a, Vector& b) {
+  using S = typename Vector::Scalar;
+  const int n = static_cast<int>(b.size());
+  for (int k = 0; k < n; ++k) {
+    int pivot = k;
+    for (int i = k + 1; i < n; ++i) {
+      if (std::abs(a(i, k)) > std::abs(a(pivot, k))) pivot = i;
+    }
+    if (pivot != k) {
+      for (int j = 0; j < n; ++j) std::swap(a(k, j), a(pivot, j));
+      std::swap(b[k], b[pivot]);
+    }
+    if (a(k, k) == S(0)) continue;
+    for (int i = k + 1; i < n; ++i) {
+      const S factor = a(i, k) / a(k, k);
+      for (int j = k + 1; j < n; ++j) a(i, j) -= factor * a(k, j);
+      b[i] -= factor * b[k];
+    }
+  }
+  for (int k = n - 1; k >= 0; --k) {
+    S sum = b[k];
+    for (int j = k + 1; j < n; ++j) sum -= a(k, j) * b[j];
+    b[k] = a(k, k) != S(0) ? sum / a(k, k) : S(0);
+  }
+}
+
 // The bends with the sag of a tip load of payload_kg (plus the model's
 // unloaded mass); the bends themselves for an empty model or no load.
 // `newton_steps` of Newton's method on x - b - diag(1 + s |b_i|) sag(x) = 0
@@ -172,7 +202,8 @@ JointVector<S, Max> sagged_bends_after(int newton_steps, const JointVector<S, Ma
       jacobian.template middleRows<2>(2 * i) *= -softening[i];
     }
     jacobian.diagonal().array() += S(1);
-    current -= jacobian.partialPivLu().solve(residual);
+    solve_in_place(jacobian, residual);
+    current -= residual;
   }
   return current;
 }
