@@ -300,8 +300,8 @@ void report_hysteresis_costs(const model::ImageView& image) {
 }
 
 // The sag's work, at the golden cases' bends and the image's default
-// payload: the forward path's sagged_bends and the inverse the IK's
-// correction runs per evaluation.
+// payload: the forward path's sagged bends and the inverse the IK's
+// correction runs per evaluation, as the firmware compiles them.
 void report_compliance_costs() {
   const firmware::Compliance& compliance = runtime.compliance();
   const float payload_kg = runtime.payload_kg();
@@ -312,11 +312,11 @@ void report_compliance_costs() {
     const firmware::Joints bend = model::bend_from_joints(joints);
     firmware::Joints sagged;
     sag_max = std::max(sag_max, counter.instructions([&] {
-      sagged = model::sagged_bends(bend, runtime.geometry(), payload_kg, compliance);
+      sagged = firmware::sagged_bends_of(compliance, runtime.geometry(), payload_kg, bend);
     }));
     firmware::Joints back;
     inverse_max = std::max(inverse_max, counter.instructions([&] {
-      back = model::commanded_bends(sagged, runtime.geometry(), payload_kg, compliance);
+      back = firmware::commanded_bends_of(compliance, runtime.geometry(), payload_kg, sagged);
     }));
   }
   console::console_write("compliance costs (instructions): sag max ");

@@ -79,6 +79,13 @@ struct RobotModel {
   bool compensated = false;
 };
 
+// The payload's sag on the board (payload_sag.cpp, out of line): the sagged
+// bends of commanded ones, and the commanded bends that sag into given
+// ones, at the payload given.
+Joints sagged_bends_of(const Compliance& compliance, const Geometry& geometry, Scalar payload_kg, const Joints& bend);
+Joints commanded_bends_of(const Compliance& compliance, const Geometry& geometry, Scalar payload_kg,
+                          const Joints& sagged);
+
 // The joints whose cables the drives are sent for the solver's joints: with
 // a compliance model (compensated only) those of the commanded bends that
 // sag into the solver's, otherwise the solver's own.
