@@ -81,9 +81,9 @@ inline constexpr std::uint32_t kHysteresisWideningUnits = 110;
 // compliance block (model::sagged_bends in the forward path: kSagNewtonSteps
 // passes of the chain with its twists and an 8 x 8 solve each), charged as
 // part of the forward path. Measured under QEMU by
-// qemu.cycle_budget_compliance_<board> on four segments: 20,912 instructions
-// on the M7 (445 of its units of 47) and 27,631 on the M4F (493 of 56); the
-// charge covers both. (The IK correction's inverse, 1,585 and 2,781 per
+// qemu.cycle_budget_compliance_<board> on four segments: 20,924 instructions
+// on the M7 (445 of its units of 47) and 25,167 on the M4F (449 of 56); the
+// charge covers both. (The IK correction's inverse, 1,585 and 2,150 per
 // evaluation, rides in the evaluation's own margin.)
 inline constexpr std::uint32_t kComplianceUnits = 500;
 
