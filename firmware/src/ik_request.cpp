@@ -193,7 +193,7 @@ void IkRequest::conclude(bool reached, const Joints& joints) {
 bool IkRequest::begin_solution_check(const Joints& joints) {
   if (!model_.compensated || !model_.uncertainty.bound()) return false;
   Scalar coordinates[Correction::kMaxInputs];
-  model_.correction.kernel_coordinates(model::bend_from_joints(joints), coordinates);
+  model_.correction.kernel_coordinates(model::bend_from_joints(commanded_joints(model_, joints)), coordinates);
   if (model_.uncertainty.outside_range(coordinates)) {
     retry_or_refuse(joints);
     return true;
@@ -261,7 +261,9 @@ void IkRequest::end(protocol::IkOutcome outcome) {
 // publish_setpoints().
 bool IkRequest::set_setpoints(const Joints& joints) {
   Cables cables;
-  if (model::cables_from_joints(joints, model_.geometry, cables) != model::Status::ok) return false;
+  if (model::cables_from_joints(commanded_joints(model_, joints), model_.geometry, cables) != model::Status::ok) {
+    return false;
+  }
   // The joints are the effective lengths'; the drives are sent what makes them.
   if (hysteresis_ != nullptr) hysteresis_->commanded_for(cables);
   hal::CanFrame frames[kMaxSegments];

@@ -15,8 +15,15 @@ constexpr Scalar kCableResolutionMm = Scalar(protocol::kLengthScaleMm);
 model::Status estimate_pose(const RobotModel& model, const Cables& cables_mm, PoseEstimate& estimate) {
   if (model.compensated) {
     model::ForwardResult<Scalar, kMaxSegments> result;
-    if (const model::Status s =
-            model::compensated_forward(cables_mm, model.geometry, model.correction, result, kCableResolutionMm);
+    // With a compliance block the nominal pose is that of the sagged bends
+    // (sagged_bends_of, out of line).
+    const auto nominal_shape = [&model](const Joints& bend) {
+      return model.compliance.empty()
+                 ? bend
+                 : sagged_bends_of(model.compliance, model.geometry, model.correction.payload_kg(), bend);
+    };
+    if (const model::Status s = model::compensated_forward_with(cables_mm, model.geometry, model.correction, result,
+                                                                 kCableResolutionMm, nominal_shape);
         s != model::Status::ok) {
       return s;
     }
@@ -62,7 +69,9 @@ bool PoseVariance::continue_slice(const Uncertainty& uncertainty) {
 
 model::Status SolverCorrection::begin_evaluation(const Joints& bend, Evaluation& evaluation,
                                                  bool with_gradient) const {
-  return correction_->begin_evaluation(bend, evaluation, with_gradient);
+  if (compliance_ == nullptr || compliance_->empty()) return correction_->begin_evaluation(bend, evaluation, with_gradient);
+  return correction_->begin_evaluation(commanded_bends_of(*compliance_, *geometry_, correction_->payload_kg(), bend),
+                                       evaluation, with_gradient);
 }
 
 std::uint32_t SolverCorrection::continue_evaluation(Evaluation& evaluation, std::uint32_t max_units) const {

@@ -1,5 +1,7 @@
 #include "cdcr/firmware/model_loader.hpp"
 
+#include "cdcr/model/image_compliance.hpp"
+
 namespace cdcr::firmware {
 
 namespace {
@@ -47,6 +49,7 @@ BootFault load_model(ModelUpdate& update, const hal::ModelStorage& storage, cons
   BootFault fault;
   const SlotImage source = model_source(update, storage, model);
   model.geometry = fallback;
+  model.compliance = Compliance{};
   if (source.region.data == nullptr || source.region.size_bytes == 0) {
     fault.code = FaultCode::image_missing;
     return fault;
@@ -60,6 +63,7 @@ BootFault load_model(ModelUpdate& update, const hal::ModelStorage& storage, cons
   model::Status status = model::geometry_from_image(model.image, model.geometry);
   if (status == model::Status::ok) status = model.correction.bind(model.image);
   if (status == model::Status::ok) status = model.uncertainty.bind(model.image);
+  if (status == model::Status::ok) model::compliance_from_image(model.image, model.compliance);
   if (status != model::Status::ok) {
     model.geometry = fallback;
     fault.code = FaultCode::image_geometry_invalid;

@@ -60,7 +60,8 @@ RuntimeState Runtime::init() {
   hysteresis_.bind(model_);
   scheduler_.configure({model_.compensated, model_.uncertainty.has_variance(),
                         model_.correction.training_points() * model_.correction.mean_point_units(),
-                        model_.correction.smallest_gradient_slice_units(), hysteresis_units(hysteresis_)});
+                        model_.correction.smallest_gradient_slice_units(), hysteresis_units(hysteresis_),
+                        model_.compliance.empty() ? 0 : kComplianceUnits});
   enter(mode());
   if (boot_fault_ != FaultCode::none) {
     ConsoleLine line;

@@ -36,6 +36,22 @@ TEST(CycleScheduler, NominalModelCostsTheOverheadOnly) {
   EXPECT_EQ(scheduler.ik_units(), kCycleWorkUnits - kWorkCosts.cycle_overhead);
 }
 
+// The payload's sag runs in the forward path of a compensated model with a
+// compliance block: its units come out of IK's share; a nominal model runs
+// no sag.
+TEST(CycleScheduler, TheSagIsChargedToTheForwardPath) {
+  CycleScheduler scheduler;
+  ModelCosts costs = compensated_model(kMeanUnits);
+  costs.compliance_units = kComplianceUnits;
+  scheduler.configure(costs);
+  scheduler.plan(1, false, false, false);
+  EXPECT_EQ(scheduler.ik_units(), kCycleWorkUnits - kWorkCosts.cycle_overhead - kMeanUnits - kComplianceUnits);
+  costs.compensated = false;
+  scheduler.configure(costs);
+  scheduler.plan(1, false, false, false);
+  EXPECT_EQ(scheduler.ik_units(), kCycleWorkUnits - kWorkCosts.cycle_overhead);
+}
+
 TEST(CycleScheduler, WhileIkRunsTheVarianceGetsEveryFewCyclesOnly) {
   CycleScheduler scheduler;
   scheduler.configure(compensated_model(kMeanUnits));

@@ -28,24 +28,6 @@ namespace {
 
 using namespace test_support;  // the image edits of image_edits.hpp
 
-// The verdict of all three modes, which must agree; the first failed
-// finding of the reporting one in `first` (empty field when none failed).
-ImageStatus parse_all_ways(const Bytes& image, ImageFinding& first) {
-  ImageView view{};
-  const ImageStatus status = parse_image(image.data(), image.size(), view);
-  Findings findings;
-  EXPECT_EQ(parse_image(image.data(), image.size(), view, ImageCapacity{}, &findings), status);
-  ImageScan scan;
-  scan.begin(image.data(), image.size());
-  while (!scan.step(64)) {
-  }
-  EXPECT_EQ(parse_image(image.data(), image.size(), view, ImageCapacity{}, scan), status);
-  first = ImageFinding{};
-  first.field = "";
-  if (const ImageFinding* f = findings.first_failure(); f != nullptr) first = *f;
-  return status;
-}
-
 class FlashImageHysteresis : public ::testing::Test {
  protected:
   static test_support::SyntheticModelOptions options() {
@@ -94,11 +76,8 @@ TEST_F(FlashImageHysteresis, AGoodBlockParsesIntoTheViewAndAModel) {
 
   Findings findings;
   ASSERT_EQ(parse_image(image.data(), image.size(), view, ImageCapacity{}, &findings), ImageStatus::ok);
-  bool reported = false;
-  for (const ImageFinding& f : findings.all) {
-    reported = reported || (f.check == ImageCheckId::hysteresis && f.passed && f.count == 48);
-  }
-  EXPECT_TRUE(reported) << "the hysteresis check passes once for the block's 48 values";
+  EXPECT_TRUE(findings.passed_once_for(ImageCheckId::hysteresis, 48))
+      << "the hysteresis check passes once for the block's 48 values";
 }
 
 TEST_F(FlashImageHysteresis, AJointsOnlyModelIsWrittenAsBeforeAndAddingTheBlockMovesOnlyTheMetadata) {

@@ -10,6 +10,8 @@
 #include <string>
 #include <vector>
 
+#include <gtest/gtest.h>
+
 #include "cdcr/model/flash_image.hpp"
 
 #include "../support/reference_crc32.hpp"
@@ -59,7 +61,33 @@ class Findings : public model::ImageCheckSink {
     return nullptr;
   }
 
+  // Whether `check` passed once for all `count` values of a block.
+  bool passed_once_for(model::ImageCheckId check, std::uint32_t count) const {
+    return std::any_of(all.begin(), all.end(), [&](const model::ImageFinding& f) {
+      return f.check == check && f.passed && f.count == count;
+    });
+  }
+
   std::vector<model::ImageFinding> all;
 };
+
+// The verdict of all three modes (stopping, reporting, scanned), which must
+// agree; the first failed finding of the reporting one in `first` (empty
+// field when none failed).
+inline model::ImageStatus parse_all_ways(const Bytes& image, model::ImageFinding& first) {
+  model::ImageView view{};
+  const model::ImageStatus status = model::parse_image(image.data(), image.size(), view);
+  Findings findings;
+  EXPECT_EQ(model::parse_image(image.data(), image.size(), view, model::ImageCapacity{}, &findings), status);
+  model::ImageScan scan;
+  scan.begin(image.data(), image.size());
+  while (!scan.step(64)) {
+  }
+  EXPECT_EQ(model::parse_image(image.data(), image.size(), view, model::ImageCapacity{}, scan), status);
+  first = model::ImageFinding{};
+  first.field = "";
+  if (const model::ImageFinding* f = findings.first_failure(); f != nullptr) first = *f;
+  return status;
+}
 
 }  // namespace cdcr::test_support

@@ -13,6 +13,7 @@
 
 #include "allocation_counter.hpp"
 #include "cdcr/model/kinematics.hpp"
+#include "cdcr/model/payload_compliance.hpp"
 
 namespace cdcr::model {
 namespace {
@@ -99,6 +100,15 @@ struct Workload {
     JointVector<S> from_cables;
     check(joints_from_cables(cables, geometry, from_cables));
     consume(from_cables);
+
+    // The payload's sag (Newton steps with an LU solve) and its inverse.
+    PayloadCompliance<S> compliance;
+    compliance.segments = geometry.segment_count;
+    compliance.weighted_gravity = Vec3<S>(S(-2e-4), S(3e-5), S(1e-5));
+    compliance.softening_per_rad = S(0.3);
+    const JointVector<S> sagged = sagged_bends(bend_from_joints(joints), geometry, S(0.8), compliance);
+    consume(sagged);
+    consume(commanded_bends(sagged, geometry, S(0.8), compliance));
 
     const Twist<S> error = tip_error_twist(target, tip);
     const Pose<S> compensated = compensate(error, tip);

@@ -6,6 +6,9 @@
 //                                 (two play operators per cable, widths 0.25
 //                                 to 0.7 mm): the cycle budget with the
 //                                 cables' hysteresis
+//   cdcr_model_image_compliance.cpp  PAYLOAD_IMAGE (a payload model of the
+//                                 same robot with a compliance block): the
+//                                 cycle budget with the payload's sag
 //   qemu_golden.hpp               cable inputs as they travel on the bus, and
 //                                 the poses the host computes for them in
 //                                 double: compensated with the image, and
@@ -75,8 +78,8 @@ void append_pose(const cdcr::model::Pose<double>& pose, std::ostringstream& posi
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 3) {
-    std::fprintf(stderr, "usage: make_qemu_golden IMAGE OUT_DIR\n");
+  if (argc != 4) {
+    std::fprintf(stderr, "usage: make_qemu_golden IMAGE OUT_DIR PAYLOAD_IMAGE\n");
     return 2;
   }
   const std::string dir = argv[2];
@@ -175,6 +178,21 @@ int main(int argc, char** argv) {
     c_options.description = "the same model with a hysteresis block of two play operators per cable";
     write_text(dir + "/cdcr_model_image_hysteresis.cpp",
                cdcr::exporting::format_c_source(with_hysteresis.data(), with_hysteresis.size(), c_options));
+
+    const std::vector<std::uint8_t> payload_image = cdcr::exporting::read_binary_file(argv[3]);
+    cdcr::model::ImageView payload_view{};
+    if (const auto s = cdcr::model::parse_image(payload_image.data(), payload_image.size(), payload_view,
+                                                cdcr::model::ImageCapacity{});
+        s != cdcr::model::ImageStatus::ok) {
+      throw std::runtime_error(std::string(argv[3]) + ": " + cdcr::model::to_string(s));
+    }
+    if (payload_view.compliance_segments != segments) {
+      throw std::runtime_error(std::string(argv[3]) + ": no compliance block for the image's " +
+                               std::to_string(segments) + " segments (cdcr train chose no sag)");
+    }
+    c_options.description = std::string("a payload model with a compliance block, from ") + argv[3];
+    write_text(dir + "/cdcr_model_image_compliance.cpp",
+               cdcr::exporting::format_c_source(payload_image.data(), payload_image.size(), c_options));
 
     // In the middle of the training data: only the CRC can tell.
     image[image.size() / 2] ^= 0xFF;

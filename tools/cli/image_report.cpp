@@ -290,6 +290,15 @@ void describe_unfailed(ImageCheck& check, const Findings& findings, const ImageR
                          b.cables, b.operators, model::kMaxHysteresisWidthMm));
       }
       return;
+    case ImageCheckId::compliance:
+      if (!r.compliance) {
+        pass("no compliance block");
+      } else {
+        pass(fmt::format("{} segments: finite, ratios > 0, unloaded mass >= 0, softening keeping the compliance "
+                         "positive to a quarter turn, payload input present",
+                         r.compliance->ratios.size()));
+      }
+      return;
     case ImageCheckId::fitted_rows:
       if (r.fitted_rows && *r.fitted_rows == h.training_points) {
         pass(fmt::format("{} rows, the training points", *r.fitted_rows));
@@ -383,6 +392,9 @@ ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
       h.hysteresis_cables = bytes[hysteresis_cables];
       h.hysteresis_operators = bytes[hysteresis_operators];
     }
+    if (h.version_major >= 2 && h.version_minor >= model::kImageVersionMinorCompliance) {
+      h.compliance_segments = bytes[compliance_segments];
+    }
     r.header = h;
   }
   if (const ImageFinding* f = findings.find(ImageCheckId::size, "total_size"); f != nullptr && f->passed) {
@@ -416,13 +428,37 @@ ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
     for (int i = 0; i < 5; ++i) {
       r.blocks.push_back({block_names[i], offsets[i], block_sizes[i], inside(offsets[i], block_sizes[i])});
     }
-    // The hysteresis block (v2.2) lies just before the metadata.
+    const auto span = [](std::uint64_t bytes_of_block) {
+      return (bytes_of_block + model::kImageBlockAlignment - 1) / model::kImageBlockAlignment *
+             model::kImageBlockAlignment;
+    };
+    // The compliance block (v2.3) lies just before the metadata.
+    const std::uint64_t compliance_bytes = 4 * std::uint64_t{model::image_compliance_floats(h.compliance_segments)};
+    const std::uint64_t compliance_span = span(compliance_bytes);
+    if (compliance_bytes > 0 && h.metadata_offset >= compliance_span) {
+      const std::uint64_t at = h.metadata_offset - compliance_span;
+      const bool readable = inside(at, compliance_bytes);
+      r.blocks.insert(r.blocks.end() - 1, {"compliance", at, compliance_bytes, readable});
+      if (readable) {
+        const std::vector<float> values = read_floats(bytes, at, compliance_bytes / 4);
+        ImageCompliance block;
+        std::copy(values.begin(), values.begin() + 3, block.weighted_gravity.begin());
+        block.ratios.assign(values.begin() + model::image_compliance_field::ratios,
+                            values.begin() + model::image_compliance_field::ratios + h.compliance_segments);
+        block.softening_per_rad = values[values.size() - 2];
+        block.unloaded_mass_kg = values[values.size() - 1];
+        r.compliance = std::move(block);
+      }
+    }
+    // The hysteresis block (v2.2) lies before them.
     const std::uint64_t hysteresis_bytes =
         4 * std::uint64_t{model::image_hysteresis_floats(h.hysteresis_cables, h.hysteresis_operators)};
-    const std::uint64_t hysteresis_span = (hysteresis_bytes + model::kImageBlockAlignment - 1) /
-                                          model::kImageBlockAlignment * model::kImageBlockAlignment;
-    if (hysteresis_bytes > 0 && h.metadata_offset >= hysteresis_span) {
-      const std::uint64_t at = h.metadata_offset - hysteresis_span;
+    const std::uint64_t hysteresis_span = span(hysteresis_bytes);
+    const std::uint64_t hysteresis_end = compliance_bytes > 0 && h.metadata_offset >= compliance_span
+                                             ? h.metadata_offset - compliance_span
+                                             : h.metadata_offset;
+    if (hysteresis_bytes > 0 && hysteresis_end >= hysteresis_span) {
+      const std::uint64_t at = hysteresis_end - hysteresis_span;
       const bool readable = inside(at, hysteresis_bytes);
       r.blocks.insert(r.blocks.end() - 1, {"hysteresis", at, hysteresis_bytes, readable});
       if (readable) {

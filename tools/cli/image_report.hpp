@@ -28,7 +28,7 @@ enum class CheckResult { passed, failed, not_checked };
 struct ImageCheck {
   model::ImageCheckId id;
   const char* name;  // size, magic, version, header, alignment, checksum, kind, capacity, layout, finite, positive,
-                     // ranges, fitted_rows, variance, hysteresis
+                     // ranges, fitted_rows, variance, hysteresis, compliance
   CheckResult result = CheckResult::not_checked;
   std::string detail;
 };
@@ -58,6 +58,7 @@ struct ImageHeaderFields {
   std::uint16_t variance_rank = 0;    // v2
   std::uint8_t hysteresis_cables = 0;     // v2.2
   std::uint8_t hysteresis_operators = 0;  // v2.2
+  std::uint8_t compliance_segments = 0;   // v2.3
 };
 
 // A block where the header says it is, with the size the dims imply.
@@ -81,6 +82,14 @@ struct ImageHysteresis {
   int cables = 0;
   int operators = 0;
   std::vector<float> widths_mm, weights, homing_lags_mm;
+};
+
+// The compliance block (v2.3).
+struct ImageCompliance {
+  std::array<float, 3> weighted_gravity{};  // rad per kg mm, base frame
+  std::vector<float> ratios;                // per segment
+  float softening_per_rad = 0;
+  float unloaded_mass_kg = 0;
 };
 
 struct ImageMetadata {
@@ -109,6 +118,7 @@ struct ImageReport {
   std::optional<float> max_abs_input;  // kernel coordinates
   std::optional<float> max_abs_alpha;
   std::optional<ImageHysteresis> hysteresis;  // a v2.2 image's block, when it lies inside the file
+  std::optional<ImageCompliance> compliance;  // a v2.3 image's block, when it lies inside the file
   std::optional<ImageMetadata> metadata;
   // Data rows the model was fitted on: the metadata's for v2, the training
   // points for v1 (whose images carry exactly the rows they were fitted on).

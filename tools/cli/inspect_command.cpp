@@ -110,6 +110,7 @@ std::string format_text(const std::string& path, const ImageReport& r) {
       if (h.hysteresis_cables != 0 || h.hysteresis_operators != 0) {
         row("hysteresis", fmt::format("{} cables, {} operators each", h.hysteresis_cables, h.hysteresis_operators));
       }
+      if (h.compliance_segments != 0) row("compliance", fmt::format("{} segments", h.compliance_segments));
     }
 
     t += "dims\n";
@@ -188,6 +189,19 @@ std::string format_text(const std::string& path, const ImageReport& r) {
       t += fmt::format("  ({} more cables not listed)\n", b.cables - static_cast<int>(kMaxListedRows));
     }
   }
+  if (r.compliance) {
+    // b_i' = b_i + c_i (1 + s |b_i|) (m_y, -m_x), m the moment of the tip
+    // load (model/include/cdcr/model/payload_compliance.hpp).
+    const ImageCompliance& c = *r.compliance;
+    t += "payload compliance (the sag of the tip load in the nominal model)\n";
+    row("weight x c_0", fmt::format("({}, {}, {}) rad per kg mm, base frame", c.weighted_gravity[0],
+                                    c.weighted_gravity[1], c.weighted_gravity[2]));
+    std::string ratios;
+    for (std::size_t i = 0; i < c.ratios.size(); ++i) ratios += fmt::format("{}{}", i ? ", " : "", c.ratios[i]);
+    row("ratios c_i/c_0", ratios);
+    row("softening", fmt::format("{} per rad", c.softening_per_rad));
+    row("unloaded mass", fmt::format("{} kg", c.unloaded_mass_kg));
+  }
   if (r.max_abs_input || r.max_abs_alpha) {
     const bool sparse = r.header && is_sparse(*r.header);
     t += sparse ? "inducing points\n" : "training set\n";
@@ -231,6 +245,9 @@ std::string format_text(const std::string& path, const ImageReport& r) {
     // An image without a hysteresis block reads as it did before v2.2.
     const bool no_block = !r.header || (r.header->hysteresis_cables == 0 && r.header->hysteresis_operators == 0);
     if (c.id == model::ImageCheckId::hysteresis && no_block && c.result != CheckResult::failed) continue;
+    // Likewise without a compliance block before v2.3.
+    const bool no_compliance = !r.header || r.header->compliance_segments == 0;
+    if (c.id == model::ImageCheckId::compliance && no_compliance && c.result != CheckResult::failed) continue;
     std::string line = fmt::format("  {:<12}{:<13}{}", c.name, result_text(c.result), c.detail);
     while (line.back() == ' ') line.pop_back();
     t += line + "\n";
@@ -287,6 +304,7 @@ Json format_json(const std::string& path, const ImageReport& r) {
       header["variance_rank"] = h.variance_rank;
       header["hysteresis_cables"] = h.hysteresis_cables;
       header["hysteresis_operators"] = h.hysteresis_operators;
+      if (h.compliance_segments != 0) header["compliance_segments"] = h.compliance_segments;
     }
   }
   header["trailing_bytes"] = r.trailing_bytes ? Json(*r.trailing_bytes) : Json(nullptr);
@@ -358,6 +376,15 @@ Json format_json(const std::string& path, const ImageReport& r) {
                        {"homing_lags_mm", floats_json(b.homing_lags_mm)}};
   } else {
     j["hysteresis"] = nullptr;
+  }
+  // Only an image with the block has the key: the output of every other
+  // image stays as it was.
+  if (r.compliance) {
+    const ImageCompliance& c = *r.compliance;
+    j["compliance"] = {{"weighted_gravity", floats_json(std::vector<float>(c.weighted_gravity.begin(), c.weighted_gravity.end()))},
+                       {"ratios", floats_json(c.ratios)},
+                       {"softening_per_rad", float_json(c.softening_per_rad)},
+                       {"unloaded_mass_kg", float_json(c.unloaded_mass_kg)}};
   }
   j["training_set"] = {{"max_abs_kernel_coordinate", r.max_abs_input ? float_json(*r.max_abs_input) : Json(nullptr)},
                        {"max_abs_alpha", r.max_abs_alpha ? float_json(*r.max_abs_alpha) : Json(nullptr)}};

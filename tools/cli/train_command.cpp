@@ -36,6 +36,7 @@ struct TrainCommandOptions {
   bool calibrate = false;
   bool ignore_payload = false;
   bool no_hysteresis = false;
+  bool no_compliance = false;
   bool json = false;
 };
 
@@ -164,10 +165,18 @@ CommandOutput run_train(const TrainCommandOptions& o) {
       throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
     }
   }
+  // Payload data: the segments' compliance under the load is identified on
+  // the training rows (or the reason it is not is reported) before the GP.
+  std::optional<training::PayloadExport> payload;
+  if (!sequence && all.has_payload() && !o.no_compliance) {
+    payload = training::train_and_export_payload(train_set, validation_set, fitted_set, geometry, options,
+                                                 data.content_hash, created_unix_s);
+  }
   const training::ExportResult r =
-      sequence ? sequence->result
-               : training::train_and_export(train_set, validation_set, fitted_set, geometry, options,
-                                            data.content_hash, created_unix_s);
+      sequence  ? sequence->result
+      : payload ? payload->result
+                : training::train_and_export(train_set, validation_set, fitted_set, geometry, options,
+                                             data.content_hash, created_unix_s);
   const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
   try {
     exporting::write_binary_file(o.out_path, r.image.data(), r.image.size());
@@ -189,6 +198,8 @@ CommandOutput run_train(const TrainCommandOptions& o) {
   run.calibration_skipped = calibration_skipped;
   run.sequence = sequence ? &*sequence : nullptr;
   run.data_has_time = data.has_time;
+  run.payload = payload ? &*payload : nullptr;
+  run.payload_input = all.has_payload();
   run.seconds = seconds;
   CommandOutput output;
   output.text = o.json ? train_report_json(run) : train_report_text(run);
@@ -232,6 +243,9 @@ void register_train_command(CLI::App& app, CommandOutput& output) {
                     "Train on the cables alone even when the data have a payload_kg column");
   command->add_flag("--no-hysteresis", o->no_hysteresis,
                     "Train the joints-only model even when the data are a motion sequence (a t_s column)");
+  command->add_flag("--no-compliance", o->no_compliance,
+                    "Train the payload-as-an-input model without identifying the segments' compliance under the "
+                    "load, even when the data have a payload_kg column");
   command->add_flag("--json", o->json, "Print one JSON object");
   command->callback([o, &output] { output = run_train(*o); });
 }

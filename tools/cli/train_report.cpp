@@ -41,14 +41,20 @@ const char* sharing_key(training::HysteresisSharing sharing) {
   return "?";
 }
 
+// What an identification before the GP did: tried, or why not; kept.
+Json identification_json(bool attempted, const std::string& skipped_reason, bool used) {
+  Json j;
+  j["identified"] = attempted;
+  j["skipped_reason"] = attempted ? Json(nullptr) : Json(skipped_reason);
+  j["used"] = used;
+  return j;
+}
+
 Json hysteresis_json(const TrainRun& run) {
   if (run.sequence == nullptr) return nullptr;
   const training::SequenceExport& s = *run.sequence;
   const training::HysteresisIdentification& id = s.identification;
-  Json j;
-  j["identified"] = id.attempted;
-  j["skipped_reason"] = id.attempted ? Json(nullptr) : Json(id.skipped_reason);
-  j["used"] = s.uses_hysteresis();
+  Json j = identification_json(id.attempted, id.skipped_reason, s.uses_hysteresis());
   j["structure"] = sharing_key(id.sharing);
   j["operators"] = id.model.operators;
   const model::HysteresisModel<double>& m = s.result.model.hysteresis;
@@ -135,6 +141,83 @@ std::string hysteresis_text(const TrainRun& run) {
   return t;
 }
 
+Json compliance_structure_json(const training::ComplianceCandidate& c) {
+  if (c.none) return "none";
+  return c.structure.name();
+}
+
+Json compliance_model_json(const training::ComplianceModel& m) {
+  if (m.empty()) return nullptr;
+  const Eigen::Vector3d direction = m.gravity_direction();
+  return Json{{"weighted_gravity", std::vector<double>(m.weighted_gravity.data(), m.weighted_gravity.data() + 3)},
+              {"gravity_direction", std::vector<double>(direction.data(), direction.data() + 3)},
+              {"compliance_rad_per_n_mm", m.compliance_rad_per_n_mm(0)},
+              {"ratios", m.ratio},
+              {"softening_per_rad", m.softening_per_rad},
+              {"unloaded_mass_kg", m.unloaded_mass_kg}};
+}
+
+Json compliance_json(const TrainRun& run) {
+  if (run.payload == nullptr) return nullptr;
+  const training::PayloadExport& p = *run.payload;
+  const training::ComplianceChoice& choice = p.choice;
+  Json j = identification_json(choice.attempted, choice.skipped_reason, p.uses_compliance());
+  j["structure"] = p.uses_compliance() ? Json(choice.structure.name()) : Json("none");
+  j["model"] = compliance_model_json(choice.model);
+  Json candidates = Json::array();
+  for (const training::ComplianceCandidate& c : choice.candidates) {
+    candidates.push_back({{"structure", compliance_structure_json(c)},
+                          {"parameters", c.parameters},
+                          {"plausible", c.plausible},
+                          {"log_marginal_likelihood", c.log_marginal_likelihood},
+                          {"criterion", c.criterion}});
+  }
+  j["candidates"] = candidates;
+  j["validation_nominal_unsagged"] =
+      p.unsagged_validation.samples > 0 ? errors_json(p.unsagged_validation.initial) : Json(nullptr);
+  return j;
+}
+
+std::string compliance_text(const TrainRun& run) {
+  if (run.payload == nullptr) {
+    return run.payload_input && !run.data_has_time
+               ? "payload compliance: not identified (--no-compliance); payload-as-an-input model\n"
+               : "";
+  }
+  const training::PayloadExport& p = *run.payload;
+  const training::ComplianceChoice& choice = p.choice;
+  if (!choice.attempted) {
+    return fmt::format("payload compliance: not identified ({}); payload-as-an-input model\n", choice.skipped_reason);
+  }
+  std::string t = fmt::format("payload compliance chosen on the {} training rows: {}\n", run.train_rows,
+                              p.uses_compliance() ? choice.structure.name() : std::string("none (no sag)"));
+  t += "  structure                             parameters  log likelihood  criterion (less 1 per parameter)\n";
+  for (const training::ComplianceCandidate& c : choice.candidates) {
+    const bool chosen = c.none ? !p.uses_compliance()
+                               : p.uses_compliance() && c.structure.per_segment == choice.structure.per_segment &&
+                                     c.structure.softening == choice.structure.softening &&
+                                     c.structure.unloaded_mass == choice.structure.unloaded_mass;
+    t += fmt::format("  {:<37} {:10d}  {:14.2f}  {:10.2f}{}{}\n", c.none ? std::string("none") : c.structure.name(),
+                     c.parameters, c.log_marginal_likelihood, c.criterion, c.plausible ? "" : "  (implausible)",
+                     chosen ? "  chosen" : "");
+  }
+  if (p.uses_compliance()) {
+    const training::ComplianceModel& m = choice.model;
+    const Eigen::Vector3d g = m.gravity_direction();
+    t += fmt::format("  gravity direction ({:.4f}, {:.4f}, {:.4f}); segment 1 compliance {:.4e} rad/(N mm)\n", g[0],
+                     g[1], g[2], m.compliance_rad_per_n_mm(0));
+    t += "  ratios c_i/c_1:";
+    for (const double r : m.ratio) t += fmt::format(" {:.4f}", r);
+    t += fmt::format("; softening {:.4f} per rad; unloaded mass {:.4f} kg\n", m.softening_per_rad,
+                     m.unloaded_mass_kg);
+    if (p.unsagged_validation.samples > 0) {
+      t += fmt::format("  held-out nominal model without the sag: {:.4f} mm, {:.4f} deg\n",
+                       p.unsagged_validation.initial.position_mm, p.unsagged_validation.initial.orientation_deg);
+    }
+  }
+  return t;
+}
+
 }  // namespace
 
 std::string train_report_json(const TrainRun& run) {
@@ -194,6 +277,8 @@ std::string train_report_json(const TrainRun& run) {
   j["float32_fidelity"] = fidelity;
   j["float32_fidelity_target_met"] = r.fidelity_met();
   if (run.data_has_time) j["hysteresis"] = hysteresis_json(run);
+  // Only payload data have the key: every other report stays as it was.
+  if (run.payload_input && !run.data_has_time) j["compliance"] = compliance_json(run);
   j["image"] = {{"path", run.out_path}, {"bytes", r.image.size()}};
   return j.dump() + "\n";
 }
@@ -245,10 +330,13 @@ std::string train_report_text(const TrainRun& run) {
   t += fmt::format("  log marginal likelihood {:.6g} after {} evaluations\n", r.report.log_marginal_likelihood,
                    r.report.likelihood_evaluations);
   t += hysteresis_text(run);
+  t += compliance_text(run);
   if (r.validation.samples > 0) {
     t += "held-out mean error          position (mm)   orientation (deg)\n";
     const bool effective = run.sequence != nullptr && run.sequence->uses_hysteresis();
-    t += fmt::format("  nominal model{}{:13.4f}   {:17.4f}\n", effective ? " (effective)  " : "              ",
+    const bool sagged = run.payload != nullptr && run.payload->uses_compliance();
+    t += fmt::format("  nominal model{}{:13.4f}   {:17.4f}\n",
+                     effective ? " (effective)  " : sagged ? " (sagged)     " : "              ",
                      r.validation.initial.position_mm,
                      r.validation.initial.orientation_deg);
     t += fmt::format("  compensated (double)       {:13.4f}   {:17.4f}\n", r.validation.compensated.position_mm,

@@ -29,6 +29,10 @@ struct TrainRun {
   // t_s column, or --no-hysteresis).
   const training::SequenceExport* sequence = nullptr;
   bool data_has_time = false;
+  // Payload data's compliance identification (null: no payload input, a
+  // motion sequence, or --no-compliance).
+  const training::PayloadExport* payload = nullptr;
+  bool payload_input = false;  // the model takes the payload
   double seconds = 0;
 };
 

@@ -73,6 +73,34 @@ void put_hysteresis(ImageBuffer& image, std::uint32_t block, const model::Hyster
   }
 }
 
+// The count a trained compliance model must have, and the payload input it
+// needs; parse_image() judges its values.
+void check_compliance_counts(const model::PayloadCompliance<double>& compliance, int segments, int extra_inputs) {
+  if (compliance.empty()) return;
+  if (compliance.segments != segments) {
+    throw std::invalid_argument("trained model's compliance has " + std::to_string(compliance.segments) +
+                                " segments; the robot has " + std::to_string(segments));
+  }
+  if (extra_inputs != 1) throw std::invalid_argument("a compliance block needs a model with the payload input");
+}
+
+std::uint32_t compliance_floats(const model::PayloadCompliance<double>& compliance) {
+  return compliance.empty() ? 0 : model::image_compliance_floats(static_cast<std::uint32_t>(compliance.segments));
+}
+
+// The header's count and the block, for a model with a compliance model.
+void put_compliance(ImageBuffer& image, std::uint32_t block, const model::PayloadCompliance<double>& compliance) {
+  if (compliance.empty()) return;
+  using namespace model::image_compliance_field;
+  image.put<std::uint16_t>(model::image_field::version_minor, model::kImageVersionMinorCompliance);
+  image.put<std::uint8_t>(model::image_field::compliance_segments, static_cast<std::uint8_t>(compliance.segments));
+  for (int k = 0; k < 3; ++k) image.put_float(block + 4 * (weighted_gravity + k), compliance.weighted_gravity[k]);
+  std::size_t at = block + 4 * ratios;
+  for (int i = 0; i < compliance.segments; ++i, at += 4) image.put_float(at, compliance.ratio[static_cast<std::size_t>(i)]);
+  image.put_float(at, compliance.softening_per_rad);
+  image.put_float(at + 4, compliance.unloaded_mass_kg);
+}
+
 // Whatever is written must parse (a non-positive scale, for one, is only
 // caught here). Capacity is a property of the firmware build, not of the
 // image, so none is imposed.
@@ -123,11 +151,12 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   }
   if (rank > 0xFFFF) throw std::invalid_argument("trained model's variance factor is too large for a flash image");
   check_hysteresis_counts(model.hysteresis, segments);
+  check_compliance_counts(model.compliance, segments, extra);
   const model::ImageLayout layout =
       model::image_layout(static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(d),
                           static_cast<std::uint32_t>(segments), model::kImageVersionMajor,
                           static_cast<std::uint32_t>(rank), static_cast<std::uint32_t>(extra),
-                          hysteresis_floats(model.hysteresis));
+                          hysteresis_floats(model.hysteresis), compliance_floats(model.compliance));
   ImageBuffer image(layout.total_size);
 
   image.put<std::uint32_t>(magic, model::kImageMagic);
@@ -225,8 +254,10 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
     }
   }
 
-  // Without a hysteresis model the image is a 2.1 image, byte for byte.
+  // Without a hysteresis or compliance model the image is a 2.1 image,
+  // byte for byte.
   put_hysteresis(image, layout.hysteresis_offset, model.hysteresis);
+  put_compliance(image, layout.compliance_offset, model.compliance);
 
   using namespace model::image_metadata_field;
   const std::size_t meta = layout.metadata_offset;
@@ -244,41 +275,57 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   return image.take();
 }
 
-std::vector<std::uint8_t> with_hysteresis_block(const std::vector<std::uint8_t>& image,
-                                                const model::HysteresisModel<double>& hysteresis) {
+namespace {
+
+// `image` (a valid v2 image without either block) with the blocks given
+// added between its last block and its metadata, which moves.
+std::vector<std::uint8_t> with_blocks(const std::vector<std::uint8_t>& image,
+                                      const model::HysteresisModel<double>& hysteresis,
+                                      const model::PayloadCompliance<double>& compliance) {
   model::ImageView view{};
   const model::ImageCapacity any_capacity{std::numeric_limits<std::uint32_t>::max(),
                                           std::numeric_limits<std::uint16_t>::max(),
                                           std::numeric_limits<std::uint16_t>::max()};
   if (const model::ImageStatus status = model::parse_image(image.data(), image.size(), view, any_capacity);
       status != model::ImageStatus::ok) {
-    throw std::invalid_argument(std::string("image to add hysteresis to: ") + model::to_string(status));
+    throw std::invalid_argument(std::string("image to add a block to: ") + model::to_string(status));
   }
-  if (view.version_major != model::kImageVersionMajor || view.hysteresis_cables != 0) {
-    throw std::invalid_argument("only a v2 image without a hysteresis block can take one");
+  if (view.version_major != model::kImageVersionMajor || view.hysteresis_cables != 0 || view.compliance_segments != 0) {
+    throw std::invalid_argument("only a v2 image without a hysteresis or compliance block can take one");
   }
   check_hysteresis_counts(hysteresis, view.segment_count);
-  const model::ImageLayout old_layout =
-      model::image_layout(view.training_points, static_cast<std::uint32_t>(view.input_dims),
-                          static_cast<std::uint32_t>(view.segment_count), view.version_major, view.variance_rank,
-                          static_cast<std::uint32_t>(view.extra_inputs));
-  const model::ImageLayout layout =
-      model::image_layout(view.training_points, static_cast<std::uint32_t>(view.input_dims),
-                          static_cast<std::uint32_t>(view.segment_count), view.version_major, view.variance_rank,
-                          static_cast<std::uint32_t>(view.extra_inputs), hysteresis_floats(hysteresis));
+  check_compliance_counts(compliance, view.segment_count, view.extra_inputs);
+  const auto layout_with = [&](std::uint32_t hysteresis_block, std::uint32_t compliance_block) {
+    return model::image_layout(view.training_points, static_cast<std::uint32_t>(view.input_dims),
+                               static_cast<std::uint32_t>(view.segment_count), view.version_major, view.variance_rank,
+                               static_cast<std::uint32_t>(view.extra_inputs), hysteresis_block, compliance_block);
+  };
+  const model::ImageLayout old_layout = layout_with(0, 0);
+  const model::ImageLayout layout = layout_with(hysteresis_floats(hysteresis), compliance_floats(compliance));
   ImageBuffer out(layout.total_size);
-  // Everything before the metadata stays where it is; the block goes
-  // between it and the metadata, which moves.
   std::memcpy(out.data(), image.data(), old_layout.metadata_offset);
   std::memcpy(out.data() + layout.metadata_offset, image.data() + old_layout.metadata_offset,
               model::kImageMetadataSize);
   out.put<std::uint32_t>(model::image_field::total_size, layout.total_size);
   out.put<std::uint32_t>(model::image_field::metadata_offset, layout.metadata_offset);
   put_hysteresis(out, layout.hysteresis_offset, hysteresis);
+  put_compliance(out, layout.compliance_offset, compliance);
   const std::uint32_t checksum = model::crc32(out.data(), layout.total_size - model::kImageTrailerSize);
   out.put<std::uint32_t>(layout.total_size - model::kImageTrailerSize, checksum);
   check_parses(out, layout.total_size);
   return out.take();
+}
+
+}  // namespace
+
+std::vector<std::uint8_t> with_hysteresis_block(const std::vector<std::uint8_t>& image,
+                                                const model::HysteresisModel<double>& hysteresis) {
+  return with_blocks(image, hysteresis, {});
+}
+
+std::vector<std::uint8_t> with_compliance_block(const std::vector<std::uint8_t>& image,
+                                                const model::PayloadCompliance<double>& compliance) {
+  return with_blocks(image, {}, compliance);
 }
 
 }  // namespace cdcr::exporting

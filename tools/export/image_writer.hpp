@@ -15,7 +15,9 @@ namespace cdcr::exporting {
 // parse_image() would refuse, such as a non-positive scale, an inverted input
 // range, or an exact model whose fitted_rows is not its number of points).
 // A model with a hysteresis model (TrainedModel::hysteresis) is written as
-// a v2.2 image with the hysteresis block; one without, as a v2.1 image.
+// a v2.2 image with the hysteresis block, one with a compliance model
+// (TrainedModel::compliance, a payload model only) as a v2.3 image with the
+// compliance block; one with neither, as a v2.1 image.
 std::vector<std::uint8_t> write_image(const training::TrainedModel& model);
 
 // `image` (a valid v2 image without a hysteresis block) with `hysteresis`
@@ -23,5 +25,11 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model);
 // write_image does.
 std::vector<std::uint8_t> with_hysteresis_block(const std::vector<std::uint8_t>& image,
                                                 const model::HysteresisModel<double>& hysteresis);
+
+// `image` (a valid v2 image with the payload input and without a hysteresis
+// or compliance block) with `compliance` added: the same model, written as
+// v2.3. Throws std::invalid_argument as write_image does.
+std::vector<std::uint8_t> with_compliance_block(const std::vector<std::uint8_t>& image,
+                                                const model::PayloadCompliance<double>& compliance);
 
 }  // namespace cdcr::exporting

@@ -54,12 +54,16 @@ bool same_rows(const TrainingSet& a, const TrainingSet& b) {
 ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& validation_set,
                               const TrainingSet& fitted_set, const model::RobotGeometry<double>& geometry,
                               const TrainingOptions& options, std::uint64_t dataset_hash,
-                              std::int64_t created_unix_s, const model::HysteresisModel<double>& hysteresis) {
+                              std::int64_t created_unix_s, const model::HysteresisModel<double>& hysteresis,
+                              const model::PayloadCompliance<double>& compliance) {
   ExportResult r;
   // The shipped model's kind and size are those for the rows it is fitted
   // on; the search's model on fewer rows is of the same kind.
   BoardLimits limits = options.board;
   limits.variance_rank = static_cast<std::uint32_t>(std::clamp(options.variance_rank, 0, fitted_set.size()));
+  // The payload's sag runs in every forward cycle beside the GP's points.
+  const std::uint32_t sag_instructions = compliance.empty() ? 0 : limits.forward_cycle.compliance_sag;
+  limits.forward_cycle_instructions -= std::min(limits.forward_cycle_instructions, sag_instructions);
   const ModelSelection shipped =
       select_model(fitted_set.size(), static_cast<int>(fitted_set.inputs.cols()), geometry.segment_count,
                    options.model, options.inducing_points, limits);
@@ -69,7 +73,9 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   search_options.inducing_points = shipped.kind == ModelKind::exact ? 0 : std::min(shipped.points, train_set.size());
   TrainedModel searched = train(train_set, geometry, search_options, &r.report);
   searched.hysteresis = hysteresis;
+  searched.compliance = compliance;
   r.report.selection = shipped;
+  r.report.selection.forward_cycle_instructions += sag_instructions;
   const auto add_variance = [&](TrainedModel& m, const TrainingSet& rows) {
     if (options.variance_rank <= 0) return;
     const int rank = std::min(options.variance_rank, rows.size());
@@ -129,6 +135,36 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   r.model.metrics = metrics_of(r.validation, r.fidelity);
   r.image = exporting::write_image(r.model);
   return r;
+}
+
+PayloadExport train_and_export_payload(const TrainingSet& train_set, const TrainingSet& validation_set,
+                                       const TrainingSet& fitted_set, const model::RobotGeometry<double>& geometry,
+                                       const TrainingOptions& options, std::uint64_t dataset_hash,
+                                       std::int64_t created_unix_s) {
+  if (!train_set.has_payload() || !fitted_set.has_payload() ||
+      (validation_set.size() > 0 && !validation_set.has_payload())) {
+    throw std::invalid_argument("the payload model's rows need a payload_kg column");
+  }
+  PayloadExport out;
+  out.choice = choose_compliance(train_set, geometry, options);
+  if (validation_set.size() > 0) {
+    out.unsagged_validation.samples = validation_set.size();
+    out.unsagged_validation.initial = mean_errors(validation_set.measured, validation_set.nominal);
+  }
+  if (out.choice.model.empty()) {
+    out.result = train_and_export(train_set, validation_set, fitted_set, geometry, options, dataset_hash,
+                                  created_unix_s);
+    return out;
+  }
+  const ComplianceModel& c = out.choice.model;
+  const TrainingSet sagged_train = with_compliance(train_set, geometry, c);
+  const TrainingSet sagged_validation =
+      validation_set.size() > 0 ? with_compliance(validation_set, geometry, c) : validation_set;
+  const TrainingSet sagged_fitted =
+      same_rows(fitted_set, train_set) ? sagged_train : with_compliance(fitted_set, geometry, c);
+  out.result = train_and_export(sagged_train, sagged_validation, sagged_fitted, geometry, options, dataset_hash,
+                                created_unix_s, {}, c.for_model(geometry.segment_count));
+  return out;
 }
 
 SequenceExport train_and_export_sequence(const dataset::Dataset& data, const std::vector<int>& train_rows,

@@ -11,6 +11,7 @@
 
 #include "cdcr/model/hysteresis.hpp"
 #include "dataset/dataset.hpp"
+#include "train/compliance_identification.hpp"
 #include "train/evaluation.hpp"
 #include "train/hysteresis_identification.hpp"
 #include "train/trainer.hpp"
@@ -53,11 +54,36 @@ struct ExportResult {
 // have the same rows). A non-empty `hysteresis` is the model's (the sets'
 // cables_mm are then the effective lengths it gives; the float32 image path
 // is measured on the same effective lengths as the trainer, so the image's
-// own hysteresis arithmetic is not part of this check).
+// own hysteresis arithmetic is not part of this check). A non-empty
+// `compliance` is the model's too: the sets' nominal poses and error twists
+// are then the sagged ones (with_compliance), and the float32 image path,
+// which sags the nominal pose itself, is measured against them.
 ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& validation_set,
                               const TrainingSet& fitted_set, const model::RobotGeometry<double>& geometry,
                               const TrainingOptions& options, std::uint64_t dataset_hash,
-                              std::int64_t created_unix_s, const model::HysteresisModel<double>& hysteresis = {});
+                              std::int64_t created_unix_s, const model::HysteresisModel<double>& hysteresis = {},
+                              const model::PayloadCompliance<double>& compliance = {});
+
+// cdcr train on payload data: the segments' compliance under the tip load
+// chosen on the training rows (choose_compliance), then, when a sag model
+// wins, the GP trained, measured and exported on the sagged residuals with
+// the image's compliance block; otherwise the payload-as-an-input model, as
+// train_and_export on the rows as they are.
+struct PayloadExport {
+  ExportResult result;
+  ComplianceChoice choice;
+  // The nominal model without the sag on the validation rows (samples 0
+  // when none are held out); result.validation.initial is the sagged one.
+  Evaluation unsagged_validation;
+
+  bool uses_compliance() const { return !result.model.compliance.empty(); }
+};
+
+// The sets must have a payload column (else std::invalid_argument).
+PayloadExport train_and_export_payload(const TrainingSet& train_set, const TrainingSet& validation_set,
+                                       const TrainingSet& fitted_set, const model::RobotGeometry<double>& geometry,
+                                       const TrainingOptions& options, std::uint64_t dataset_hash,
+                                       std::int64_t created_unix_s);
 
 // cdcr train on a motion sequence: the hysteresis identified on the training
 // rows (see hysteresis_identification.hpp), then the model trained, measured

@@ -18,13 +18,6 @@ namespace cdcr::training {
 
 namespace {
 
-// The sag is a few hundredths of a radian per segment; its effect on its own
-// lever arms converges by a factor of about 20 per iteration (the first
-// kilogram's sag over the robot's length), so eight leave less than 1e-10 rad.
-constexpr int kSagIterations = 8;
-// A softening s is plausible while 1 + s |b| stays positive for bends up to
-// this (a quarter turn, beyond any segment's design limit here).
-constexpr double kLargestBendRad = 1.5707963267948966;
 // The background (see background_basis) is projected out of the residuals
 // only with at least this many rows per column of it (180 for 4 segments).
 constexpr int kBackgroundRowsPerColumn = 4;
@@ -113,39 +106,27 @@ double ComplianceModel::compliance_rad_per_n_mm(int segment) const {
   return r * weighted_gravity.norm() / kStandardGravityM_per_s2;
 }
 
+model::PayloadCompliance<double> ComplianceModel::for_model(int segments) const {
+  model::PayloadCompliance<double> c;
+  if (empty()) return c;
+  c.segments = segments;
+  c.weighted_gravity = weighted_gravity;
+  for (int i = 0; i < segments && !ratio.empty(); ++i) c.ratio[static_cast<std::size_t>(i)] = ratio[static_cast<std::size_t>(i)];
+  c.softening_per_rad = softening_per_rad;
+  c.unloaded_mass_kg = unloaded_mass_kg;
+  return c;
+}
+
 Eigen::VectorXd sagged_bends(const Eigen::VectorXd& bends, const model::RobotGeometry<double>& geometry,
                              double payload_kg, const ComplianceModel& compliance) {
-  const double tip_mass_kg = payload_kg + compliance.unloaded_mass_kg;
-  if (compliance.empty() || tip_mass_kg == 0.0) return bends;
-  const int n = geometry.segment_count;
-  std::vector<model::Pose<double>> bases(static_cast<std::size_t>(n));
-  Eigen::VectorXd current = bends;
-  for (int iteration = 0; iteration < kSagIterations; ++iteration) {
-    model::Pose<double> frame;
-    for (int i = 0; i < n; ++i) {
-      bases[static_cast<std::size_t>(i)] = frame;
-      frame = frame * model::segment_pose<double>(current.segment<2>(2 * i), geometry.segments[i].backbone_length_mm);
-    }
-    Eigen::VectorXd next = bends;
-    for (int i = 0; i < n; ++i) {
-      const model::Pose<double>& base = bases[static_cast<std::size_t>(i)];
-      const Eigen::Vector3d moment =
-          (tip_mass_kg * (frame.position_mm - base.position_mm)).cross(compliance.weighted_gravity);
-      const Eigen::Vector3d local = base.rotation.transpose() * moment;
-      const double ratio = compliance.ratio.empty() ? 1.0 : compliance.ratio[static_cast<std::size_t>(i)];
-      const double softening = 1.0 + compliance.softening_per_rad * bends.segment<2>(2 * i).norm();
-      // A rotation vector (kx, ky, 0) is the bend (u, w) = (ky, -kx).
-      next.segment<2>(2 * i) += ratio * softening * Eigen::Vector2d(local.y(), -local.x());
-    }
-    current = next;
-  }
-  return current;
+  const model::JointVector<double> commanded = bends;
+  return model::sagged_bends(commanded, geometry, payload_kg, compliance.for_model(geometry.segment_count));
 }
 
 model::Pose<double> sagged_pose(const Eigen::VectorXd& bends, const model::RobotGeometry<double>& geometry,
                                 double payload_kg, const ComplianceModel& compliance) {
-  const model::JointVector<double> sagged = sagged_bends(bends, geometry, payload_kg, compliance);
-  return model::forward_kinematics_bend(sagged, geometry);
+  const model::JointVector<double> commanded = bends;
+  return model::sagged_pose(commanded, geometry, payload_kg, compliance.for_model(geometry.segment_count));
 }
 
 TrainingSet with_compliance(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
@@ -220,7 +201,7 @@ bool plausible(const ComplianceModel& m) {
   for (const double r : m.ratio) {
     if (!(r > 0.0)) return false;
   }
-  return m.unloaded_mass_kg >= 0.0 && m.softening_per_rad > -1.0 / kLargestBendRad;
+  return m.unloaded_mass_kg >= 0.0 && model::plausible_softening(m.softening_per_rad);
 }
 
 }  // namespace

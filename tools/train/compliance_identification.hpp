@@ -7,9 +7,9 @@
 // tip load's weight about its base, times the segment's compliance,
 //   b_i' = b_i + c_i (1 + s |b_i|) (m_y, -m_x),
 //   m = R_i^T (m_tip (p_tip - p_i) x g),   m_tip = payload + m_0,
-// in the segment's base frame R_i, p_i of the sagged shape (a fixed-point
-// iteration from the nominal shape: the sag moves its own lever arms). g is
-// the weight of a kilogram (9.81 N) in an identified direction, c_i the
+// in the segment's base frame R_i, p_i of the sagged shape (the fixed point,
+// found by Newton steps from the nominal shape: the sag moves its own lever
+// arms). g is the weight of a kilogram (9.81 N) in an identified direction, c_i the
 // compliance (rad per N mm), s a softening with the segment's own bend and
 // m_0 an unloaded tip mass, which stands for the end platform's and the
 // segments' own weight (they sag the robot without payload the same way,
@@ -30,10 +30,10 @@
 // Data without a payload column is not identified: its training set is the
 // one it always was.
 //
-// Not yet in the exported model: the flash image has no block for the sag
-// and the board's nominal model does not compute it, so `cdcr train` still
-// ships the payload-as-an-input model; tools/bench/compliance_bench.cpp
-// measures what the sag buys on the test rows.
+// The sag itself is the model library's (model/include/cdcr/model/
+// payload_compliance.hpp), the one the board runs; `cdcr train` on payload
+// data ships the chosen model in the image's compliance block
+// (pipeline/train_and_export.hpp).
 
 #include <string>
 #include <vector>
@@ -41,6 +41,7 @@
 #include <Eigen/Core>
 
 #include "cdcr/model/geometry.hpp"
+#include "cdcr/model/payload_compliance.hpp"
 #include "cdcr/model/se3.hpp"
 #include "trainer.hpp"
 #include "training_set.hpp"
@@ -71,6 +72,9 @@ struct ComplianceModel {
   bool empty() const { return weighted_gravity.isZero(0.0); }
   Eigen::Vector3d gravity_direction() const { return weighted_gravity.normalized(); }
   double compliance_rad_per_n_mm(int segment) const;
+  // The model library's form for a robot of `segments` segments (empty for
+  // the empty model).
+  model::PayloadCompliance<double> for_model(int segments) const;
 };
 
 // The stacked bend vectors with the sag of a tip load of payload_kg (plus the

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cdcr/model/compensated_kinematics.hpp"
+#include "cdcr/model/image_compliance.hpp"
 #include "cdcr/model/pose_error_summary.hpp"
 
 namespace cdcr::training {
@@ -72,13 +73,15 @@ std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, cons
   if (const model::Status s = uncertainty.bind(image); s != model::Status::ok) {
     throw std::invalid_argument(std::string("image: ") + model::to_string(s));
   }
+  model::PayloadCompliance<float> compliance;
+  model::compliance_from_image(image, compliance);
   std::vector<FirmwareEstimate> estimates;
   estimates.reserve(static_cast<std::size_t>(cables_mm.rows()));
   for (Eigen::Index i = 0; i < cables_mm.rows(); ++i) {
     const model::CableVector<float> cables = cables_mm.row(i).transpose().cast<float>();
     if (image.extra_inputs > 0) correction.set_payload_kg(static_cast<float>(payload_kg[i]));
     model::ForwardResult<float> result;
-    if (const model::Status s = model::compensated_forward(cables, geometry, correction, result);
+    if (const model::Status s = model::compensated_forward(cables, geometry, correction, compliance, result);
         s != model::Status::ok) {
       throw std::invalid_argument("sample " + std::to_string(i + 1) + ": " + model::to_string(s));
     }

@@ -46,7 +46,8 @@ const char* to_string(FirmwareAccumulator accumulator);
 // parsed image) over the samples' commanded cables. An image with the
 // payload input takes each sample's payload_kg, set on the correction before
 // the sample as the runtime sets a received one (throws
-// std::invalid_argument when there are none); other images ignore them.
+// std::invalid_argument when there are none); other images ignore them. An
+// image with a compliance block sags the nominal pose under that payload.
 std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
                                                 FirmwareAccumulator accumulator = FirmwareAccumulator::float64,
                                                 const Eigen::VectorXd& payload_kg = {});

@@ -11,6 +11,7 @@
 #include "cdcr/model/geometry.hpp"
 #include "cdcr/model/hysteresis.hpp"
 #include "cdcr/model/input_encoding.hpp"
+#include "cdcr/model/payload_compliance.hpp"
 
 namespace cdcr::training {
 
@@ -62,6 +63,10 @@ struct TrainedModel {
   // The cables' identified hysteresis (empty: a joints-only model). The GP's
   // inputs are then the joints of the effective cable lengths.
   model::HysteresisModel<double> hysteresis;
+  // The segments' compliance under the tip load (empty: none; a payload
+  // model only). The nominal poses the GP was fitted against are then the
+  // sagged ones, and the GP's inputs stay the commanded bends.
+  model::PayloadCompliance<double> compliance;
 
   // Metadata carried into the image.
   std::uint64_t dataset_hash = 0;

@@ -19,6 +19,12 @@
 // make it known, and the program also reports what the hysteresis itself
 // costs: the tracking of a cable set and the widening's Jacobian, at most,
 // in instructions.
+//
+// Linked with a payload model whose image has a compliance block
+// (cdcr_qemu_cycle_budget_compliance, kExpectComplianceBlock), the runtime
+// sags the nominal pose under the payload in every cycle, and the program
+// reports what the sag costs: the forward path's sagged bends and the IK
+// correction's commanded bends, at most, in instructions.
 
 #include <algorithm>
 #include <cmath>
@@ -295,6 +301,35 @@ void report_hysteresis_costs(const model::ImageView& image) {
   console::console_write(" units a cycle\n");
 }
 
+// The sag's work, at the golden cases' bends and the image's default
+// payload: the forward path's sagged bends and the inverse the IK's
+// correction runs per evaluation, as the firmware compiles them.
+void report_compliance_costs() {
+  const firmware::Compliance& compliance = runtime.compliance();
+  const float payload_kg = runtime.payload_kg();
+  std::uint32_t sag_max = 0, inverse_max = 0;
+  for (int c = 0; c < 8; ++c) {
+    firmware::Joints joints(2 * segments);
+    for (int k = 0; k < 2 * segments; ++k) joints[k] = cdcr::qemu_golden::kJoints[c][k];
+    const firmware::Joints bend = model::bend_from_joints(joints);
+    firmware::Joints sagged;
+    sag_max = std::max(sag_max, counter.instructions([&] {
+      sagged = firmware::sagged_bends_of(compliance, runtime.geometry(), payload_kg, bend);
+    }));
+    firmware::Joints back;
+    inverse_max = std::max(inverse_max, counter.instructions([&] {
+      back = firmware::commanded_bends_of(compliance, runtime.geometry(), payload_kg, sagged);
+    }));
+  }
+  console::console_write("compliance costs (instructions): sag max ");
+  console::console_write_int(static_cast<std::int32_t>(sag_max));
+  console::console_write(", inverse max ");
+  console::console_write_int(static_cast<std::int32_t>(inverse_max));
+  console::console_write("; charged ");
+  console::console_write_int(static_cast<std::int32_t>(firmware::kComplianceUnits));
+  console::console_write(" units a cycle\n");
+}
+
 }  // namespace
 
 int main() {
@@ -321,6 +356,13 @@ int main() {
     }
     report_hysteresis_costs(image);
   }
+  const bool with_compliance = cdcr::qemu_programs::kExpectComplianceBlock;
+  if (runtime.compliance().empty() == with_compliance) {
+    console::console_write(with_compliance ? "FAIL: the image's compliance block is not bound\n"
+                                           : "FAIL: a compliance block where the image has none\n");
+    return 1;
+  }
+  if (with_compliance) report_compliance_costs();
 
   // The drives start where golden case 0 has them.
   for (int s = 0; s < segments; ++s) {

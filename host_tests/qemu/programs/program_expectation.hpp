@@ -12,5 +12,7 @@ namespace cdcr::qemu_programs {
 extern const bool kExpectDegradedBoot;
 // The image carries a hysteresis block: the runtime must track it.
 extern const bool kExpectHysteresisBlock;
+// The image has a compliance block: the runtime sags the nominal pose.
+extern const bool kExpectComplianceBlock;
 
 }  // namespace cdcr::qemu_programs

@@ -3,13 +3,16 @@
 // sag of a tip load on a segment of stiffness K = EI / L + 2 k r^2 is the
 // sagged nominal model's, so the identification must find 1 / K, the end
 // platform's mass and gravity's direction. Data without payload must keep
-// the training set it always had.
+// the training set it always had. Then the pipeline that exports it.
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include <gtest/gtest.h>
 
 #include "cdcr/model/chain.hpp"
+#include "cdcr/model/image_compliance.hpp"
+#include "pipeline/train_and_export.hpp"
 #include "sim/simulated_robot.hpp"
 #include "train/compliance_identification.hpp"
 
@@ -74,7 +77,7 @@ TEST(ComplianceIdentification, FindsTheSimulatorsStiffnessPlatformMassAndGravity
 
   const double stiffness = simulator_segment_stiffness(design, config);
   // Tolerances: 0.1 % on the compliance, 1 g on the platform, 0.05 deg on
-  // the direction (the sag is the same formula; eight fixed-point steps
+  // the direction (the sag is the same formula; the model library's Newton steps
   // against the simulator's converged equilibrium).
   for (int s = 0; s < design.segment_count; ++s) {
     EXPECT_NEAR(c.compliance_rad_per_n_mm(s) * stiffness, 1.0, 1e-3) << s;
@@ -176,6 +179,75 @@ TEST(ComplianceIdentification, TooFewRowsAreRefused) {
   EXPECT_THROW(identify_compliance(set, design, structure), std::invalid_argument);
   const TrainingSet enough = make_training_set(recorded(robot, 8, true), design, model::InputEncoding::bend_vector);
   EXPECT_NO_THROW(identify_compliance(enough, design, structure));
+}
+
+// cdcr train's job on payload data, below the command line: the chosen sag
+// goes into the image's compliance block, the GP is fitted on the sagged
+// residuals, the float32 image path (which sags the nominal pose itself)
+// stays within the fidelity target of the double trainer on the payload
+// rows, and the held-out error is below the payload-as-an-input model's.
+TEST(PayloadTraining, TheChosenSagIsExportedAndTheImagePathFollowsTheTrainer) {
+  const auto design = model::RobotGeometry<double>::prototype();
+  sim::SimulatorConfig config = gravity_only();
+  config.mocap_noise.enabled = true;
+  sim::SimulatedRobot robot(design, config);
+  const TrainingSet all = make_training_set(recorded(robot, 300, true, true), design, model::InputEncoding::bend_vector);
+  const Split split = random_split(all.size(), 60, 3);
+  const TrainingSet train_set = all.subset(split.train);
+  const TrainingSet validation_set = all.subset(split.test);
+  TrainingOptions options;
+  options.search.restarts = 0;
+  options.variance_rank = 16;
+
+  const PayloadExport out = train_and_export_payload(train_set, validation_set, all, design, options, 0, 0);
+  ASSERT_TRUE(out.choice.attempted);
+  ASSERT_TRUE(out.uses_compliance());
+  const model::PayloadCompliance<double> chosen = out.choice.model.for_model(design.segment_count);
+  EXPECT_EQ(out.result.model.compliance.weighted_gravity, chosen.weighted_gravity);
+  EXPECT_EQ(out.result.model.compliance.unloaded_mass_kg, chosen.unloaded_mass_kg);
+
+  model::ImageView view{};
+  ASSERT_EQ(model::parse_image(out.result.image.data(), out.result.image.size(), view), model::ImageStatus::ok);
+  model::PayloadCompliance<float> from_image;
+  ASSERT_TRUE(model::compliance_from_image(view, from_image));
+  EXPECT_EQ(from_image.weighted_gravity, chosen.weighted_gravity.cast<float>());
+
+  // Float32 fidelity on the held-out payload rows, both accumulators the
+  // firmware builds use.
+  ASSERT_EQ(out.result.fidelity_by_accumulator.size(), 3u);
+  for (const auto& [accumulator, f] : out.result.fidelity_by_accumulator) {
+    std::printf("  %s: max %.2e mm, %.2e deg\n", to_string(accumulator), f.max_position_mm, f.max_orientation_deg);
+    if (accumulator == FirmwareAccumulator::float32) continue;
+    EXPECT_LE(f.max_position_mm, 0.01) << to_string(accumulator);
+    EXPECT_LE(f.max_orientation_deg, 0.001) << to_string(accumulator);
+  }
+  // The same measure, independently: the image path at the rows' cables
+  // and payloads against the double trainer's sagged nominal pose and GP.
+  const std::vector<model::Pose<double>> double_poses = compensated_poses(
+      with_compliance(validation_set, design, out.choice.model),
+      predict_error_twists(out.result.model, validation_set.bends, validation_set.payload_kg));
+  const Fidelity f = compare_poses(
+      double_poses, firmware_poses(view, validation_set.cables_mm, FirmwareAccumulator::compensated_float32,
+                                   validation_set.payload_kg));
+  EXPECT_LE(f.max_position_mm, 0.01);
+  EXPECT_LE(f.max_orientation_deg, 0.001);
+
+  // The payload-as-an-input model of the same rows, without the sag.
+  const ExportResult plain = train_and_export(train_set, validation_set, all, design, options, 0, 0);
+  EXPECT_TRUE(plain.model.compliance.empty());
+  std::printf("  held out: %.3f mm with the sag, %.3f mm payload as an input\n",
+              out.result.validation.compensated.position_mm, plain.validation.compensated.position_mm);
+  EXPECT_LT(out.result.validation.compensated.position_mm, plain.validation.compensated.position_mm);
+  // The nominal model without the sag, for the report.
+  EXPECT_EQ(out.unsagged_validation.initial.position_mm, mean_errors(validation_set.measured, validation_set.nominal).position_mm);
+}
+
+TEST(PayloadTraining, RowsWithoutAPayloadAreRefused) {
+  const auto design = model::RobotGeometry<double>::prototype();
+  sim::SimulatedRobot robot(design, gravity_only());
+  const TrainingSet set = make_training_set(recorded(robot, 40, false), design, model::InputEncoding::bend_vector);
+  EXPECT_THROW(train_and_export_payload(set, TrainingSet{}, set, design, TrainingOptions{}, 0, 0),
+               std::invalid_argument);
 }
 
 }  // namespace

@@ -145,7 +145,9 @@ nlohmann::json eval_json(const std::string& image, const std::string& data) {
 // rows comes within 1.15 times their noise floor (measured against the true
 // poses by the simulator); trained on the same rows without the column, the
 // model cannot tell a heavy tip from a light one, and the payload model's
-// error is at most 0.7 times that one's.
+// error is at most 0.7 times that one's. The simulator's segments sag under
+// the load: cdcr train identifies their compliance and ships it in the
+// image's compliance block.
 TEST(TrainEndToEnd, ThePayloadAsAnInputReachesTheNoiseFloor) {
   const std::string dir = testing::TempDir();
   const std::string train = dir + "payload_train.csv";
@@ -166,12 +168,23 @@ TEST(TrainEndToEnd, ThePayloadAsAnInputReachesTheNoiseFloor) {
   EXPECT_TRUE(trained.at("payload_input").get<bool>());
   // Its own length scale: one per bend input and one for the payload.
   EXPECT_EQ(trained.at("length_scales").size(), 9u);
+  ASSERT_TRUE(trained.contains("compliance"));
+  EXPECT_TRUE(trained.at("compliance").at("used").get<bool>());
+  EXPECT_EQ(trained.at("compliance").at("candidates").size(), 9u);
   run = run_cdcr("inspect " + with_image + " --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
-  EXPECT_EQ(nlohmann::json::parse(run.out).at("extra_inputs").get<int>(), 1);
+  const nlohmann::json inspected = nlohmann::json::parse(run.out);
+  EXPECT_EQ(inspected.at("extra_inputs").get<int>(), 1);
+  ASSERT_TRUE(inspected.contains("compliance"));
+  EXPECT_EQ(inspected.at("compliance").at("ratios").size(), 4u);
+  run = run_cdcr("inspect " + with_image);
+  EXPECT_NE(run.out.find("payload compliance"), std::string::npos) << run.out;
+  EXPECT_NE(run.out.find("\n  compliance  pass "), std::string::npos) << run.out;
   run = run_cdcr("train --data '" + train_stripped + "' --out " + without_image + " --json");
   ASSERT_EQ(run.exit_code, 0) << run.err;
   EXPECT_FALSE(nlohmann::json::parse(run.out).at("payload_input").get<bool>());
+  // Data without the column: no compliance in the report.
+  EXPECT_FALSE(nlohmann::json::parse(run.out).contains("compliance"));
 
   const nlohmann::json with = eval_json(with_image, "'" + test + "'");
   const nlohmann::json without = eval_json(without_image, "'" + test_stripped + "'");

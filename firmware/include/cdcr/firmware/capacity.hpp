@@ -77,6 +77,16 @@ inline constexpr int kMaxVarianceRank = static_cast<int>(model::kMaxVarianceRank
 inline constexpr std::uint32_t kHysteresisUnitsPerOperator = 1;
 inline constexpr std::uint32_t kHysteresisWideningUnits = 110;
 
+// Work units the payload's sag takes from a cycle, with an image that has a
+// compliance block (model::sagged_bends in the forward path: kSagNewtonSteps
+// passes of the chain with its twists and an 8 x 8 solve each), charged as
+// part of the forward path. Measured under QEMU by
+// qemu.cycle_budget_compliance_<board> on four segments: 20,924 instructions
+// on the M7 (445 of its units of 47) and 25,167 on the M4F (449 of 56); the
+// charge covers both. (The IK correction's inverse, 1,585 and 2,150 per
+// evaluation, rides in the evaluation's own margin.)
+inline constexpr std::uint32_t kComplianceUnits = 500;
+
 // Bounds of one IK request: correction evaluations, nominal LM iterations
 // and restarts after a stall (see model::IkSolverOptions), and the cycles
 // it may span before it is reported unreachable. Over the full design

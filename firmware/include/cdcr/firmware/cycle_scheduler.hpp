@@ -20,6 +20,7 @@ struct ModelCosts {
   std::uint32_t mean_units = 0;      // training points x units per point
   std::uint32_t gradient_slice = 0;  // the smallest block of the GP gradient
   std::uint32_t hysteresis_units = 0;  // the cables' hysteresis (hysteresis_units(); 0 without a block)
+  std::uint32_t compliance_units = 0;  // the payload's sag (kComplianceUnits; 0 without a block)
 };
 
 // The cycle's decisions, in the order the runtime acts on them.

@@ -70,7 +70,9 @@ class IkRequest {
   const IkReport& report() const { return report_; }
 
   // Setpoint frames sent, final and best-so-far; the joints and lengths of
-  // the last ones (valid once one was sent).
+  // the last ones (valid once one was sent). With a compliance model the
+  // joints are the solver's, of the sagged bends; the lengths those of the
+  // commanded bends (commanded_joints).
   std::uint32_t setpoints_published() const { return setpoints_published_; }
   bool has_setpoints() const { return has_setpoints_; }
   const Joints& setpoint_joints() const { return setpoint_joints_; }
@@ -92,7 +94,7 @@ class IkRequest {
   const RobotModel& model_;
   Outbox& outbox_;
   const HysteresisTracker* hysteresis_;
-  SolverCorrection solver_correction_{model_.correction};
+  SolverCorrection solver_correction_{model_.correction, &model_.compliance, &model_.geometry};
   Solver solver_;
   IkReport report_;
   bool solving_ = false;

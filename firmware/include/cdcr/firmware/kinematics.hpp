@@ -11,6 +11,7 @@
 #include "cdcr/model/gp_correction.hpp"
 #include "cdcr/model/gp_uncertainty.hpp"
 #include "cdcr/model/inverse_kinematics.hpp"
+#include "cdcr/model/payload_compliance.hpp"
 
 namespace cdcr::firmware {
 
@@ -30,15 +31,26 @@ using Joints = model::JointVector<Scalar, kMaxSegments>;
 using Correction = model::GpCorrection<Scalar, Accumulator, kMaxSegments>;
 using Uncertainty = model::GpUncertainty<Scalar, Correction::kMaxInputs>;
 using Pose = model::Pose<Scalar>;
+using Compliance = model::PayloadCompliance<Scalar, kMaxSegments>;
 
 // The correction as the IK solver sees it: the GP's evaluation in slices.
 // Its functions are defined in kinematics.cpp, beside the forward path, so
 // the GP loops are compiled as the forward path's are wherever the solver is
 // compiled (firmware/CMakeLists.txt).
+//
+// With a compliance model (an image's compliance block) the solver works in
+// sagged-bend space: its nominal model is the plain kinematics of the
+// sagged bends b', and the correction, trained at the commanded bends b, is
+// evaluated at b = commanded_bends(b') (payload_compliance.hpp, explicit:
+// no fixed point). Its gradient is taken as d(eps)/db for d(eps)/db': db/db'
+// differs from the identity by the sag's change with the shape (a tenth at
+// most), and the gradient only steers the iteration.
 class SolverCorrection {
  public:
   using Evaluation = Correction::Evaluation;
-  explicit SolverCorrection(const Correction& correction) : correction_(&correction) {}
+  explicit SolverCorrection(const Correction& correction, const Compliance* compliance = nullptr,
+                            const Geometry* geometry = nullptr)
+      : correction_(&correction), compliance_(compliance), geometry_(geometry) {}
   model::Status begin_evaluation(const Joints& bend, Evaluation& evaluation, bool with_gradient) const;
   std::uint32_t continue_evaluation(Evaluation& evaluation, std::uint32_t max_units) const;
   bool evaluation_finished(const Evaluation& evaluation) const;
@@ -48,6 +60,8 @@ class SolverCorrection {
 
  private:
   const Correction* correction_;
+  const Compliance* compliance_;
+  const Geometry* geometry_;
 };
 using Solver = model::IkSolver<Scalar, kMaxSegments, SolverCorrection>;
 
@@ -59,8 +73,23 @@ struct RobotModel {
   model::ImageView image{};
   Correction correction;
   Uncertainty uncertainty;
+  // The image's compliance block (empty without one): the nominal pose sags
+  // under the correction's payload.
+  Compliance compliance;
   bool compensated = false;
 };
+
+// The payload's sag on the board (payload_sag.cpp, out of line): the sagged
+// bends of commanded ones, and the commanded bends that sag into given
+// ones, at the payload given.
+Joints sagged_bends_of(const Compliance& compliance, const Geometry& geometry, Scalar payload_kg, const Joints& bend);
+Joints commanded_bends_of(const Compliance& compliance, const Geometry& geometry, Scalar payload_kg,
+                          const Joints& sagged);
+
+// The joints whose cables the drives are sent for the solver's joints: with
+// a compliance model (compensated only) those of the commanded bends that
+// sag into the solver's, otherwise the solver's own.
+Joints commanded_joints(const RobotModel& model, const Joints& solver_joints);
 
 struct PoseEstimate {
   Pose pose;

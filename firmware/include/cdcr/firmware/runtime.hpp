@@ -141,6 +141,8 @@ class Runtime {
   const ModelUpdate& model_update() const { return update_; }
   // The cables' hysteresis state (an image with a hysteresis block).
   const HysteresisTracker& hysteresis() const { return hysteresis_; }
+  // The bound image's compliance block (empty without one).
+  const Compliance& compliance() const { return model_.compliance; }
 
  private:
   // The switch to a newly committed image (model_loader.hpp).

@@ -1,12 +1,14 @@
 #pragma once
 // The forward path that the firmware runs each cycle, and that the host tools
 // run to measure it: cable lengths -> joints -> nominal pose -> GP error twist
-// -> compensated pose (eqs. 5, 13, 16, 19).
+// -> compensated pose (eqs. 5, 13, 16, 19); with an image's compliance block
+// the nominal pose is the one sagged under the tip payload.
 
 #include "cdcr/model/chain.hpp"
 #include "cdcr/model/compensation.hpp"
 #include "cdcr/model/flash_image.hpp"
 #include "cdcr/model/gp_correction.hpp"
+#include "cdcr/model/payload_compliance.hpp"
 #include "cdcr/model/status.hpp"
 
 namespace cdcr::model {
@@ -35,19 +37,43 @@ struct ForwardResult {
 };
 
 // Outputs are written only when the cables are valid. cable_resolution_mm as
-// in joints_from_cables.
-template <typename S, typename Accumulator, int Max, typename Arch>
-Status compensated_forward(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
-                           const GpCorrection<S, Accumulator, Max, Arch>& correction, ForwardResult<S, Max>& result,
-                           S cable_resolution_mm = S(0)) {
+// in joints_from_cables. nominal_shape(bend) gives the bends whose plain
+// kinematics is the nominal pose: the bend itself, or (with a compliance
+// model) the bends sagged under the payload. The GP correction stays
+// evaluated at the commanded bends, as it was trained.
+template <typename S, typename Accumulator, int Max, typename Arch, typename NominalShape>
+Status compensated_forward_with(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
+                                const GpCorrection<S, Accumulator, Max, Arch>& correction,
+                                ForwardResult<S, Max>& result, S cable_resolution_mm, NominalShape&& nominal_shape) {
   JointVector<S, Max> joints;
   if (const Status s = joints_from_cables(cables_mm, geometry, joints, cable_resolution_mm); s != Status::ok) return s;
   const JointVector<S, Max> bend = bend_from_joints(joints);
   result.joints = joints;
-  result.nominal = forward_kinematics_bend(bend, geometry);
+  result.nominal = forward_kinematics_bend(nominal_shape(bend), geometry);
   result.error_twist = correction.predict(bend);
   result.compensated = compensate(result.error_twist, result.nominal);
   return Status::ok;
+}
+
+template <typename S, typename Accumulator, int Max, typename Arch>
+Status compensated_forward(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
+                           const GpCorrection<S, Accumulator, Max, Arch>& correction, ForwardResult<S, Max>& result,
+                           S cable_resolution_mm = S(0)) {
+  return compensated_forward_with(cables_mm, geometry, correction, result, cable_resolution_mm,
+                                  [](const JointVector<S, Max>& bend) -> const JointVector<S, Max>& { return bend; });
+}
+
+// The same with a compliance model (payload_compliance.hpp): the nominal
+// pose sags under the correction's payload. An empty one changes nothing.
+template <typename S, typename Accumulator, int Max, typename Arch>
+Status compensated_forward(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
+                           const GpCorrection<S, Accumulator, Max, Arch>& correction,
+                           const PayloadCompliance<S, Max>& compliance, ForwardResult<S, Max>& result,
+                           S cable_resolution_mm = S(0)) {
+  return compensated_forward_with(cables_mm, geometry, correction, result, cable_resolution_mm,
+                                  [&](const JointVector<S, Max>& bend) {
+                                    return sagged_bends(bend, geometry, correction.payload_kg(), compliance);
+                                  });
 }
 
 }  // namespace cdcr::model

@@ -31,6 +31,9 @@ inline constexpr std::uint16_t kImageVersionMinor = 1;  // 2.1: the predictive-v
 // 2.2: the cables' hysteresis block. The exporter writes 2.2 only for a model
 // with one, so an image without it stays byte for byte a 2.1 image.
 inline constexpr std::uint16_t kImageVersionMinorHysteresis = 2;
+// 2.3: the segments' compliance under the tip load (payload_compliance.hpp),
+// in an image with the payload input. Written only for a model with one.
+inline constexpr std::uint16_t kImageVersionMinorCompliance = 3;
 inline constexpr std::uint16_t kImageOldestVersionMajor = 1;  // still read: deployed boards carry v1 images
 inline constexpr std::uint32_t kImageHeaderSize = 64;
 inline constexpr std::uint32_t kImageBlockAlignment = 8;
@@ -126,6 +129,20 @@ constexpr std::uint32_t image_hysteresis_floats(std::uint32_t cables, std::uint3
   return 3 * cables * operators;
 }
 
+// The compliance block (v2.3), float32: the weight of a kilogram times
+// segment 0's compliance in the base frame (3, rad per kg mm), the ratio of
+// each segment's compliance to segment 0's (segments), the softening (per
+// rad) and the unloaded tip mass (kg). The count is the header's
+// compliance_segments, the image's segment count.
+namespace image_compliance_field {
+inline constexpr std::uint32_t weighted_gravity = 0;  // 3 floats
+inline constexpr std::uint32_t ratios = 3;            // then the softening and the unloaded mass
+}  // namespace image_compliance_field
+
+constexpr std::uint32_t image_compliance_floats(std::uint32_t segments) {
+  return segments == 0 ? 0 : image_compliance_field::ratios + segments + 2;
+}
+
 constexpr std::uint32_t packed_triangle_floats(std::uint32_t rank) { return rank * (rank + 1) / 2; }
 
 // In 64 bits: a damaged header's rank (up to 65535) must not wrap the count.
@@ -150,7 +167,8 @@ inline constexpr std::size_t kernel_kind = 27;      // u8, ImageKernel
 inline constexpr std::size_t input_encoding = 28;   // u8, InputEncoding
 inline constexpr std::size_t model_kind = 29;       // u8, ImageModelKind (v1: reserved, zero)
 inline constexpr std::size_t extra_inputs = 30;     // u8, inputs after the joint encoding: 0, or 1 the payload (v1: reserved)
-inline constexpr std::size_t reserved_a = 31;       // 1 byte, zero (v1: bytes 29..31)
+inline constexpr std::size_t reserved_a = 31;       // 1 byte, zero before v2.3 (v1: bytes 29..31)
+inline constexpr std::size_t compliance_segments = 31;  // u8, v2.3: segments of the compliance block; zero without
 inline constexpr std::size_t geometry_offset = 32;  // u32
 inline constexpr std::size_t parameters_offset = 36;
 inline constexpr std::size_t inputs_offset = 40;
@@ -224,6 +242,14 @@ struct ImageView {
   const float* hysteresis_widths;      // mm, finite, in [0, kMaxHysteresisWidthMm]
   const float* hysteresis_weights;     // finite, >= 0, summing to <= 1 per cable
   const float* hysteresis_homing_lags; // mm, within +-width
+  // The segments' compliance under the tip load (v2.3; zero and null
+  // pointers without it; image_compliance.hpp makes a
+  // model::PayloadCompliance of it). Only in an image with the payload input.
+  int compliance_segments;
+  const float* compliance_weighted_gravity;  // 3, rad per kg mm, finite
+  const float* compliance_ratios;            // compliance_segments, finite, > 0
+  const float* compliance_softening;         // 1, per rad, finite, keeps 1 + s |b| > 0 to a quarter turn
+  const float* compliance_unloaded_mass;     // 1, kg, finite, >= 0
   std::uint64_t dataset_hash;
   std::int64_t created_unix_s;
   std::uint32_t validation_samples;
@@ -239,6 +265,7 @@ struct ImageLayout {
   std::uint32_t alpha_offset;
   std::uint32_t variance_offset;  // 0 without a variance block
   std::uint32_t hysteresis_offset;  // 0 without a hysteresis block
+  std::uint32_t compliance_offset;  // 0 without a compliance block
   std::uint32_t metadata_offset;
   std::uint32_t total_size;
 };
@@ -261,7 +288,7 @@ constexpr std::uint32_t image_parameter_floats(std::uint32_t input_dims,
 constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t input_dims,
                                    std::uint32_t segment_count, std::uint16_t version_major = kImageVersionMajor,
                                    std::uint32_t variance_rank = 0, std::uint32_t extra_inputs = 0,
-                                   std::uint32_t hysteresis_floats = 0) {
+                                   std::uint32_t hysteresis_floats = 0, std::uint32_t compliance_floats = 0) {
   ImageLayout layout{};
   std::uint32_t at = kImageHeaderSize;
   layout.geometry_offset = at;
@@ -280,6 +307,10 @@ constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t 
   if (hysteresis_floats > 0) {
     layout.hysteresis_offset = at;
     at = align_up(at + 4 * hysteresis_floats, kImageBlockAlignment);
+  }
+  if (compliance_floats > 0) {
+    layout.compliance_offset = at;
+    at = align_up(at + 4 * compliance_floats, kImageBlockAlignment);
   }
   layout.metadata_offset = at;
   at = align_up(at + kImageMetadataSize, kImageBlockAlignment);
@@ -307,8 +338,9 @@ enum class ImageCheckId : std::uint8_t {
   fitted_rows,  // invalid_parameters, v2: the metadata's fitted_rows
   variance,     // invalid_parameters, v2.1: what the variance block requires of the model
   hysteresis,   // invalid_parameters, v2.2: the hysteresis block's widths, weights and homing lags
+  compliance,   // invalid_parameters, v2.3: the compliance block's values
 };
-inline constexpr int kImageCheckCount = static_cast<int>(ImageCheckId::hysteresis) + 1;
+inline constexpr int kImageCheckCount = static_cast<int>(ImageCheckId::compliance) + 1;
 
 constexpr const char* to_string(ImageCheckId check) {
   switch (check) {
@@ -327,6 +359,7 @@ constexpr const char* to_string(ImageCheckId check) {
     case ImageCheckId::fitted_rows: return "fitted_rows";
     case ImageCheckId::variance: return "variance";
     case ImageCheckId::hysteresis: return "hysteresis";
+    case ImageCheckId::compliance: return "compliance";
   }
   return "unknown";
 }
@@ -474,6 +507,54 @@ bool check_hysteresis_block(Run& run, const float* block, std::uint32_t cables, 
   if (all_good) {
     run.expect(true, ImageCheckId::hysteresis, ImageStatus::invalid_parameters, Run::name("hysteresis"), -1, 0, 0,
                Expect::finite, 3 * count);
+  }
+  return true;
+}
+// The compliance block's values (payload_compliance.hpp): all finite, the
+// ratios above zero, the unloaded mass not below zero and a softening that
+// keeps 1 + s |b| positive for bends up to a quarter turn (a segment that
+// stiffens into bending against the load is no stiffness). A failure per bad
+// value, or one pass for the block. False where a stopping run must stop.
+template <typename Run>
+bool check_compliance_block(Run& run, const float* block, std::uint32_t segments) {
+  using Expect = ImageExpectation;
+  const float* ratios = block + image_compliance_field::ratios;
+  const float softening = ratios[segments];
+  const float unloaded_mass = ratios[segments + 1];
+  bool all_good = true;
+  const auto expect = [&](bool passed, const char* field, std::int32_t index, double value, double expected,
+                          Expect expectation) {
+    if (passed) return true;
+    all_good = false;
+    return run.expect(false, ImageCheckId::compliance, ImageStatus::invalid_parameters, field, index, value, expected,
+                      expectation);
+  };
+  for (std::uint32_t k = 0; k < 3; ++k) {
+    const float g = block[image_compliance_field::weighted_gravity + k];
+    if (!expect(std::isfinite(g), "compliance_weighted_gravity", static_cast<std::int32_t>(k), g, 0, Expect::finite)) {
+      return false;
+    }
+  }
+  for (std::uint32_t i = 0; i < segments; ++i) {
+    const float r = ratios[i];
+    if (!expect(std::isfinite(r), "compliance_ratio", static_cast<std::int32_t>(i), r, 0, Expect::finite) ||
+        !expect(!std::isfinite(r) || r > 0.0f, "compliance_ratio", static_cast<std::int32_t>(i), r, 0,
+                Expect::positive)) {
+      return false;
+    }
+  }
+  const float least_softening = static_cast<float>(-1.0 / kComplianceLargestBendRad);
+  if (!expect(std::isfinite(softening), "compliance_softening", -1, softening, 0, Expect::finite) ||
+      !expect(!std::isfinite(softening) || softening > least_softening, "compliance_softening", -1, softening,
+              least_softening, Expect::at_least) ||
+      !expect(std::isfinite(unloaded_mass), "compliance_unloaded_mass", -1, unloaded_mass, 0, Expect::finite) ||
+      !expect(!std::isfinite(unloaded_mass) || unloaded_mass >= 0.0f, "compliance_unloaded_mass", -1, unloaded_mass,
+              0, Expect::at_least)) {
+    return false;
+  }
+  if (all_good) {
+    run.expect(true, ImageCheckId::compliance, ImageStatus::invalid_parameters, Run::name("compliance"), -1, 0, 0,
+               Expect::finite, image_compliance_floats(segments));
   }
   return true;
 }
@@ -639,7 +720,11 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
 
   // v2 gives bytes 29 and 30 a meaning, and bytes 56..61 a meaning that v2.0
   // requires to be zero; reserved bytes are zero in both versions.
-  for (std::size_t at = v1 ? model_kind : reserved_a; at < geometry_offset; ++at) {
+  const std::uint16_t minor = read_u16(bytes + version_minor);
+  // v2.3 gives byte 31 the compliance block's segment count.
+  const bool compliance_fields = !v1 && minor >= kImageVersionMinorCompliance;
+  for (std::size_t at = v1 ? model_kind : (compliance_fields ? geometry_offset : reserved_a); at < geometry_offset;
+       ++at) {
     if (!run.expect(bytes[at] == 0, Check::header, Status::bad_header, "reserved", static_cast<std::int32_t>(at),
                     bytes[at], 0, Expect::equal)) {
       return run.status;
@@ -647,7 +732,6 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   }
   // v2.0 reserves the variance fields and requires them to be zero; v2.1
   // defines the block they locate.
-  const std::uint16_t minor = read_u16(bytes + version_minor);
   const std::uint32_t declared_variance_offset = v1 ? 0 : read_u32(bytes + variance_offset);
   const std::uint32_t rank = v1 ? 0 : read_u16(bytes + variance_rank);
   if (!v1 && minor == 0) {
@@ -723,6 +807,18 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
     }
   }
   const std::uint32_t hysteresis_floats = image_hysteresis_floats(hysteresis_cable_count, hysteresis_operator_count);
+  // v2.3: the compliance block's segment count, zero without one. The sag
+  // needs the tip load, so only a model with the payload input has one.
+  const std::uint32_t compliance_segment_count = compliance_fields ? bytes[compliance_segments] : 0;
+  if (compliance_segment_count != 0) {
+    if (!run.expect(compliance_segment_count == segments, Check::header, Status::bad_header, "compliance_segments", -1,
+                    compliance_segment_count, segments, Expect::equal) ||
+        !run.expect(extra == 1, Check::header, Status::bad_header, "compliance_without_payload_input", -1, extra, 1,
+                    Expect::equal)) {
+      return run.status;
+    }
+  }
+  const std::uint32_t compliance_floats = image_compliance_floats(compliance_segment_count);
   if (!run.expect(n <= capacity.max_training_points, Check::capacity, Status::over_capacity, "training_points", -1, n,
                   capacity.max_training_points, Expect::at_most) ||
       !run.expect(segments <= capacity.max_segments, Check::capacity, Status::over_capacity, "segment_count", -1,
@@ -748,13 +844,15 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   // Under a generous capacity the 32-bit layout arithmetic below could wrap
   // into a size that matches; dims whose arrays alone exceed the image cannot.
   const std::uint64_t array_bytes =
-      (std::uint64_t{n} * (d + kImageOutputs) + std::uint64_t{image_variance_floats(rank, d)} + hysteresis_floats) * 4;
+      (std::uint64_t{n} * (d + kImageOutputs) + std::uint64_t{image_variance_floats(rank, d)} + hysteresis_floats +
+       compliance_floats) *
+      4;
   if (!run.expect(array_bytes <= declared_total, Check::layout, Status::size_mismatch, "total_size", -1,
                   declared_total, static_cast<double>(array_bytes), Expect::at_least)) {
     return run.status;
   }
   if (array_bytes <= declared_total) {
-    const ImageLayout expected = image_layout(n, d, segments, major, rank, extra, hysteresis_floats);
+    const ImageLayout expected = image_layout(n, d, segments, major, rank, extra, hysteresis_floats, compliance_floats);
     const std::uint32_t expected_offsets[] = {expected.geometry_offset, expected.parameters_offset,
                                               expected.inputs_offset,   expected.alpha_offset,
                                               expected.metadata_offset, expected.variance_offset};
@@ -793,12 +891,14 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
       reinterpret_cast<const std::uint8_t*>(block(offsets[4], kImageMetadataSize / sizeof(float)));
   const std::uint64_t variance_floats = image_variance_floats(rank, d);
   const float* variance = rank > 0 ? block(offsets[5], variance_floats) : nullptr;
-  // The hysteresis block lies where the dims put it (no offset field).
+  // The hysteresis and compliance blocks lie where the dims put them (no
+  // offset fields).
+  const ImageLayout implied = image_layout(n, d, segments, major, rank, extra, hysteresis_floats, compliance_floats);
+  const bool blocks_fit = array_bytes <= declared_total;
   const float* hysteresis =
-      hysteresis_floats > 0 && array_bytes <= declared_total
-          ? block(image_layout(n, d, segments, major, rank, extra, hysteresis_floats).hysteresis_offset,
-                  hysteresis_floats)
-          : nullptr;
+      hysteresis_floats > 0 && blocks_fit ? block(implied.hysteresis_offset, hysteresis_floats) : nullptr;
+  const float* compliance =
+      compliance_floats > 0 && blocks_fit ? block(implied.compliance_offset, compliance_floats) : nullptr;
 
   const struct {
     const char* name;
@@ -945,6 +1045,13 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
       !check_hysteresis_block(run, hysteresis, hysteresis_cable_count, hysteresis_operator_count)) {
     return run.status;
   }
+  if (compliance == nullptr && Run::kEveryCheck) {
+    run.expect(true, Check::compliance, Status::invalid_parameters, "compliance_segments", -1,
+               compliance_segment_count, 0, Expect::at_least);
+  }
+  if (compliance != nullptr && !check_compliance_block(run, compliance, compliance_segment_count)) {
+    return run.status;
+  }
   if (run.status != Status::ok) return run.status;
 
   ImageView v{};
@@ -982,6 +1089,11 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   v.hysteresis_widths = hysteresis;
   v.hysteresis_weights = hysteresis != nullptr ? hysteresis + hysteresis_values : nullptr;
   v.hysteresis_homing_lags = hysteresis != nullptr ? hysteresis + 2 * hysteresis_values : nullptr;
+  v.compliance_segments = compliance != nullptr ? static_cast<int>(compliance_segment_count) : 0;
+  v.compliance_weighted_gravity = compliance;
+  v.compliance_ratios = compliance != nullptr ? compliance + image_compliance_field::ratios : nullptr;
+  v.compliance_softening = compliance != nullptr ? v.compliance_ratios + compliance_segment_count : nullptr;
+  v.compliance_unloaded_mass = compliance != nullptr ? v.compliance_softening + 1 : nullptr;
   v.dataset_hash = read_u64(metadata + image_metadata_field::dataset_hash);
   v.created_unix_s = static_cast<std::int64_t>(read_u64(metadata + image_metadata_field::created_unix_s));
   v.validation_samples = read_u32(metadata + image_metadata_field::validation_samples);

@@ -31,4 +31,9 @@ inline constexpr int kMaxHysteresisOperators = 4;
 // must take every cable twice as far to make the state known.
 inline constexpr double kMaxHysteresisWidthMm = 2.0;
 
+// A payload compliance's softening s must keep 1 + s |b| positive for
+// bends up to this (a quarter turn, beyond any segment's design limit
+// here): the image parser and the trainer's ranking both require it.
+inline constexpr double kComplianceLargestBendRad = 1.5707963267948966;
+
 }  // namespace cdcr::model
