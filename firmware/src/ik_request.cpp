@@ -50,12 +50,9 @@ void IkRequest::start(const Pose& target, const TargetRequest& request, const Po
 }
 
 void IkRequest::configure() {
-  model::IkSolverOptions<Scalar> options;
-  options.max_corrections = kMaxIkCorrections;
-  options.max_iterations = kMaxIkIterations;
-  options.max_restarts = kMaxIkRestarts;
   // In DEGRADED the same solver solves the nominal model.
-  solver_.configure(model_.geometry, model_.compensated ? &solver_correction_ : nullptr, options, kIkWorkCosts);
+  solver_.configure(model_.geometry, model_.compensated ? &solver_correction_ : nullptr,
+                    runtime_solver_options<Scalar>(), kIkWorkCosts);
 }
 
 void IkRequest::refuse(std::uint8_t sequence, protocol::IkOutcome outcome) {

@@ -145,12 +145,8 @@ struct Tally {
 void nominal_sets(int count, unsigned seed) {
   const model::RobotGeometry<double> geometry = model::RobotGeometry<double>::prototype();
   const model::RobotGeometry<float> geometry_f = geometry.cast<float>();
-  model::IkSolverOptions<float> board_options;
-  board_options.max_corrections = fw::kMaxIkCorrections;
-  board_options.max_iterations = fw::kMaxIkIterations;
-  board_options.max_restarts = fw::kMaxIkRestarts;
   model::IkSolver<float, model::kMaxSegments> board;
-  board.configure(geometry_f, nullptr, board_options);
+  board.configure(geometry_f, nullptr, fw::runtime_solver_options<float>());
   const model::JointVector<double> cli_start = fw::ik_straight_start(geometry);
   for (const TargetSet set : {TargetSet::paper, TargetSet::full_range, TargetSet::near_straight, TargetSet::at_limit}) {
     const int n = set == TargetSet::full_range ? count : std::max(1, count / 4);
@@ -191,12 +187,8 @@ void nominal_sets(int count, unsigned seed) {
 void nominal_paths(int paths, int steps, double step_rad, unsigned seed) {
   const model::RobotGeometry<double> geometry = model::RobotGeometry<double>::prototype();
   const model::RobotGeometry<float> geometry_f = geometry.cast<float>();
-  model::IkSolverOptions<float> options;
-  options.max_corrections = fw::kMaxIkCorrections;
-  options.max_iterations = fw::kMaxIkIterations;
-  options.max_restarts = fw::kMaxIkRestarts;
   model::IkSolver<float, model::kMaxSegments> board;
-  board.configure(geometry_f, nullptr, options);
+  board.configure(geometry_f, nullptr, fw::runtime_solver_options<float>());
   std::mt19937 rng(seed + 5000u);
   const auto uniform = [&](double lo, double hi) { return std::uniform_real_distribution<double>(lo, hi)(rng); };
   Tally tally;
@@ -241,11 +233,8 @@ void nominal_paths(int paths, int steps, double step_rad, unsigned seed) {
 void compensated_sets(const fw::Runtime& runtime) {
   const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
   fw::SolverCorrection correction(runtime.correction());
-  model::IkSolverOptions<float> options;
-  options.max_corrections = fw::kMaxIkCorrections;
-  options.max_iterations = fw::kMaxIkIterations;
   fw::Solver solver;
-  solver.configure(runtime.geometry(), correction, options, fw::kIkWorkCosts);
+  solver.configure(runtime.geometry(), correction, fw::runtime_solver_options<float>(), fw::kIkWorkCosts);
   const int n = 200;
   std::printf("the compensated model's own poses as targets, %d each, the board's solver from straight, %u units per "
               "cycle:\n",

@@ -10,6 +10,16 @@
 
 namespace cdcr::firmware {
 
+// A request's bounds and restarts, as the runtime configures its solver.
+template <typename S>
+model::IkSolverOptions<S> runtime_solver_options() {
+  model::IkSolverOptions<S> options;
+  options.max_corrections = kMaxIkCorrections;
+  options.max_iterations = kMaxIkIterations;
+  options.max_restarts = kMaxIkRestarts;
+  return options;
+}
+
 template <typename S>
 model::IkOptions<S> runtime_ik_options() {
   model::IkOptions<S> options;
