@@ -214,18 +214,20 @@ bool IkRequest::begin_solution_check(const Joints& joints) {
 // start alone, to 1 of 20 on both; a fourth and fifth start (three
 // quarters, a tenth of the bends) changed nothing.
 void IkRequest::retry_or_refuse(const Joints& refused) {
+  // The refused solution's bends scaled by these, then the straight start.
+  static constexpr Scalar kRetryBendScales[] = {Scalar(0.5), Scalar(0.25)};
+  constexpr int kRetries = int(sizeof(kRetryBendScales) / sizeof(kRetryBendScales[0])) + 1;
   checking_solution_ = false;
   Joints start;
-  if (solution_retries_ + 1 < kMaxExtrapolationRetries) {
+  if (solution_retries_ < kRetries - 1) {
     start = refused;
-    const Scalar shrink = solution_retries_ == 0 ? Scalar(0.5) : Scalar(0.25);
-    for (int s = 0; s < model_.geometry.segment_count; ++s) start[2 * s + 1] *= shrink;
+    for (int s = 0; s < model_.geometry.segment_count; ++s) start[2 * s + 1] *= kRetryBendScales[solution_retries_];
   } else {
     straight_start(start);
   }
   const model::IkTargetKind kind =
       mode_ == protocol::TargetMode::pose ? model::IkTargetKind::pose : model::IkTargetKind::position;
-  if (solution_retries_ < kMaxExtrapolationRetries && solver_.start(target_, kind, start) == model::Status::ok) {
+  if (solution_retries_ < kRetries && solver_.start(target_, kind, start) == model::Status::ok) {
     ++solution_retries_;
     end_ = model::IkSolveState::running;
     return;

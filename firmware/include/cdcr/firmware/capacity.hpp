@@ -99,9 +99,6 @@ inline constexpr int kMaxIkCorrections = 40;
 inline constexpr int kMaxIkIterations = 1200;
 inline constexpr int kMaxIkRestarts = 10;
 inline constexpr int kMaxIkCycles = 250;
-// Searches after a solution refused as extrapolating, before the request
-// ends refused (ik_request.cpp, retry_or_refuse).
-inline constexpr int kMaxExtrapolationRetries = 3;
 // The start of a request with no setpoints and no pose yet (and of the
 // retry of a refused solution): every segment at this bend, alpha 0. The
 // straight robot is singular (the alpha columns of the Jacobian vanish).

@@ -104,8 +104,8 @@ class IkRequest {
   // IK slices) before its setpoints go out.
   bool refuses_extrapolation_ = false;
   bool checking_solution_ = false;
-  // A refused solution is looked for once more from the slightly bent
-  // straight start, near the middle of any training data.
+  // Searches made since a solution was refused as extrapolating
+  // (retry_or_refuse).
   int solution_retries_ = 0;
   Pose target_;
   Uncertainty::Evaluation solution_check_;
