@@ -53,6 +53,7 @@ void IkRequest::configure() {
   // In DEGRADED the same solver solves the nominal model.
   solver_.configure(model_.geometry, model_.compensated ? &solver_correction_ : nullptr,
                     runtime_solver_options<Scalar>(), kIkWorkCosts);
+  solver_.set_preference(ik_preference(model_.geometry, model_.compensated ? &model_.image : nullptr));
 }
 
 void IkRequest::refuse(std::uint8_t sequence, protocol::IkOutcome outcome) {

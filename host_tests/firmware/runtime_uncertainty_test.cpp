@@ -9,6 +9,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cdcr/firmware/ik_settings.hpp"
 #include "runtime_test_fixture.hpp"
 #include "train/predictive_variance.hpp"
 #include "../support/variance_block.hpp"
@@ -44,6 +45,33 @@ class RuntimeUncertaintyTest : public RuntimeTest {
     send_frame(commit);
   }
 };
+
+// A request prefers solutions in the middle of the bends the model was
+// fitted on, each bend weighted by the inverse square of its range's
+// half-width (the narrowest range weighing 1); the nominal model, which is as
+// sure everywhere, has no preference.
+TEST(IkPreference, IsTheMiddleOfTheFittedRange) {
+  const std::vector<std::uint8_t> bytes = image_with_variance(16);
+  model::ImageView image{};
+  ASSERT_EQ(model::parse_image(bytes.data(), bytes.size(), image, model::ImageCapacity{}), model::ImageStatus::ok);
+  ASSERT_EQ(image.encoding, model::InputEncoding::bend_vector);
+  Geometry geometry;
+  ASSERT_EQ(model::geometry_from_image(image, geometry), model::Status::ok);
+  const model::IkPreference<Scalar, kMaxSegments> preference = ik_preference(geometry, &image);
+  const int columns = 2 * geometry.segment_count;
+  ASSERT_EQ(preference.centre.size(), columns);
+  EXPECT_GT(preference.gain, 0.0f);
+  double narrowest = 1e9;
+  for (int d = 0; d < columns; ++d) {
+    narrowest = std::min(narrowest, double(image.input_max[d]) - double(image.input_min[d]));
+  }
+  for (int d = 0; d < columns; ++d) {
+    const double width = double(image.input_max[d]) - double(image.input_min[d]);
+    EXPECT_NEAR(preference.centre[d], 0.5 * (image.input_max[d] + image.input_min[d]), 1e-6) << d;
+    EXPECT_NEAR(preference.weight[d], (narrowest * narrowest) / (width * width), 1e-5) << d;
+  }
+  EXPECT_EQ(ik_preference(geometry, nullptr).gain, 0.0f);
+}
 
 TEST_F(RuntimeUncertaintyTest, RadiiOfARecentPoseGoOutEveryFewCycles) {
   boot(image_with_variance(64));

@@ -226,15 +226,17 @@ void nominal_paths(int paths, int steps, double step_rad, unsigned seed) {
 }
 
 // Targets the compensated model reaches by construction: its own poses at
-// the sets' bends. The board's solver on the runtime's correction, from
+// the sets' bends. The board's solver on the runtime's correction, with the
+// runtime's preference among solutions (firmware::ik_preference), from
 // the runtime's straight start, within the runtime's per-cycle budget and
 // kMaxIkCycles; converged means the solver's own tolerance on the
 // compensated model (2 um, 2e-5 rad in float).
-void compensated_sets(const fw::Runtime& runtime) {
+void compensated_sets(const fw::Runtime& runtime, const model::ImageView& image) {
   const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
   fw::SolverCorrection correction(runtime.correction());
   fw::Solver solver;
   solver.configure(runtime.geometry(), correction, fw::runtime_solver_options<float>(), fw::kIkWorkCosts);
+  solver.set_preference(fw::ik_preference(runtime.geometry(), &image));
   const int n = 200;
   std::printf("the compensated model's own poses as targets, %d each, the board's solver from straight, %u units per "
               "cycle:\n",
@@ -263,6 +265,75 @@ void compensated_sets(const fw::Runtime& runtime) {
     };
     std::printf("  %-32s converged %3d / %3d; cycles p50 %3d p99 %3d max %3d\n", name_of(set), converged, n, at(0.5),
                 at(0.99), at(1.0));
+  }
+}
+
+// The solver's preference among the many solutions of a target
+// (firmware::ik_preference): the compensated model's own poses at random
+// bends inside the data (theta <= 0.15 on every segment, random bend
+// directions; the image's data reach 0.2 per bend component), each solved
+// from the last one's answer as the runtime starts a request from the
+// setpoints in place, with and without the preference, on the same targets.
+// A solution is extrapolating as the runtime judges a target that refuses
+// extrapolation (outside the fitted range, or its variance above the
+// image's threshold); the normalised bend is the largest |b_d - centre_d| /
+// half-width_d of the fitted range (1 at its edge).
+void in_range_preference(const fw::Runtime& runtime, const model::ImageView& image) {
+  fw::SolverCorrection correction(runtime.correction());
+  const int n = 200;
+  const int columns = 2 * runtime.geometry().segment_count;
+  const model::IkPreference<float, model::kMaxSegments> preferred = fw::ik_preference(runtime.geometry(), &image);
+  std::printf("the compensated model's poses inside the data (theta <= 0.15), %d, each from the last answer:\n", n);
+  for (const bool prefer : {false, true}) {
+    fw::Solver solver;
+    solver.configure(runtime.geometry(), correction, fw::runtime_solver_options<float>(), fw::kIkWorkCosts);
+    if (prefer) solver.set_preference(preferred);
+    std::mt19937 rng(4242u);
+    const auto uniform = [&](double lo, double hi) { return float(std::uniform_real_distribution<double>(lo, hi)(rng)); };
+    fw::Joints start = fw::ik_straight_start(runtime.geometry());
+    int converged = 0, extrapolating = 0;
+    std::vector<int> cycles_taken;
+    std::vector<double> normalised;
+    for (int t = 0; t < n; ++t) {
+      fw::Joints joints(columns);
+      for (int i = 0; i < runtime.geometry().segment_count; ++i) {
+        joints[2 * i] = uniform(-kPi, kPi);
+        joints[2 * i + 1] = uniform(0.0, 0.15);
+      }
+      const fw::Joints bend = model::bend_from_joints(joints);
+      const model::Pose<float> target =
+          model::exp(runtime.correction().predict(bend)) * model::forward_kinematics_bend(bend, runtime.geometry());
+      solver.start(target, model::IkTargetKind::pose, start);
+      int cycles = 0;
+      while (solver.state() == model::IkSolveState::running && cycles < fw::kMaxIkCycles) {
+        solver.run(runtime.ik_units_per_cycle());
+        ++cycles;
+      }
+      if (solver.state() != model::IkSolveState::converged) continue;
+      ++converged;
+      cycles_taken.push_back(cycles);
+      start = solver.best_joints();
+      const fw::Joints solution = solver.best_bend();
+      fw::PoseEstimate estimate;
+      estimate.compensated = true;
+      estimate.pose = target;
+      runtime.correction().kernel_coordinates(solution, estimate.kernel_coordinates);
+      extrapolating += runtime.estimate_uncertainty(estimate).extrapolating ? 1 : 0;
+      double largest = 0;
+      for (int d = 0; d < columns; ++d) {
+        const double half_width = 0.5 * (double(image.input_max[d]) - double(image.input_min[d]));
+        const double centre = 0.5 * (double(image.input_max[d]) + double(image.input_min[d]));
+        largest = std::max(largest, std::abs(double(solution[d]) - centre) / half_width);
+      }
+      normalised.push_back(largest);
+    }
+    std::sort(cycles_taken.begin(), cycles_taken.end());
+    std::sort(normalised.begin(), normalised.end());
+    const auto at = [](const auto& v, double q) { return v.empty() ? 0.0 : double(v[std::size_t(q * double(v.size() - 1))]); };
+    std::printf("  %-18s converged %3d / %3d, extrapolating %3d; cycles p50 %3.0f p99 %3.0f; normalised bend p50 %.3f "
+                "p99 %.3f max %.3f\n",
+                prefer ? "with preference" : "without", converged, n, extrapolating, at(cycles_taken, 0.5),
+                at(cycles_taken, 0.99), at(normalised, 0.5), at(normalised, 0.99), at(normalised, 1.0));
   }
 }
 
@@ -445,7 +516,12 @@ void circle_start(const std::string& image_path, double radius_mm) {
   std::printf("    the closest the model comes to it (Eigen's Levenberg-Marquardt in double, %d starts): %.4f um, "
               "%.3g rad\n",
               kStarts + 1, 1000.0 * best.position_mm, best.orientation_rad);
-  compensated_sets(runtime);
+  model::ImageView view{};
+  if (model::parse_image(image.data(), image.size(), view, model::ImageCapacity{}) != model::ImageStatus::ok) {
+    throw std::runtime_error("the image does not parse");
+  }
+  compensated_sets(runtime, view);
+  in_range_preference(runtime, view);
 }
 
 }  // namespace
