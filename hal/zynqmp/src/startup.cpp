@@ -7,12 +7,14 @@
 #include <cdcr/baremetal/startup.hpp>
 
 #include "cdcr/zynqmp/console.hpp"
+#include "cdcr/zynqmp/second_core.hpp"
 
 extern "C" {
 // ISO C++ forbids calling main, so the start-up reaches the program's main
 // through another name for the same symbol.
 int cdcr_zynqmp_application_main() __asm__("main");
 [[noreturn]] void cdcr_zynqmp_start();
+[[noreturn]] void cdcr_zynqmp_second_core_start();
 [[noreturn]] void cdcr_zynqmp_exception(std::uint32_t exception, std::uint32_t return_address);
 }
 
@@ -24,6 +26,35 @@ extern "C" [[noreturn]] void cdcr_zynqmp_start() {
   cdcr::baremetal::run_static_constructors();
 
   cdcr::zynqmp::exit(cdcr_zynqmp_application_main());
+}
+
+namespace {
+
+// The word the first core sets when the second may run; a value unlikely
+// to be left in RAM by anything else.
+constexpr std::uint32_t kSecondCoreReleased = 0x52355F31u;  // "R5_1"
+CDCR_ZYNQMP_CORE_SHARED volatile std::uint32_t second_core_release;
+
+}  // namespace
+
+void cdcr::zynqmp::release_second_core() {
+  asm volatile("dsb" ::: "memory");
+  second_core_release = kSecondCoreReleased;
+  // The write before the event that wakes the second core from its WFE.
+  asm volatile("dsb\n\tsev" ::: "memory");
+}
+
+// A program without a second core's part leaves the core parked.
+extern "C" __attribute__((weak)) void cdcr_zynqmp_second_core_main() {}
+
+// vectors.S has set this core's stacks, FPU, MPU and caches. The first
+// core's start-up initialises what both share; until it releases this core,
+// WFE (which QEMU 7.2 takes as a yield to the other core).
+extern "C" [[noreturn]] void cdcr_zynqmp_second_core_start() {
+  while (second_core_release != kSecondCoreReleased) asm volatile("wfe" ::: "memory");
+  asm volatile("dmb" ::: "memory");
+  cdcr_zynqmp_second_core_main();
+  for (;;) asm volatile("wfi");
 }
 
 namespace {
