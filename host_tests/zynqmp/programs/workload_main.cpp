@@ -622,6 +622,11 @@ int main() {
   if (failures != 0) return verdict();
 
   // The peer prepares; the cycles start when it is ready (or has failed).
+  // The shared words start cleared whatever the RAM held (the start-up
+  // leaves .core_shared alone).
+  peer_state = kPeerPreparing;
+  peer_failures = 0;
+  peer_turns = 0;
   zynqmp::release_second_core();
   while (peer_state == kPeerPreparing) zynqmp::yield_to_other_core();
   board.start_cycles();

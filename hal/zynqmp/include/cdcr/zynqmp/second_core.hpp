@@ -18,7 +18,8 @@
 
 // A variable both cores read and write: `CDCR_ZYNQMP_CORE_SHARED volatile
 // std::uint32_t done;`. Not cleared by the start-up (the second core may read
-// it first); QEMU starts with it zero.
+// the release word in it before the first core's start-up runs): the first
+// core sets the program's words before release_second_core().
 #define CDCR_ZYNQMP_CORE_SHARED __attribute__((section(".core_shared")))
 
 extern "C" {
