@@ -221,8 +221,12 @@ IdealDrives drives;
 Random random_numbers{0x2545F491u};
 bool drives_report = true;  // false: the drives keep the setpoints they get, and say nothing
 // The planner's model: the robot's geometry and the image the board
-// carries (the same file), for its targets.
+// carries (the same file, read from the program's .cdcr_model), for its
+// targets and its update.
 const firmware::Geometry geometry = cdcr::boards::mps2::golden_geometry();
+struct PlannerFiles {
+  zynqmp::SectionModelStorage model_storage;
+} planner_files;
 firmware::Correction correction;
 
 // One frame the runtime sent, other than a setpoint.
@@ -418,12 +422,12 @@ void run_peer() {
   check(peer.controller.start(r5f::kCanTiming), "can1 starts at 1 Mbit/s");
   cdcr::model::ImageView image{};
   // The planner has the model the board carries (the same image file).
-  check(bind_board_image(board, correction, image), "the image binds");
+  check(bind_board_image(planner_files, correction, image), "the image binds");
   print("model: ", image.training_points, " training points\n");
   drives.segments = geometry.segment_count;
   // The update's image and its digest, made before the cycles start: the
   // peer's own work, which would otherwise take the periods' room.
-  const cdcr::hal::MemoryRegion region = board.model_storage.model_region();
+  const cdcr::hal::MemoryRegion region = planner_files.model_storage.model_region();
   const std::uint32_t image_size = static_cast<std::uint32_t>(region.size_bytes);
   check(image_size <= sizeof(updated_image), "the image fits the update's buffer");
   if (failures != 0) return;
