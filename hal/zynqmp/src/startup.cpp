@@ -37,7 +37,19 @@ CDCR_ZYNQMP_CORE_SHARED volatile std::uint32_t second_core_release;
 
 }  // namespace
 
+// The linker script's size of the second core's stacks: 0 in a program
+// linked without them, whose second core parked at reset (vectors.S).
+extern "C" char __core_stacks_size__[];
+
 void cdcr::zynqmp::release_second_core() {
+  // The symbol's address is the size; the compiler may not take an
+  // object's address for never null.
+  std::uintptr_t second_core_stacks = reinterpret_cast<std::uintptr_t>(__core_stacks_size__);
+  asm("" : "+r"(second_core_stacks));
+  if (second_core_stacks == 0) {
+    console_write("second core: the program has no stacks for it (link cdcr::zynqmp_second_core)\n");
+    exit(ExitCode::failure);
+  }
   asm volatile("dsb" ::: "memory");
   second_core_release = kSecondCoreReleased;
   // The write before the event that wakes the second core from its WFE.

@@ -93,12 +93,20 @@ cdcr_zynqmp_reset:
      * affinity field is the core's number: 0 and 1 on silicon, 4 and 5
      * under QEMU, which numbers the zcu102's cores after the four A53s; its
      * lowest bit tells them apart on both. r11 holds it to the end of the
-     * reset code, r12 the offset of the core's stacks. */
+     * reset code, r12 the offset of the core's stacks. In a program linked
+     * without the second core's stacks, that core parks here, touching no
+     * memory. */
     mrc p15, 0, r11, c0, c0, 5          /* MPIDR */
     and r11, r11, #1
     mov r12, #0
     cmp r11, #0
-    ldrne r12, =__core_stacks_size__
+    beq 3f
+    ldr r12, =__core_stacks_size__
+    cmp r12, #0
+    bne 3f
+2:  wfi
+    b 2b
+3:
 
     /* One stack per exception mode, so a fault handler runs on a stack of its
      * own even when the program's stack is what went wrong; the program runs
@@ -185,10 +193,10 @@ cdcr_zynqmp_reset:
     isb
 
     cmp r11, #0
-    bne 2f
+    bne 4f
     bl cdcr_zynqmp_start                /* startup.cpp; does not return */
 1:  b 1b
-2:  bl cdcr_zynqmp_second_core_start    /* startup.cpp; does not return */
+4:  bl cdcr_zynqmp_second_core_start    /* startup.cpp; does not return */
     b 1b
     .size cdcr_zynqmp_reset, . - cdcr_zynqmp_reset
 

@@ -1,11 +1,13 @@
 #pragma once
 // The RPU's second Cortex-R5F core, in split mode: a program that defines
-// cdcr_zynqmp_second_core_main runs it there, beside its main on the first
-// core. Both cores start at the ELF's entry (vectors.S gives each its own
-// stacks); the second waits in the start-up until the first has initialised
-// .data, .bss and the static constructors and calls release_second_core().
-// Programs that do not define it leave the second core parked (and QEMU
-// leaves it powered off unless run_r5f.cmake is told SECOND_CORE).
+// cdcr_zynqmp_second_core_main and links cdcr::zynqmp_second_core (the
+// linker script then reserves the second core's stacks) runs it there,
+// beside its main on the first core. Both cores start at the ELF's entry
+// (vectors.S gives each its own stacks); the second waits in the start-up
+// until the first has initialised .data, .bss and the static constructors
+// and calls release_second_core(). In other programs the second core parks
+// at reset (and QEMU leaves it powered off unless run_r5f.cmake is told
+// SECOND_CORE).
 //
 // What the cores share is the program's code and memory; words that both
 // write belong in .core_shared (CDCR_ZYNQMP_CORE_SHARED), 32 bytes that no
@@ -31,7 +33,9 @@ void cdcr_zynqmp_second_core_main();
 namespace cdcr::zynqmp {
 
 // From the first core, once its start-up and whatever the second core's
-// program needs first are done: lets the second core's start-up go on.
+// program needs first are done: lets the second core's start-up go on. In
+// a program linked without the second core's stacks, reports that and
+// exits with ExitCode::failure.
 void release_second_core();
 
 // This core has nothing to do for now: the hint a spinning core gives its
