@@ -48,14 +48,15 @@
 // only ever waiting while the runtime computes. Should a time slice end
 // inside a cycle, the peer's turn is one look at its clock, 24
 // instructions (a YIELD forced into every cycle added 24 to the worst).
-// The peer counts its turns in a shared word and the runtime reads it
-// around each cycle: a turn inside a cycle fails the run, as does a period
-// whose work runs past the limit, so the count printed is the runtime's
-// own. Measured: no turn inside any of the 6,662 cycles.
+// The peer counts its turns in a shared word and flags its periods' work
+// in another, and the runtime reads both around each cycle: a turn inside
+// a cycle fails the run, as does a cycle begun or ended with the peer at
+// work, or a period whose work runs past the limit, so the count printed
+// is the runtime's own. Measured: no turn inside any of the 6,662 cycles.
 //
 // The cores share nothing but the program and, in .core_shared, the start
-// handshake, the peer's turn count and the end of the run with its
-// verdict.
+// handshake, the peer's turn count and work flag, and the end of the run
+// with its verdict.
 
 #include <cmath>
 #include <cstdint>
@@ -102,8 +103,10 @@ CDCR_ZYNQMP_CORE_SHARED volatile std::uint32_t peer_state;
 // after, through this word, which no cache holds.
 CDCR_ZYNQMP_CORE_SHARED volatile std::uint32_t peer_failures;
 // Turns the peer has taken while waiting for its period (one per look at
-// its clock, each followed by a YIELD).
+// its clock, each followed by a YIELD), and whether it is at a period's
+// work: between the two, every instruction the peer runs is seen.
 CDCR_ZYNQMP_CORE_SHARED volatile std::uint32_t peer_turns;
+CDCR_ZYNQMP_CORE_SHARED volatile std::uint32_t peer_working;
 
 // ---- The runtime's core ----
 
@@ -125,6 +128,7 @@ int first_over_budget_cycle = -1;
 std::uint64_t first_over_budget_instructions = 0;
 std::uint32_t most_peer_turns_inside = 0;
 int cycles_with_peer_turns = 0;
+int cycles_with_peer_working = 0;  // begun or ended while the peer was at a period's work
 
 // Instructions of one Runtime::run_cycle (none with run false: the
 // counting's own, which every count leaves out).
@@ -140,14 +144,18 @@ std::uint64_t counted(const cdcr::hal::TimerTick& tick, bool run) {
 }
 
 // Runtime::run_cycle for the release `tick`, counted and held to the
-// budget; the peer's turns around it counted too. Nothing printed: the
-// console is the peer's until the run ends.
+// budget; whether the peer ran inside it seen too (its turns, and its work
+// under way at either end). Nothing printed: the console is the peer's
+// until the run ends.
 void run_counted_cycle(const cdcr::hal::TimerTick& tick) {
   const std::uint32_t turns_before = peer_turns;
+  const bool working_before = peer_working != 0;
   const std::uint64_t instructions = counted(tick, true);
+  const bool working_after = peer_working != 0;
   const std::uint32_t turns_inside = peer_turns - turns_before;
   if (turns_inside > most_peer_turns_inside) most_peer_turns_inside = turns_inside;
   if (turns_inside != 0) cycles_with_peer_turns += 1;
+  if (working_before || working_after) cycles_with_peer_working += 1;
   if (instructions > worst_cycle) worst_cycle = instructions;
   if (instructions > r5f::kCycleBudgetInstructions && over_budget++ == 0) {
     first_over_budget_cycle = cycles_run;
@@ -163,7 +171,8 @@ void run_counted_cycle(const cdcr::hal::TimerTick& tick) {
 // after the peer says ready, the peer its periods half a period after), so
 // that what the peer sends in a period is what the runtime's next cycle
 // receives, as the drives' reports before each cycle on a one-core board.
-// A period's work must end within kPeerWorkLimitNs of its release, well
+// The peer's work from a release on (the period's, and what it prepares
+// for the next, such as a target) must end within kPeerWorkLimitNs, well
 // before the runtime's next release: the peer never computes while the
 // runtime does.
 constexpr std::int64_t kPeriodNs = r5f::kCyclePeriodNs;
@@ -209,7 +218,6 @@ std::int64_t reported_rejected_frames = -1;
 protocol::UpdateReport last_update_report;
 // UPDATE_REPORT's ACTIVE_SLOT for slot A (0 is the board's image, 2 slot B).
 constexpr std::uint8_t kWireSlotA = 1;
-int update_reports = 0;
 int setpoint_frames[firmware::kMaxSegments] = {};  // CABLE_SETPOINT frames per segment
 
 // The model update under way, if any; its frames share a period's room on
@@ -232,7 +240,7 @@ firmware::Correction correction;
 // One frame the runtime sent, other than a setpoint.
 void record(const CanFrame& frame) {
   if (protocol::update_report::kMessage.carries(frame.id)) {
-    if (protocol::decode(frame, last_update_report) == protocol::DecodeStatus::ok) update_reports += 1;
+    protocol::decode(frame, last_update_report);
     if (sender != nullptr) sender->on_report(frame, periods_run, peer);
     return;
   }
@@ -312,25 +320,32 @@ void settle_golden_case() {
   worst_orientation_rad = 0;
 }
 
-// The start of a period: waits for its release, a turn at a time.
+// The end of the peer's work since its last release (the period's, and
+// whatever it prepared after it for the next): in time, or counted late.
+void finish_work() {
+  if (periods_run == 0) return;
+  const std::int64_t work_ns = peer_clock.now_ns() - period_release_ns;
+  if (work_ns > longest_period_work_ns) longest_period_work_ns = work_ns;
+  if (work_ns > kPeerWorkLimitNs) periods_late += 1;
+}
+
+// The start of a period: waits for its release, a turn at a time. The
+// peer is at work (peer_working) everywhere but in this wait.
 void begin_period() {
+  finish_work();
+  peer_working = 0;
   for (;;) {
     const std::int64_t now_ns = peer_clock.now_ns();
     if (now_ns >= next_release_ns) break;
     peer_turns = peer_turns + 1;
     zynqmp::yield_to_other_core();
   }
+  peer_working = 1;
   period_release_ns = next_release_ns;
   next_release_ns += kPeriodNs;
 }
 
-// The end of a period's work: in time, or counted late.
-void end_period() {
-  const std::int64_t work_ns = peer_clock.now_ns() - period_release_ns;
-  if (work_ns > longest_period_work_ns) longest_period_work_ns = work_ns;
-  if (work_ns > kPeerWorkLimitNs) periods_late += 1;
-  periods_run += 1;
-}
+void end_period() { periods_run += 1; }
 
 // The drives' part of a period: the runtime's frames taken (setpoints move
 // the drives), then, unless silent, every drive's report.
@@ -594,6 +609,7 @@ void run_peer() {
   check(bus.reported_state == static_cast<int>(RuntimeState::run), "STATUS reports RUN once the drives are back");
 
   while (periods_run < 2000) period();
+  finish_work();
   print("peer: ", periods_run, " periods on the second core, the longest's work ",
         static_cast<std::int32_t>(longest_period_work_ns / 1000), " us (limit ",
         static_cast<std::int32_t>(kPeerWorkLimitNs / 1000), "), ", peer_turns, " turns waiting\n");
@@ -607,9 +623,11 @@ void run_peer() {
 // The second core: the peer, from the runtime's first cycle to the end of
 // the scenario; then its verdict to the runtime's core, and park.
 extern "C" void cdcr_zynqmp_second_core_main() {
+  peer_working = 1;
   peer_clock.enable();
   run_peer();
   peer_failures = static_cast<std::uint32_t>(failures);
+  peer_working = 0;
   peer_state = kPeerDone;
 }
 
@@ -631,6 +649,7 @@ int main() {
   peer_state = kPeerPreparing;
   peer_failures = 0;
   peer_turns = 0;
+  peer_working = 0;
   zynqmp::release_second_core();
   while (peer_state == kPeerPreparing) zynqmp::yield_to_other_core();
   board.start_cycles();
@@ -647,7 +666,7 @@ int main() {
           static_cast<std::uint32_t>(first_over_budget_instructions), " instructions\n");
   }
   print("peer turns inside a cycle: at most ", most_peer_turns_inside, ", in ", cycles_with_peer_turns, " of ",
-        cycles_run, " cycles\n");
+        cycles_run, " cycles; cycles begun or ended with the peer at work: ", cycles_with_peer_working, "\n");
   print("runtime: RX FIFO overflows counted ", board.can.error_counters().rx_overruns, ", rejected frames ",
         runtime.statistics().rejected_frames, ", active slot ", runtime.model_update().active_slot(), ", state ",
         firmware::to_string(runtime.state()), "\n");
@@ -657,6 +676,7 @@ int main() {
   check_equal(over_budget, 0, "cycles over budget");
   check_equal(most_peer_turns_inside, 0,
               "peer turns inside a cycle (their instructions would count as the runtime's)");
+  check_equal(cycles_with_peer_working, 0, "cycles begun or ended with the peer at a period's work");
   check_equal(board.timer.overruns(), 0, "releases missed");
   check(board.can.error_counters().rx_overruns >= 1, "the flood's RX FIFO overflow is counted");
   check(runtime.model_update().active_slot() == 0, "the runtime runs the new model from slot A");
