@@ -5,10 +5,10 @@
 # controllers on one emulated bus. The R5Fs start powered off and -kernel
 # alone does not start them: QEMU starts stopped (-S), and QMP on stdin
 # powers the cores on, resets the machine (the loader puts every core at the
-# ELF's entry) and continues. Either core may end the run. The program's console is uart0, written to
+# ELF's entry) and continues. The program's console is uart0, written to
 # WORK_DIR/uart.log and printed here; its exit status comes through
-# semihosting. The verdict, on the UART output, is the Cortex-M boards'
-# (host_tests/qemu/qemu_verdict.cmake).
+# semihosting, from either core. The verdict, on the UART output, is the
+# Cortex-M boards' (host_tests/qemu/qemu_verdict.cmake).
 # With ICOUNT, each instruction advances the virtual clock by 2^ICOUNT ns.
 foreach(variable QEMU ELF WORK_DIR)
   if(NOT ${variable})

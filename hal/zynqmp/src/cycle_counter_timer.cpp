@@ -51,14 +51,16 @@ hal::TimerTick CycleCounterTimer::wait_next() {
   // The wait reads the counter rarely: under -icount each read ends QEMU's
   // translated block, and a loop of reads made the waits most of a run's
   // host time (zynqmp.forward_path took 5 s, now under 2). Between reads it
-  // spins an eighth of what is left, at two instructions and at least one
-  // clock an iteration, and at most kSpinIterations: never past the
-  // release, and within about 150 reads of it.
+  // spins an eighth of what is left, at three instructions and at least
+  // one clock an iteration, and at most kSpinIterations (15 us under
+  // icount): never past the release, and about 65 reads in a period's wait.
   // Before each read, the idle hint an SMP core gives its sibling (YIELD):
   // under QEMU's TCG, which runs the cores in turn on one virtual clock,
   // it ends this core's turn, so that a program on the RPU's second core
   // (zynqmp.workload's peer) works while this one idles instead of in its
-  // cycles. With the second core off it costs one instruction a read.
+  // cycles; the spins' cap gives it a turn every 15 us or sooner, so that
+  // its own waits end close to their deadlines. With the second core off
+  // the hint costs one instruction a read.
   constexpr std::uint32_t kSpinIterations = 5'000;
   for (;;) {
     yield_to_other_core();
