@@ -41,6 +41,31 @@ CDCR_ZYNQMP_CORE_SHARED volatile std::uint32_t second_core_release;
 // linked without them, whose second core parked at reset (vectors.S).
 extern "C" char __core_stacks_size__[];
 
+namespace {
+
+// Everything this core wrote through its data cache (.data, .bss, the
+// static constructors' objects) out to the DDR, where the second core reads
+// it: the two cores' caches are not coherent. The level 1 data cache set by
+// set and way over the geometry CCSIDR reports, as vectors.S invalidates it.
+void clean_data_cache() {
+  asm volatile("mcr p15, 2, %0, c0, c0, 0\n\tisb" ::"r"(0u));  // CSSELR: level 1 data cache
+  std::uint32_t geometry;
+  asm volatile("mrc p15, 1, %0, c0, c0, 0" : "=r"(geometry));  // CCSIDR
+  const std::uint32_t set_shift = (geometry & 7u) + 4u;       // log2(line bytes)
+  const std::uint32_t last_way = (geometry >> 3) & 0x3FFu;
+  const std::uint32_t last_set = (geometry >> 13) & 0x7FFFu;
+  const std::uint32_t way_shift = last_way == 0 ? 0u : static_cast<std::uint32_t>(__builtin_clz(last_way));
+  for (std::uint32_t way = 0; way <= last_way; ++way) {
+    for (std::uint32_t set = 0; set <= last_set; ++set) {
+      const std::uint32_t set_way = (way << way_shift) | (set << set_shift);
+      asm volatile("mcr p15, 0, %0, c7, c10, 2" ::"r"(set_way) : "memory");  // DCCSW
+    }
+  }
+  asm volatile("dsb" ::: "memory");
+}
+
+}  // namespace
+
 void cdcr::zynqmp::release_second_core() {
   // The symbol's address is the size; the compiler may not take an
   // object's address for never null.
@@ -50,7 +75,7 @@ void cdcr::zynqmp::release_second_core() {
     console_write("second core: the program has no stacks for it (link cdcr::zynqmp_second_core)\n");
     exit(ExitCode::failure);
   }
-  asm volatile("dsb" ::: "memory");
+  clean_data_cache();
   second_core_release = kSecondCoreReleased;
   // The write before the event that wakes the second core from its WFE.
   asm volatile("dsb\n\tsev" ::: "memory");

@@ -33,7 +33,9 @@ void cdcr_zynqmp_second_core_main();
 namespace cdcr::zynqmp {
 
 // From the first core, once its start-up and whatever the second core's
-// program needs first are done: lets the second core's start-up go on. In
+// program needs first are done: cleans the first core's data cache (what
+// it wrote reaches the DDR the second core reads) and lets the second
+// core's start-up go on. In
 // a program linked without the second core's stacks, reports that and
 // exits with ExitCode::failure.
 void release_second_core();
