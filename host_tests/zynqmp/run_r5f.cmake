@@ -1,13 +1,14 @@
 # cmake -DQEMU=<qemu-system-aarch64> -DELF= -DWORK_DIR= [-DICOUNT=shift] [-DTIMEOUT_SECONDS=60]
-#       [-DEXPECT_STATUS=n -DEXPECT=regex | -DRUN_SECONDS=s -DEXPECT=regex] -P run_r5f.cmake
-# Runs a program on the first Cortex-R5F of QEMU's xlnx-zcu102, with both
-# CAN controllers on one emulated bus. The R5F starts powered off and
-# -kernel alone does not start it: QEMU starts stopped (-S), and QMP on stdin
-# powers the core on, resets the machine (the loader puts the core at the
+#       [-DSECOND_CORE=ON] [-DEXPECT_STATUS=n -DEXPECT=regex | -DRUN_SECONDS=s -DEXPECT=regex] -P run_r5f.cmake
+# Runs a program on the first Cortex-R5F of QEMU's xlnx-zcu102 (with
+# SECOND_CORE, on both, hal/zynqmp second_core.hpp), with both CAN
+# controllers on one emulated bus. The R5Fs start powered off and -kernel
+# alone does not start them: QEMU starts stopped (-S), and QMP on stdin
+# powers the cores on, resets the machine (the loader puts every core at the
 # ELF's entry) and continues. The program's console is uart0, written to
 # WORK_DIR/uart.log and printed here; its exit status comes through
-# semihosting. The verdict, on the UART output, is the Cortex-M boards'
-# (host_tests/qemu/qemu_verdict.cmake).
+# semihosting, from either core. The verdict, on the UART output, is the
+# Cortex-M boards' (host_tests/qemu/qemu_verdict.cmake).
 # With ICOUNT, each instruction advances the virtual clock by 2^ICOUNT ns.
 foreach(variable QEMU ELF WORK_DIR)
   if(NOT ${variable})
@@ -30,13 +31,23 @@ file(MAKE_DIRECTORY ${WORK_DIR})
 set(uart_log ${WORK_DIR}/uart.log)
 set(qmp_commands ${WORK_DIR}/start_rpu.qmp)
 file(REMOVE ${uart_log})
+set(cores 0)
+if(SECOND_CORE)
+  list(APPEND cores 1)
+endif()
+set(power_on "")
+foreach(core IN LISTS cores)
+  string(APPEND power_on
+    "{\"execute\":\"qom-set\",\"arguments\":{\"path\":\"/machine/soc/rpu-cluster/rpu-cpu[${core}]\",\"property\":\"start-powered-off\",\"value\":false}}\n")
+endforeach()
 file(WRITE ${qmp_commands}
   "{\"execute\":\"qmp_capabilities\"}\n"
-  "{\"execute\":\"qom-set\",\"arguments\":{\"path\":\"/machine/soc/rpu-cluster/rpu-cpu[0]\",\"property\":\"start-powered-off\",\"value\":false}}\n"
+  "${power_on}"
   "{\"execute\":\"system_reset\"}\n"
   "{\"execute\":\"cont\"}\n")
 
-# -smp 6: four A53s and the two R5Fs; the A53s stay powered off.
+# -smp 6: four A53s and the two R5Fs; the A53s stay powered off. Under
+# -icount all cores take turns on one virtual clock (second_core.hpp).
 # The bus object must not be called canbus0 (an ambiguous QOM path).
 # -audiodev none: the DisplayPort's audio would otherwise look for a sound card.
 # timeout -k: under -icount a QEMU whose guest spins may not act on SIGTERM.

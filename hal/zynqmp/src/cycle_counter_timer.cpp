@@ -1,5 +1,7 @@
 #include "cdcr/zynqmp/cycle_counter_timer.hpp"
 
+#include "cdcr/zynqmp/second_core.hpp"
+
 namespace cdcr::zynqmp {
 namespace {
 
@@ -49,13 +51,23 @@ hal::TimerTick CycleCounterTimer::wait_next() {
   // The wait reads the counter rarely: under -icount each read ends QEMU's
   // translated block, and a loop of reads made the waits most of a run's
   // host time (zynqmp.forward_path took 5 s, now under 2). Between reads it
-  // spins an eighth of what is left, at two instructions and at least one
-  // clock an iteration: never past the release, and within about 50 reads
-  // of it.
+  // spins an eighth of what is left, at three instructions and at least
+  // one clock an iteration, and at most kSpinIterations (15 us under
+  // icount): never past the release, and about 65 reads in a period's wait.
+  // Before each read, the idle hint an SMP core gives its sibling (YIELD):
+  // under QEMU's TCG, which runs the cores in turn on one virtual clock,
+  // it ends this core's turn, so that a program on the RPU's second core
+  // (zynqmp.workload's peer) works while this one idles instead of in its
+  // cycles; the spins' cap gives it a turn every 15 us or sooner, so that
+  // its own waits end close to their deadlines. With the second core off
+  // the hint costs one instruction a read.
+  constexpr std::uint32_t kSpinIterations = 5'000;
   for (;;) {
+    yield_to_other_core();
     const std::int64_t remaining_ns = tick.release_ns - now_ns();
     if (remaining_ns <= 0) break;
     std::uint32_t iterations = static_cast<std::uint32_t>(remaining_ns / ns_per_count_ / 8);
+    if (iterations > kSpinIterations) iterations = kSpinIterations;
     while (iterations != 0) {
       iterations -= 1;
       asm volatile("" ::: "memory");

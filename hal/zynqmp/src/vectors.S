@@ -25,11 +25,16 @@
     .equ SCTLR_TE, (1 << 30) /* exceptions in Thumb state */
 
 /* MPU regions (RGNR, DRBAR, DRSR, DRACR). A region covers 2^(N+1) bytes
- * for a DRSR size field of N, at a base aligned to its size.
+ * for a DRSR size field of N, at a base aligned to its size; where regions
+ * overlap, the higher number wins.
  *   0: the DDR's low 2 GiB (program, data, stacks): normal memory, write-back
  *      write-allocate cacheable, full access, executable.
  *   1: the low-power domain's peripherals, 8 MiB at 0xFF000000 (uart0,
- *      can0, can1, the timers): device memory, never executed. */
+ *      can0, can1, the timers): device memory, never executed.
+ *   2: the 32 bytes both R5F cores share (.core_shared, second_core.hpp):
+ *      normal memory, shareable and not cacheable, never executed. The two
+ *      cores' data caches are not coherent: a word one core writes through
+ *      its cache the other might never see. */
     .equ MPU_REGION_MEMORY, 0
     .equ MPU_MEMORY_BASE, 0x00000000
     .equ MPU_MEMORY_SIZE_ENABLE, (30 << 1) | 1
@@ -38,9 +43,12 @@
     .equ MPU_PERIPHERALS_BASE, 0xFF000000
     .equ MPU_PERIPHERALS_SIZE_ENABLE, (22 << 1) | 1
     .equ MPU_PERIPHERALS_ACCESS, (1 << 12) | (0x3 << 8) | (1 << 0)
-/* DRACR: XN bit 12, AP bits 10:8 (0b011 full access), TEX bits 5:3, C bit 1,
- * B bit 0. TEX 001 C B: normal, write-back write-allocate; TEX 000 B:
- * shareable device. */
+    .equ MPU_REGION_CORE_SHARED, 2
+    .equ MPU_CORE_SHARED_SIZE_ENABLE, (4 << 1) | 1
+    .equ MPU_CORE_SHARED_ACCESS, (1 << 12) | (0x3 << 8) | (0x1 << 3) | (1 << 2)
+/* DRACR: XN bit 12, AP bits 10:8 (0b011 full access), TEX bits 5:3, S bit 2,
+ * C bit 1, B bit 0. TEX 001 C B: normal, write-back write-allocate; TEX 001
+ * with neither: normal, not cacheable; TEX 000 B: shareable device. */
 
 /* Exception numbers cdcr_zynqmp_exception reports (startup.cpp). */
     .equ EXC_UNDEFINED, 1
@@ -79,12 +87,35 @@ cdcr_zynqmp_reset:
     mcr p15, 0, r0, c1, c0, 0
     isb
 
+    /* Both R5F cores of the RPU in split mode start here (QEMU puts every
+     * core it powers on at the ELF's entry): the first runs the program, the
+     * second (second_core.hpp) its own stacks and entry. MPIDR's lowest
+     * affinity field is the core's number: 0 and 1 on silicon, 4 and 5
+     * under QEMU, which numbers the zcu102's cores after the four A53s; its
+     * lowest bit tells them apart on both. r11 holds it to the end of the
+     * reset code, r12 the offset of the core's stacks. In a program linked
+     * without the second core's stacks, that core parks here, touching no
+     * memory. */
+    mrc p15, 0, r11, c0, c0, 5          /* MPIDR */
+    and r11, r11, #1
+    mov r12, #0
+    cmp r11, #0
+    beq 3f
+    ldr r12, =__core_stacks_size__
+    cmp r12, #0
+    bne 3f
+2:  wfi
+    b 2b
+3:
+
     /* One stack per exception mode, so a fault handler runs on a stack of its
      * own even when the program's stack is what went wrong; the program runs
-     * in System mode on the main stack. Interrupts stay masked. */
+     * in System mode on the main stack. Interrupts stay masked. Each core
+     * has a set of its own (the linker script's .stack). */
     .macro mode_stack mode, top
     cps #\mode
     ldr sp, =\top
+    add sp, sp, r12
     .endm
     mode_stack MODE_FIQ, __fiq_stack_top__
     mode_stack MODE_IRQ, __irq_stack_top__
@@ -102,7 +133,7 @@ cdcr_zynqmp_reset:
     mov r0, #(1 << 30)
     vmsr fpexc, r0
 
-    /* The MPU: two regions and nothing else, so a stray access anywhere
+    /* The MPU: three regions and nothing else, so a stray access anywhere
      * else (the OCM, the DDR above 2 GiB, the other peripherals) is a data
      * abort instead of a silent read or write. No background region. */
     mov r0, #MPU_REGION_MEMORY
@@ -120,6 +151,14 @@ cdcr_zynqmp_reset:
     ldr r0, =MPU_PERIPHERALS_ACCESS
     mcr p15, 0, r0, c6, c1, 4
     ldr r0, =MPU_PERIPHERALS_SIZE_ENABLE
+    mcr p15, 0, r0, c6, c1, 2
+    mov r0, #MPU_REGION_CORE_SHARED
+    mcr p15, 0, r0, c6, c2, 0
+    ldr r0, =__core_shared_start__
+    mcr p15, 0, r0, c6, c1, 0
+    ldr r0, =MPU_CORE_SHARED_ACCESS
+    mcr p15, 0, r0, c6, c1, 4
+    ldr r0, =MPU_CORE_SHARED_SIZE_ENABLE
     mcr p15, 0, r0, c6, c1, 2
 
     /* Both caches invalidated before they are enabled (their contents are
@@ -153,8 +192,12 @@ cdcr_zynqmp_reset:
     mcr p15, 0, r0, c1, c0, 0
     isb
 
+    cmp r11, #0
+    bne 4f
     bl cdcr_zynqmp_start                /* startup.cpp; does not return */
 1:  b 1b
+4:  bl cdcr_zynqmp_second_core_start    /* startup.cpp; does not return */
+    b 1b
     .size cdcr_zynqmp_reset, . - cdcr_zynqmp_reset
 
 /* Each entry reports its exception and the return address, and exits. */
