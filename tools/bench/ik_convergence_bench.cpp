@@ -226,17 +226,15 @@ void nominal_paths(int paths, int steps, double step_rad, unsigned seed) {
 }
 
 // Targets the compensated model reaches by construction: its own poses at
-// the sets' bends. The board's solver on the runtime's correction, with the
-// runtime's preference among solutions (firmware::ik_preference), from
+// the sets' bends. The board's solver on the runtime's correction, from
 // the runtime's straight start, within the runtime's per-cycle budget and
 // kMaxIkCycles; converged means the solver's own tolerance on the
 // compensated model (2 um, 2e-5 rad in float).
-void compensated_sets(const fw::Runtime& runtime, const model::ImageView& image) {
+void compensated_sets(const fw::Runtime& runtime) {
   const model::RobotGeometry<double> geometry = runtime.geometry().cast<double>();
   fw::SolverCorrection correction(runtime.correction());
   fw::Solver solver;
   solver.configure(runtime.geometry(), correction, fw::runtime_solver_options<float>(), fw::kIkWorkCosts);
-  solver.set_preference(fw::ik_preference(runtime.geometry(), &image));
   const int n = 200;
   std::printf("the compensated model's own poses as targets, %d each, the board's solver from straight, %u units per "
               "cycle:\n",
@@ -520,7 +518,7 @@ void circle_start(const std::string& image_path, double radius_mm) {
   if (model::parse_image(image.data(), image.size(), view, model::ImageCapacity{}) != model::ImageStatus::ok) {
     throw std::runtime_error("the image does not parse");
   }
-  compensated_sets(runtime, view);
+  compensated_sets(runtime);
   in_range_preference(runtime, view);
 }
 

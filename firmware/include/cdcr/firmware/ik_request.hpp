@@ -96,6 +96,9 @@ class IkRequest {
   const HysteresisTracker* hysteresis_;
   SolverCorrection solver_correction_{model_.correction, &model_.compliance, &model_.geometry};
   Solver solver_;
+  // Where a target that refuses extrapolation prefers its solution
+  // (ik_preference(); the others have none: see configure()).
+  model::IkPreference<Scalar, kMaxSegments> preference_{};
   IkReport report_;
   bool solving_ = false;
   bool tracking_ = false;
