@@ -917,10 +917,10 @@ class IkSolver {
     const S scale = normal.trace() / S(kind_ == IkTargetKind::pose ? 6 : 3);
     normal.diagonal().array() += damping_ * scale + std::numeric_limits<S>::min();
     // The pose task's step J^T (J J^T + damping)^-1 r and, with a
-    // preference, that of its pull z, solved together on one factor (a
-    // second solve of its own cost the M7 program 3.5 KB of code): the
-    // pull's step is then z less what the pose task sees of it,
-    // z - J^T (J J^T + damping)^-1 J z.
+    // preference, that of its pull z on the same factor: z less what the
+    // pose task sees of it, z - J^T (J J^T + damping)^-1 J z. (One vector
+    // at a time: Eigen's solve of a two-column right-hand side goes
+    // through a blocked path that allocates.)
     using Step = Eigen::Matrix<S, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxColumns, 1>;
     Step z = Step::Zero(columns);
     if (preferred) {
@@ -941,13 +941,13 @@ class IkSolver {
         }
       }
     }
-    Eigen::Matrix<S, Rows, 2> sides;
-    sides.col(0) = inner_residual_.template head<Rows>();
-    sides.col(1) = used.lazyProduct(z);
-    const Eigen::Matrix<S, Rows, 2> solved = normal.ldlt().solve(sides);
-    Step step = used.transpose().lazyProduct(solved.col(0));
+    const Eigen::LDLT<Eigen::Matrix<S, Rows, Rows>> factor = normal.ldlt();
+    const Eigen::Matrix<S, Rows, 1> y = factor.solve(inner_residual_.template head<Rows>());
+    Step step = used.transpose().lazyProduct(y);
     if (preferred) {
-      Step null_step = z - used.transpose().lazyProduct(solved.col(1));
+      const Eigen::Matrix<S, Rows, 1> seen = used.lazyProduct(z);
+      const Eigen::Matrix<S, Rows, 1> y_seen = factor.solve(seen);
+      Step null_step = z - used.transpose().lazyProduct(y_seen);
       // Never longer than the pose task's own step: the preference's leak
       // through the damping then stays a fraction of the step, and the last
       // steps before a solution are left alone (in the IK bench, with no cap
