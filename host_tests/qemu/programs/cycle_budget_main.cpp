@@ -495,11 +495,14 @@ int main() {
     ok = false;
   }
   // A target made inside the data has a solution there, which the search
-  // should find: one of the 20 is still refused on both boards (the goal is
-  // none; with a single retry from the straight start, 4 on the M7 and 9 on
-  // the M4F were). One made beyond it may have one too (the robot is
-  // redundant), but not all of them do.
-  if (refusing_refused[0] > 1) {
+  // should find: with the preference for the middle of the data none of the
+  // 20 is refused on either board (1 without it; with a single retry from
+  // the straight start, 4 on the M7 and 9 on the M4F were). The payload
+  // model with a compliance block, on which IK converges on fewer than half
+  // the targets within a request's cycles, still has one refused on the
+  // M4F. One made beyond it may have one too (the robot is redundant), but
+  // not all of them do.
+  if (refusing_refused[0] > (cdcr::qemu_programs::kExpectComplianceBlock ? 1 : 0)) {
     console::console_write("FAIL: targets made inside the data were refused as extrapolating\n");
     ok = false;
   }
