@@ -150,6 +150,31 @@ wait_until "RUN after the traffic" seen 07 150#01
 wait_until "$poses_wanted poses after the traffic" seen_count 07 132# "$poses_wanted"
 progress "phase 7 (after the traffic) done"
 
+marker 08
+# Pose targets one after another, each a pose of the model: every attempt
+# must get exactly one final IK_REPORT and poses must keep coming while it
+# is solved (the checker reads both from the capture). An attempt refused
+# or aborted in FAULT is sent again under a new sequence number.
+target=0
+while [ "$target" -lt "$POSE_TARGETS" ]; do
+  eval "orientation=\$POSE_TARGET_Q_$target position=\$POSE_TARGET_XY_$target"
+  attempt=0
+  while :; do
+    [ "$attempt" -lt "$POSE_TARGET_ATTEMPTS" ] || fail "pose target $target did not converge in $attempt attempts"
+    eval "commit=\$POSE_TARGET_Z_${target}_$attempt sequence=\$POSE_TARGET_SEQUENCE_${target}_$attempt"
+    wait_until "RUN before pose target $target" in_run
+    send "120#$orientation"
+    send "121#$position"
+    send "122#$commit"
+    # A final report: any outcome but 06 (in progress).
+    wait_until "the final IK_REPORT of pose target $target, attempt $attempt" seen 08 "140#${sequence}0[0-57-9A-F]"
+    seen 08 "140#${sequence}00" && break
+    attempt=$((attempt + 1))
+  done
+  target=$((target + 1))
+done
+progress "phase 8 (pose targets) done"
+
 kill -INT "$runtime_pid"
 wait "$runtime_pid"
 runtime_status=$?

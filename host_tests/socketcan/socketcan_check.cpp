@@ -79,6 +79,23 @@ model::CableVector<double> bent_cables(const Model& m, double theta_rad, double 
 
 model::CableVector<double> feedback_cables(const Model& m) { return bent_cables(m, 0.15, 0.0); }
 
+// Phase 8's pose targets: the compensated model's own poses at these bends
+// (reachable by construction), each sent up to kPoseTargetAttempts times
+// (a target refused in FAULT is sent again, as a planner would), every
+// attempt with a sequence number of its own.
+constexpr double kPoseTargetBends[][2] = {{0.1, 0.0}, {0.25, 1.0}, {0.05, -2.0}, {0.3, 2.5}};
+constexpr int kPoseTargets = int(sizeof(kPoseTargetBends) / sizeof(kPoseTargetBends[0]));
+constexpr int kPoseTargetAttempts = 4;
+std::uint8_t pose_target_sequence(int target, int attempt) {
+  return std::uint8_t(0x20 + kPoseTargetAttempts * target + attempt);
+}
+model::Pose<double> pose_target(const Model& m, int target) {
+  model::ForwardResult<double> result;
+  model::compensated_forward(bent_cables(m, kPoseTargetBends[target][0], kPoseTargetBends[target][1]), m.geometry,
+                             m.correction, result);
+  return result.compensated;
+}
+
 model::Vec3<double> target_position_mm(const Model& m) {
   model::ForwardResult<double> result;
   model::compensated_forward(bent_cables(m, 0.25, 0.4), m.geometry, m.correction, result);
@@ -129,6 +146,23 @@ int print_frames(const Model& m) {
   protocol::encode(protocol::TargetPositionXy{target.x(), target.y()}, xy);
   protocol::encode(protocol::TargetPositionZ{target.z(), protocol::TargetMode::position, false, kTargetSequence}, z);
   std::printf("TARGET_XY=%s\nTARGET_Z=%s\n", hex(xy).c_str(), hex(z).c_str());
+  std::printf("POSE_TARGETS=%d\nPOSE_TARGET_ATTEMPTS=%d\n", kPoseTargets, kPoseTargetAttempts);
+  for (int t = 0; t < kPoseTargets; ++t) {
+    const model::Pose<double> pose = pose_target(m, t);
+    const Eigen::Quaterniond q(pose.rotation);
+    CanFrame orientation, position;
+    protocol::encode(protocol::TargetOrientation{q.w(), q.x(), q.y(), q.z()}, orientation);
+    protocol::encode(protocol::TargetPositionXy{pose.position_mm.x(), pose.position_mm.y()}, position);
+    std::printf("POSE_TARGET_Q_%d=%s\nPOSE_TARGET_XY_%d=%s\n", t, hex(orientation).c_str(), t, hex(position).c_str());
+    for (int a = 0; a < kPoseTargetAttempts; ++a) {
+      CanFrame commit;
+      protocol::encode(protocol::TargetPositionZ{pose.position_mm.z(), protocol::TargetMode::pose, false,
+                                                 pose_target_sequence(t, a)},
+                       commit);
+      std::printf("POSE_TARGET_Z_%d_%d=%s\nPOSE_TARGET_SEQUENCE_%d_%d=%02X\n", t, a, hex(commit).c_str(), t, a,
+                  pose_target_sequence(t, a));
+    }
+  }
   return 0;
 }
 
@@ -265,8 +299,8 @@ int check(const Model& m, const std::string& log_path) {
     phases.back().frames.push_back(logged);
   }
   Checker c(m);
-  c.expect(phases.size() == 8, "all 7 markers in the log (got " + std::to_string(phases.size() - 1) + ")");
-  if (phases.size() != 8) return 1;
+  c.expect(phases.size() == 9, "all 8 markers in the log (got " + std::to_string(phases.size() - 1) + ")");
+  if (phases.size() != 9) return 1;
   constexpr std::uint32_t kStatusId = protocol::status::kMessage.id;
   const auto state_of = [](const LoggedFrame* f) { return status_of(f).state; };
   // Under User-Mode Linux every system call is expensive and the feeders
@@ -398,6 +432,62 @@ int check(const Model& m, const std::string& log_path) {
       std::printf("last STATUS: overruns %lld, execution max %lld us, mean %lld us; jitter max %d us\n",
                   (long long)status_of(s.back()).overruns, (long long)status_of(s.back()).exec_max_us,
                   (long long)status_of(s.back()).exec_mean_us, last_stat(phases, 7, &protocol::Stats::jitter_max_us));
+    }
+  }
+  // 8: pose targets one after another: every attempt sent gets exactly one
+  // final IK_REPORT (in_progress ones aside), each target's last attempt
+  // converged, and poses kept coming while it was solved.
+  {
+    const std::uint32_t commit_id = protocol::target_position_z::kMessage.id;
+    const std::uint32_t report_id = protocol::ik_report::kMessage.id;
+    const std::uint32_t pose_id = protocol::pose_orientation::kMessage.id;
+    for (int t = 0; t < kPoseTargets; ++t) {
+      int attempts = 0;
+      bool converged = false;
+      for (int a = 0; a < kPoseTargetAttempts; ++a) {
+        const std::uint8_t sequence = pose_target_sequence(t, a);
+        double committed_s = -1;
+        for (const LoggedFrame& f : phases[8].frames) {
+          protocol::TargetPositionZ commit;
+          if (f.frame.id == commit_id && protocol::decode(f.frame, commit) == protocol::DecodeStatus::ok &&
+              commit.sequence == sequence) {
+            committed_s = f.time_s;
+            break;
+          }
+        }
+        if (committed_s < 0) continue;
+        ++attempts;
+        int finals = 0, poses = 0;
+        protocol::IkReport final_report;
+        bool ended = false;
+        for (const LoggedFrame& f : phases[8].frames) {
+          if (f.time_s < committed_s) continue;
+          protocol::IkReport report;
+          if (f.frame.id == report_id && protocol::decode(f.frame, report) == protocol::DecodeStatus::ok &&
+              report.sequence == sequence && report.outcome != protocol::IkOutcome::in_progress) {
+            ++finals;
+            if (!ended) final_report = report;
+            ended = true;
+          }
+          if (!ended && f.frame.id == pose_id) ++poses;
+        }
+        const std::string name = "pose target " + std::to_string(t) + " attempt " + std::to_string(a);
+        c.expect(finals == 1, name + ": exactly one final IK_REPORT (got " + std::to_string(finals) + ")");
+        if (finals == 0) continue;
+        std::printf("%s: outcome %d after %d cycles, %d iterations, %.4f mm / %.2g rad; %d poses meanwhile\n",
+                    name.c_str(), int(final_report.outcome), final_report.cycles, final_report.iterations,
+                    final_report.position_residual_mm, final_report.orientation_residual_rad, poses);
+        if (final_report.outcome == protocol::IkOutcome::converged) {
+          converged = true;
+          // At least one pose every other cycle of the solve: the solve's
+          // work is spread over cycles, and each cycle still publishes.
+          c.expect(poses >= 1 && 2 * poses >= final_report.cycles,
+                   name + ": poses kept coming during the solve (" + std::to_string(poses) + " in " +
+                       std::to_string(final_report.cycles) + " cycles)");
+        }
+      }
+      c.expect(attempts > 0, "pose target " + std::to_string(t) + ": sent");
+      c.expect(converged, "pose target " + std::to_string(t) + ": converged");
     }
   }
   std::printf("%d check(s) failed\n", c.failures());
