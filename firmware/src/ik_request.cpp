@@ -24,11 +24,12 @@ void IkRequest::start(const Pose& target, const TargetRequest& request, const Po
       request.mode == protocol::TargetMode::pose ? model::IkTargetKind::pose : model::IkTargetKind::position;
   model::Status started = model::Status::ok;
   // A streamed target starts where the last request's best point is, with
-  // the correction there and its slope known; any other from the setpoints.
+  // the correction there and its slope known; any other from the setpoints,
+  // and with the same knowledge when they are that point.
   solver_.set_preference(request.refuse_extrapolating ? preference_ : model::IkPreference<Scalar, kMaxSegments>{});
   started = retarget          ? solver_.retarget(target, kind, initial)
             : request.tracking ? solver_.start_warm(target, kind, initial)
-                              : solver_.start(target, kind, initial);
+                              : solver_.start_near(target, kind, initial);
   sequence_ = request.sequence;
   mode_ = request.mode;
   tracking_ = request.tracking;

@@ -233,6 +233,55 @@ TEST(IkSolver, PrefersSolutionsNearThePreferencesCentre) {
   EXPECT_LT(with, 0.85f * without) << "with " << with << " without " << without;
 }
 
+// A target started from the last solve's answer (the setpoints it left)
+// starts where the correction is known: the solve needs no evaluation at its
+// start, and reaches the target as a start from scratch there does; from
+// any other joints it is start().
+TEST(IkSolver, AStartAtTheLastAnswerReusesItsCorrection) {
+  Fixture f;
+  static Solver solver;
+  make(f, 203, {&solver});
+  std::mt19937 rng(31);
+  const auto target_of = [&](const JointVector<float>& q) {
+    const JointVector<float> b = bend_from_joints(q);
+    return Pose<float>(exp(f.correction.predict(b)) * forward_kinematics_bend(b, f.geometry));
+  };
+  JointVector<float> straight = JointVector<float>::Zero(8);
+  for (int s = 0; s < 4; ++s) straight[2 * s + 1] = 0.1f;
+  int fewer = 0;
+  for (int t = 0; t < 10; ++t) {
+    const Pose<float> first = target_of(random_joints(rng, 4, 0.2));
+    const JointVector<float> other = random_joints(rng, 4, 0.2);
+    const Pose<float> second = target_of(random_joints(rng, 4, 0.2));
+    // The same first solve each time: the solver is deterministic.
+    const auto solve_first = [&] {
+      ASSERT_EQ(solver.start(first, IkTargetKind::pose, straight), Status::ok);
+      ASSERT_EQ(solver.run_to_end(), IkSolveState::converged);
+    };
+    solve_first();
+    const JointVector<float> answer = solver.best_joints();
+    ASSERT_EQ(solver.start(second, IkTargetKind::pose, answer), Status::ok);
+    ASSERT_EQ(solver.run_to_end(), IkSolveState::converged) << t;
+    const int from_scratch = solver.corrections();
+
+    solve_first();
+    ASSERT_EQ(solver.start_near(second, IkTargetKind::pose, solver.best_joints()), Status::ok);
+    ASSERT_EQ(solver.run_to_end(), IkSolveState::converged) << t;
+    EXPECT_LE(solver.best_position_error_mm(), 2e-3f);
+    fewer += solver.corrections() < from_scratch ? 1 : 0;
+
+    // From other joints it is start().
+    ASSERT_EQ(solver.start(second, IkTargetKind::pose, other), Status::ok);
+    solver.run_to_end();
+    const int from_other = solver.corrections();
+    solve_first();
+    ASSERT_EQ(solver.start_near(second, IkTargetKind::pose, other), Status::ok);
+    solver.run_to_end();
+    EXPECT_EQ(solver.corrections(), from_other) << t;
+  }
+  EXPECT_GE(fewer, 7);
+}
+
 // Between evaluations the solver offers the linearised solve's point; its
 // residual is the linearised model's, which near the last evaluation is the
 // compensated model's (computed here from its joints) to well within the
