@@ -55,11 +55,11 @@ void IkRequest::configure() {
   // In DEGRADED the same solver solves the nominal model.
   solver_.configure(model_.geometry, model_.compensated ? &solver_correction_ : nullptr,
                     runtime_solver_options<Scalar>(), kIkWorkCosts);
-  // Only a target that refuses extrapolation gets the preference: for the
-  // others it cost 1-2 cycles of p50 latency on the paper's targets (M7
-  // 24 -> 25, M4F 18 -> 20) and took the M4F's worst cycle past its budget
-  // (122,160 instructions), where the refusing ones need it (inside the
-  // data: 1 of 20 refused without it, 0 with it, on both boards).
+  // Only a target that refuses extrapolation gets the preference: the
+  // refusing ones need it (inside the data: 1 of 20 refused without it, 0
+  // with it, on both boards); for every target, in the QEMU workload, the
+  // paper's pose targets took p50/p99 M7 23/42 and M4F 17/37 cycles (21/54
+  // and 15/37 without), at a third of the gain M7 21/41 and M4F 17/45.
   preference_ = ik_preference(model_.geometry, model_.compensated ? &model_.image : nullptr);
 }
 
