@@ -30,6 +30,7 @@
 #include <cmath>
 
 #include <cdcr/cortexm/semihosting.hpp>
+#include <cdcr/firmware/ik_settings.hpp>
 #include <cdcr/firmware/runtime.hpp>
 
 #include "board.hpp"
@@ -182,7 +183,7 @@ int solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies
 firmware::Solver probe_solver;
 firmware::SolverCorrection probe_correction(correction);
 
-void report_unit_costs() {
+void report_unit_costs(const model::ImageView& image) {
   const std::uint32_t points = correction.training_points();
   model::JointVector<float> bend = model::JointVector<float>::Zero(2 * segments);
   for (int s = 0; s < segments; ++s) bend[2 * s] = 0.1f;
@@ -204,8 +205,17 @@ void report_unit_costs() {
     std::uint32_t units, max = 0, count = 0;
     std::uint64_t total = 0;
   } steps[3] = {{kProbeJacobian}, {kProbeStep}, {kProbeOuter}};
-  for (int t = 0; t < 16; ++t) {
-    const model::Pose<float> target = reachable_target(t % 2 ? 0.2f : 1.5f);
+  // The same targets again with the preference a target that refuses
+  // extrapolation has: its steps' own cost.
+  Step preferred_step{kProbeStep};
+  model::Pose<float> targets[16];
+  for (int t = 0; t < 16; ++t) targets[t] = reachable_target(t % 2 ? 0.2f : 1.5f);
+  for (int pass = 0; pass < 32; ++pass) {
+    const int t = pass % 16;
+    if (pass == 16) probe_solver.set_preference(firmware::ik_preference(runtime.geometry(), &image));
+    Step* measured = pass < 16 ? steps : &preferred_step;
+    const int kinds = pass < 16 ? 3 : 1;
+    const model::Pose<float>& target = targets[t];
     model::JointVector<float> initial(2 * segments);
     for (int s = 0; s < segments; ++s) {
       initial[2 * s] = 0.0f;
@@ -216,7 +226,8 @@ void report_unit_costs() {
     for (int call = 0; call < 4000 && probe_solver.state() == model::IkSolveState::running; ++call) {
       std::uint32_t units = 0;
       const std::uint32_t instructions = counter.instructions([&] { units = probe_solver.run(kProbeBudget); });
-      for (Step& step : steps) {
+      for (int k = 0; k < kinds; ++k) {
+        Step& step = measured[k];
         if (units != step.units) continue;
         step.max = std::max(step.max, instructions);
         step.total += instructions;
@@ -236,6 +247,9 @@ void report_unit_costs() {
     write(names[i], steps[i].count ? std::uint32_t(steps[i].total / steps[i].count) : 0);
     write(" max ", steps[i].max);
   }
+  write("; nominal step with the preference mean ",
+        preferred_step.count ? std::uint32_t(preferred_step.total / preferred_step.count) : 0);
+  write(" max ", preferred_step.max);
   write("; start max ", start_max);
   // A request's end: the setpoints (cable lengths of the joints and their
   // frames) and the report's frame, as the runtime makes them.
@@ -343,7 +357,7 @@ int main() {
   console::console_write(" training points; IK work per cycle ");
   console::console_write_int(static_cast<std::int32_t>(runtime.ik_units_per_cycle()));
   console::console_write(" units\n");
-  report_unit_costs();
+  report_unit_costs(image);
   const bool with_hysteresis = cdcr::qemu_programs::kExpectHysteresisBlock;
   if (runtime.hysteresis().active() != with_hysteresis) {
     console::console_write(with_hysteresis ? "FAIL: the image's hysteresis block is not tracked\n"
