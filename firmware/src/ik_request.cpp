@@ -23,10 +23,15 @@ void IkRequest::start(const Pose& target, const TargetRequest& request, const Po
   const model::IkTargetKind kind =
       request.mode == protocol::TargetMode::pose ? model::IkTargetKind::pose : model::IkTargetKind::position;
   model::Status started = model::Status::ok;
+  // Only a target that refuses extrapolation gets the preference: the
+  // refusing ones need it (inside the data: 1 of 20 refused without it, 0
+  // with it, on both boards); for every target, in the QEMU workload, the
+  // paper's pose targets took p50/p99 M7 23/42 and M4F 17/37 cycles (21/54
+  // and 15/37 without), at a third of the gain M7 21/41 and M4F 17/45.
+  solver_.set_preference(request.refuse_extrapolating ? preference_ : model::IkPreference<Scalar, kMaxSegments>{});
   // A streamed target starts where the last request's best point is, with
   // the correction there and its slope known; any other from the setpoints,
   // and with the same knowledge when they are that point.
-  solver_.set_preference(request.refuse_extrapolating ? preference_ : model::IkPreference<Scalar, kMaxSegments>{});
   started = retarget          ? solver_.retarget(target, kind, initial)
             : request.tracking ? solver_.start_warm(target, kind, initial)
                               : solver_.start_near(target, kind, initial);
@@ -55,11 +60,6 @@ void IkRequest::configure() {
   // In DEGRADED the same solver solves the nominal model.
   solver_.configure(model_.geometry, model_.compensated ? &solver_correction_ : nullptr,
                     runtime_solver_options<Scalar>(), kIkWorkCosts);
-  // Only a target that refuses extrapolation gets the preference: the
-  // refusing ones need it (inside the data: 1 of 20 refused without it, 0
-  // with it, on both boards); for every target, in the QEMU workload, the
-  // paper's pose targets took p50/p99 M7 23/42 and M4F 17/37 cycles (21/54
-  // and 15/37 without), at a third of the gain M7 21/41 and M4F 17/45.
   preference_ = ik_preference(model_.geometry, model_.compensated ? &model_.image : nullptr);
 }
 

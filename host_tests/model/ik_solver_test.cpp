@@ -49,6 +49,11 @@ void make(Fixture& f, int training_points, std::initializer_list<Solver*> solver
   for (Solver* solver : solvers) solver->configure(f.geometry, f.correction);
 }
 
+// The compensated model's tip pose at a bend vector.
+Pose<float> compensated_pose(const Fixture& f, const JointVector<float>& bend) {
+  return exp(f.correction.predict(bend)) * forward_kinematics_bend(bend, f.geometry);
+}
+
 JointVector<float> random_joints(std::mt19937& rng, int segments, double theta_max) {
   std::uniform_real_distribution<double> alpha(-3.1, 3.1), theta(0.0, theta_max);
   JointVector<float> q(2 * segments);
@@ -107,7 +112,7 @@ TEST(IkSolver, ResultDoesNotDependOnTheBudgetAndNoCallExceedsIt) {
   for (int trial = 0; trial < 30; ++trial) {
     const JointVector<float> q = random_joints(rng, 4, 0.3);
     const JointVector<float> b = bend_from_joints(q);
-    const Pose<float> target = exp(f.correction.predict(b)) * forward_kinematics_bend(b, f.geometry);
+    const Pose<float> target = compensated_pose(f, b);
     const IkTargetKind kind = trial % 3 == 0 ? IkTargetKind::position : IkTargetKind::pose;
     ASSERT_EQ(whole.start(target, kind, start), Status::ok);
     ASSERT_EQ(sliced.start(target, kind, start), Status::ok);
@@ -128,8 +133,7 @@ TEST(IkSolver, ResultDoesNotDependOnTheBudgetAndNoCallExceedsIt) {
       ++converged;
       // Independently: the compensated model at the answer, in double.
       const JointVector<float> answer = sliced.best_joints();
-      const Pose<float> tip = exp(f.correction.predict(bend_from_joints(answer))) *
-                              forward_kinematics_bend(JointVector<float>(bend_from_joints(answer)), f.geometry);
+      const Pose<float> tip = compensated_pose(f, bend_from_joints(answer));
       EXPECT_LE((tip.position_mm - target.position_mm).norm(), 5e-3f);
     }
   }
@@ -166,7 +170,7 @@ TEST(IkSolver, WarmStartsAlongAPathNeedFewEvaluations) {
     JointVector<float> p = q;
     for (int s = 0; s < 4; ++s) p[2 * s] += float(0.2 * t);
     const JointVector<float> b = bend_from_joints(p);
-    return Pose<float>(exp(f.correction.predict(b)) * forward_kinematics_bend(b, f.geometry));
+    return compensated_pose(f, b);
   };
   ASSERT_EQ(solver.start(target_at(0), IkTargetKind::pose, q), Status::ok);
   ASSERT_EQ(solver.run_to_end(), IkSolveState::converged);
@@ -209,11 +213,11 @@ TEST(IkSolver, PrefersSolutionsNearThePreferencesCentre) {
     converged = 0;
     for (int t = 0; t < 60; ++t) {
       const JointVector<float> b = bend_from_joints(random_joints(rng, 4, 0.15));
-      const Pose<float> target = exp(f.correction.predict(b)) * forward_kinematics_bend(b, f.geometry);
+      const Pose<float> target = compensated_pose(f, b);
       EXPECT_EQ(solver.start(target, IkTargetKind::pose, start), Status::ok);
       while (solver.state() == IkSolveState::running) solver.run(500);
       const JointVector<float> answer = solver.best_bend();
-      const Pose<float> reached = exp(f.correction.predict(answer)) * forward_kinematics_bend(answer, f.geometry);
+      const Pose<float> reached = compensated_pose(f, answer);
       if ((reached.position_mm - target.position_mm).norm() > 0.005f) continue;
       ++converged;
       start = solver.best_joints();
@@ -245,7 +249,7 @@ TEST(IkSolver, AStartAtTheLastAnswerReusesItsCorrection) {
   std::mt19937 rng(31);
   const auto target_of = [&](const JointVector<float>& q) {
     const JointVector<float> b = bend_from_joints(q);
-    return Pose<float>(exp(f.correction.predict(b)) * forward_kinematics_bend(b, f.geometry));
+    return compensated_pose(f, b);
   };
   JointVector<float> straight = JointVector<float>::Zero(8);
   for (int s = 0; s < 4; ++s) straight[2 * s + 1] = 0.1f;
@@ -309,7 +313,7 @@ TEST(IkSolver, AStreamedPathStaysOnOneBranch) {
   };
   const auto target_at = [&](int k) {
     const JointVector<float> b = bend_from_joints(path_at(k));
-    return Pose<float>(exp(f.correction.predict(b)) * forward_kinematics_bend(b, f.geometry));
+    return compensated_pose(f, b);
   };
   ASSERT_EQ(solver.start(target_at(0), IkTargetKind::pose, path_at(0)), Status::ok);
   ASSERT_EQ(solver.run_to_end(), IkSolveState::converged);
@@ -325,7 +329,7 @@ TEST(IkSolver, AStreamedPathStaysOnOneBranch) {
   // A cycle of the path moves a bend component by about 0.5 mrad; the
   // answers moved at most 0.6 mrad a cycle.
   EXPECT_LT(largest_move, 0.005f);
-  const Pose<float> reached = exp(f.correction.predict(last)) * forward_kinematics_bend(last, f.geometry);
+  const Pose<float> reached = compensated_pose(f, last);
   EXPECT_LT((reached.position_mm - target_at(600).position_mm).norm(), 0.05f);
 }
 
@@ -344,13 +348,13 @@ TEST(IkSolver, LinearisedPointIsWhereItsResidualSays) {
     JointVector<float> goal = start;
     for (int s = 0; s < 4; ++s) goal[2 * s + 1] += 0.02f;
     const JointVector<float> goal_bend = bend_from_joints(goal);
-    const Pose<float> target = exp(f.correction.predict(goal_bend)) * forward_kinematics_bend(goal_bend, f.geometry);
+    const Pose<float> target = compensated_pose(f, goal_bend);
     ASSERT_EQ(solver.start(target, IkTargetKind::position, start), Status::ok);
     while (solver.state() == IkSolveState::running) {
       solver.run(400);
       if (!solver.has_linearised_point()) continue;
       const JointVector<float> bend = bend_from_joints(solver.linearised_joints());
-      const Pose<float> tip = exp(f.correction.predict(bend)) * forward_kinematics_bend(bend, f.geometry);
+      const Pose<float> tip = compensated_pose(f, bend);
       const float exact = (target.position_mm - tip.position_mm).norm();
       EXPECT_NEAR(exact, solver.linearised_position_error_mm(), 0.05f) << "target " << t;
       ++checked;

@@ -136,30 +136,19 @@ cdcr_zynqmp_reset:
     /* The MPU: three regions and nothing else, so a stray access anywhere
      * else (the OCM, the DDR above 2 GiB, the other peripherals) is a data
      * abort instead of a silent read or write. No background region. */
-    mov r0, #MPU_REGION_MEMORY
+    .macro mpu_region number, base, access, size_enable
+    mov r0, #\number
     mcr p15, 0, r0, c6, c2, 0           /* RGNR */
-    ldr r0, =MPU_MEMORY_BASE
+    ldr r0, =\base
     mcr p15, 0, r0, c6, c1, 0           /* DRBAR */
-    ldr r0, =MPU_MEMORY_ACCESS
+    ldr r0, =\access
     mcr p15, 0, r0, c6, c1, 4           /* DRACR */
-    ldr r0, =MPU_MEMORY_SIZE_ENABLE
+    ldr r0, =\size_enable
     mcr p15, 0, r0, c6, c1, 2           /* DRSR */
-    mov r0, #MPU_REGION_PERIPHERALS
-    mcr p15, 0, r0, c6, c2, 0
-    ldr r0, =MPU_PERIPHERALS_BASE
-    mcr p15, 0, r0, c6, c1, 0
-    ldr r0, =MPU_PERIPHERALS_ACCESS
-    mcr p15, 0, r0, c6, c1, 4
-    ldr r0, =MPU_PERIPHERALS_SIZE_ENABLE
-    mcr p15, 0, r0, c6, c1, 2
-    mov r0, #MPU_REGION_CORE_SHARED
-    mcr p15, 0, r0, c6, c2, 0
-    ldr r0, =__core_shared_start__
-    mcr p15, 0, r0, c6, c1, 0
-    ldr r0, =MPU_CORE_SHARED_ACCESS
-    mcr p15, 0, r0, c6, c1, 4
-    ldr r0, =MPU_CORE_SHARED_SIZE_ENABLE
-    mcr p15, 0, r0, c6, c1, 2
+    .endm
+    mpu_region MPU_REGION_MEMORY, MPU_MEMORY_BASE, MPU_MEMORY_ACCESS, MPU_MEMORY_SIZE_ENABLE
+    mpu_region MPU_REGION_PERIPHERALS, MPU_PERIPHERALS_BASE, MPU_PERIPHERALS_ACCESS, MPU_PERIPHERALS_SIZE_ENABLE
+    mpu_region MPU_REGION_CORE_SHARED, __core_shared_start__, MPU_CORE_SHARED_ACCESS, MPU_CORE_SHARED_SIZE_ENABLE
 
     /* Both caches invalidated before they are enabled (their contents are
      * unknown after reset): the instruction cache at once, the data cache

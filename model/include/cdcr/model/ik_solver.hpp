@@ -954,8 +954,11 @@ class IkSolver {
     // at a time: Eigen's solve of a two-column right-hand side goes
     // through a blocked path that allocates.)
     using Step = Eigen::Matrix<S, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxColumns, 1>;
-    Step z = Step::Zero(columns);
+    const Eigen::LDLT<Eigen::Matrix<S, Rows, Rows>> factor = normal.ldlt();
+    const Eigen::Matrix<S, Rows, 1> y = factor.solve(inner_residual_.template head<Rows>());
+    Step step = used.transpose().lazyProduct(y);
     if (preferred) {
+      Step z(columns);
       columns = 0;
       for (int i = 0; i < segments; ++i) {
         const Vec2<S> b = inner_bend_.template segment<2>(2 * i);
@@ -972,14 +975,8 @@ class IkSolver {
           columns += 2;
         }
       }
-    }
-    const Eigen::LDLT<Eigen::Matrix<S, Rows, Rows>> factor = normal.ldlt();
-    const Eigen::Matrix<S, Rows, 1> y = factor.solve(inner_residual_.template head<Rows>());
-    Step step = used.transpose().lazyProduct(y);
-    if (preferred) {
       const Eigen::Matrix<S, Rows, 1> seen = used.lazyProduct(z);
-      const Eigen::Matrix<S, Rows, 1> y_seen = factor.solve(seen);
-      Step null_step = z - used.transpose().lazyProduct(y_seen);
+      Step null_step = z - used.transpose().lazyProduct(factor.solve(seen));
       // Never longer than the pose task's own step: the preference's leak
       // through the damping then stays a fraction of the step, and the last
       // steps before a solution are left alone (in the IK bench, with no cap
