@@ -9,14 +9,24 @@
 // Near the straight robot the tip's travel along the backbone and its roll
 // about it are weakly actuated (a few mm/rad, no more than the slope of
 // this model's correction): the last outer iterations let the residual
-// wander at 2-3 um (2.1 -> 2.5 -> 3.5 um), and the floor rule stopped the
-// solve a few um short after two stalled iterations: 190 of 200 near
-// straight and 197 of 200 in the paper's workspace converged. With a third
-// iteration allowed within 3 tolerances (ik_solver.hpp, outer_step): 199 and 200.
-// The floors sit just under that.
+// wander at 2-3 um (2.1 -> 2.5 -> 3.5 um), and a stall rule that ends the
+// solve after two stalled iterations stops it a few um short. A third
+// iteration is allowed within 3 tolerances (ik_solver.hpp, outer_step).
+//
+// Which targets end a few um short depends on the last bits of the float
+// arithmetic, so the counts differ from CPU to CPU: the image the build
+// trains depends on OpenBLAS's kernels and glibc's maths variants, and the
+// host's GP loops are AVX2 or portable. The floors below sit under the
+// lowest count of 24 runs (the image trained with five kernel sets, each
+// target set solved with the AVX2 and the portable GP loops, three target
+// seeds) with a margin of about two standard deviations of the count; with
+// the stall rule's third iteration removed, the near-straight count falls
+// below its floor on every kernel set (tools/bench/README.md, "IK on
+// other CPUs"). 2,000 targets a set keep the two apart.
 
 #include <algorithm>
 #include <cstdint>
+#include <cstdlib>
 #include <fstream>
 #include <iterator>
 #include <random>
@@ -37,6 +47,7 @@ using Correction = GpCorrection<float, double, kMaxSegments>;
 using Solver = IkSolver<float, kMaxSegments, Correction>;
 
 constexpr double kPi = 3.14159265358979323846;
+constexpr int kTargets = 2000;
 
 struct DemoModel {
   std::vector<std::uint8_t> image;
@@ -45,9 +56,17 @@ struct DemoModel {
   Correction correction;
 };
 
+// The image under test: the build's demo model, or the one named by
+// CDCR_DEMO_MODEL_IMAGE (the same data trained with other CPUs' kernels).
+std::string demo_model_path() {
+  const char* path = std::getenv("CDCR_DEMO_MODEL_IMAGE");
+  return path != nullptr ? path : CDCR_DEMO_MODEL_IMAGE;
+}
+
 void load(DemoModel& m) {
-  std::ifstream file(CDCR_DEMO_MODEL_IMAGE, std::ios::binary);
-  ASSERT_TRUE(file) << "no demo model at " CDCR_DEMO_MODEL_IMAGE " (the qemu.golden test makes it)";
+  const std::string path = demo_model_path();
+  std::ifstream file(path, std::ios::binary);
+  ASSERT_TRUE(file) << "no demo model at " << path << " (the qemu.golden test makes it)";
   m.image.assign(std::istreambuf_iterator<char>(file), std::istreambuf_iterator<char>());
   ImageCapacity capacity;
   capacity.max_training_points = 4096;
@@ -95,34 +114,33 @@ int converged_from_straight(const DemoModel& m, Solver& solver, double theta_max
   return converged;
 }
 
-// 200 of the model's own poses with every bend up to theta_max_rad, from the
+// kTargets of the model's own poses with every bend up to theta_max_rad, from the
 // straight start: at least `floor` converge.
 void expect_converged_from_straight(double theta_max_rad, unsigned seed, int floor) {
   DemoModel m;
   ASSERT_NO_FATAL_FAILURE(load(m));
   static Solver solver;
-  const int converged = converged_from_straight(m, solver, theta_max_rad, 200, seed);
+  const int converged = converged_from_straight(m, solver, theta_max_rad, kTargets, seed);
   ::testing::Test::RecordProperty("converged", converged);
   EXPECT_GE(converged, floor);
 }
 
-TEST(IkDemoModel, NearStraightPoseTargetsConvergeFromStraight) { expect_converged_from_straight(0.06, 2606u, 197); }
+TEST(IkDemoModel, NearStraightPoseTargetsConvergeFromStraight) { expect_converged_from_straight(0.06, 2606u, 1935); }
 
-TEST(IkDemoModel, PaperWorkspacePoseTargetsConvergeFromStraight) { expect_converged_from_straight(0.2, 2620u, 199); }
+TEST(IkDemoModel, PaperWorkspacePoseTargetsConvergeFromStraight) { expect_converged_from_straight(0.2, 2620u, 1930); }
 
 // The full design range and targets on the theta limit: the restarts and
-// the active set (the floors guard those; this change leaves them as they
-// were).
+// the active set.
 TEST(IkDemoModel, FullRangeAndLimitPoseTargetsConvergeFromStraight) {
   DemoModel m;
   ASSERT_NO_FATAL_FAILURE(load(m));
   static Solver solver;
-  const int full_range = converged_from_straight(m, solver, kPi / 2, 200, 2657u);
-  const int at_limit = converged_from_straight(m, solver, kPi / 2, 200, 2658u, true);
+  const int full_range = converged_from_straight(m, solver, kPi / 2, kTargets, 2657u);
+  const int at_limit = converged_from_straight(m, solver, kPi / 2, kTargets, 2658u, true);
   RecordProperty("full_range_converged", full_range);
   RecordProperty("at_limit_converged", at_limit);
-  EXPECT_GE(full_range, 198);
-  EXPECT_GE(at_limit, 196);
+  EXPECT_GE(full_range, 1975);
+  EXPECT_GE(at_limit, 1940);
 }
 
 }  // namespace
