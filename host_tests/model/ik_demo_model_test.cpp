@@ -63,6 +63,13 @@ std::string demo_model_path() {
   return path != nullptr ? path : CDCR_DEMO_MODEL_IMAGE;
 }
 
+// Added to every target set's seed: other target sets of the same kinds,
+// for measuring the counts' spread (tools/bench/run_ik_other_cpus_bench.sh).
+unsigned target_seed(unsigned seed) {
+  const char* offset = std::getenv("CDCR_IK_TARGET_SEED_OFFSET");
+  return seed + (offset != nullptr ? static_cast<unsigned>(std::strtoul(offset, nullptr, 10)) : 0u);
+}
+
 void load(DemoModel& m) {
   const std::string path = demo_model_path();
   std::ifstream file(path, std::ios::binary);
@@ -89,7 +96,7 @@ int converged_from_straight(const DemoModel& m, Solver& solver, double theta_max
     straight[2 * s] = 0.0f;
     straight[2 * s + 1] = 0.1f;
   }
-  std::mt19937 rng(seed);
+  std::mt19937 rng(target_seed(seed));
   std::uniform_real_distribution<double> alpha(-kPi, kPi), theta(0.0, theta_max);
   int converged = 0;
   for (int t = 0; t < targets; ++t) {
