@@ -12,6 +12,15 @@
 # or by running it, and a firmware, model or bus test that needs a sender
 # or a report uses the layer that has it.
 #
+# Within the HAL, the interfaces (hal/include) and each backend (hal/linux,
+# hal/sim, ...) are layers of their own: the runtime is written against the
+# interfaces only (hal/hal.hpp), so the model, the HAL's interfaces and the
+# firmware include no backend's header, and a backend none of another's
+# but the bare-metal code it builds on (hal/baremetal, under hal/cortexm and
+# hal/zynqmp). What picks a backend may include it: a board (firmware/boards)
+# or an example's board file (firmware/examples), the C API its callbacks'
+# backend (hal/callbacks), the tools and the tests any.
+#
 # Every #include of every source file under the four folders is resolved the
 # way the compiler would find it in this tree (next to the including file, or
 # as the tail of a path below a layer); a header found nowhere in the tree (a
@@ -36,6 +45,26 @@ layer_of() {
   esac
 }
 
+# Sets `backend` to the HAL backend folder a path lies in (hal/linux, ...;
+# empty: none).
+backend_of() {
+  backend=
+  if [[ $1 == hal/*/* && $1 != hal/include/* ]]; then
+    backend=${1#hal/}
+    backend=hal/${backend%%/*}
+  fi
+}
+
+# The backends `file` may include (besides its own): "any" or a list.
+backends_allowed() {
+  case $1 in
+    hal/cortexm/* | hal/zynqmp/*) allowed=hal/baremetal ;;
+    firmware/boards/* | firmware/examples/* | tools/*) allowed=any ;;
+    firmware/include/cdcr/cdcr.h | firmware/src/c_api.cpp) allowed=hal/callbacks ;;
+    *) allowed= ;;
+  esac
+}
+
 source_files() {
   find "$@" -type f \( -name '*.hpp' -o -name '*.h' -o -name '*.cpp' -o -name '*.c' -o -name '*.inc' \) | LC_ALL=C sort
 }
@@ -51,8 +80,11 @@ fi
 # folders they lie in.
 declare -A lowest_layer
 declare -A tool_folders
+declare -A tail_backends   # the backends a tail names, if it names only backends' files
+declare -A tail_elsewhere  # set: the tail names a file outside every backend
 for file in "${sources[@]}"; do
   layer_of "$file"
+  backend_of "$file"
   tool_folder=
   if [[ $file == tools/*/* ]]; then
     tool_folder=${file#tools/}
@@ -66,6 +98,11 @@ for file in "${sources[@]}"; do
     fi
     if [[ -n $tool_folder && " ${tool_folders[$tail]:-} " != *" $tool_folder "* ]]; then
       tool_folders[$tail]="${tool_folders[$tail]:-} $tool_folder"
+    fi
+    if [[ -z $backend ]]; then
+      tail_elsewhere[$tail]=1
+    elif [[ " ${tail_backends[$tail]:-} " != *" $backend "* ]]; then
+      tail_backends[$tail]="${tail_backends[$tail]:-} $backend"
     fi
   done
 done
@@ -124,10 +161,28 @@ while IFS= read -r match; do
     echo "$file:$line_number: includes $included, a ${layer_names[target]} header, from ${layer_names[own]}"
     violations=$((violations + 1))
   fi
+  # The backends the include can resolve to.
+  if [[ -f $beside ]]; then
+    backend_of "$beside"
+    reached_backends=$backend
+  elif [[ -z ${tail_elsewhere[$included]:-} ]]; then
+    reached_backends=${tail_backends[$included]:-}
+  else
+    reached_backends=
+  fi
+  if [[ -n $reached_backends ]]; then
+    backend_of "$file"
+    backends_allowed "$file"
+    for reached_backend in $reached_backends; do
+      [[ $reached_backend == "$backend" || $allowed == any || " $allowed " == *" $reached_backend "* ]] && continue
+      echo "$file:$line_number: includes $included, a header of the HAL backend $reached_backend, from ${backend:-${layer_names[own]}}"
+      violations=$((violations + 1))
+    done
+  fi
 done < <(grep -nH -E '^[[:space:]]*#[[:space:]]*include' "${sources[@]}" "${tests[@]}")
 
 if ((violations > 0)); then
-  echo "$violations include(s) go up the chain model <- hal <- firmware <- tools/sim <- tools or join what is kept apart"
+  echo "$violations include(s) go up the chain model <- hal <- firmware <- tools/sim <- tools, reach a HAL backend from outside it, or join what is kept apart"
   exit 1
 fi
-echo "$((${#sources[@]} + ${#tests[@]})) files, $checked includes: none goes up the chain model <- hal <- firmware <- tools/sim <- tools, tools/train and tools/export include nothing of each other, no test includes tools/cdcr"
+echo "$((${#sources[@]} + ${#tests[@]})) files, $checked includes: none goes up the chain model <- hal <- firmware <- tools/sim <- tools, none reaches a HAL backend but from what picks it, tools/train and tools/export include nothing of each other, no test includes tools/cdcr"

@@ -113,7 +113,7 @@ class IntelHex : public ExportTest, public ::testing::WithParamInterface<HexCase
 
 TEST_P(IntelHex, ObjcopyDecodesTheImageAtItsAddress) {
 #ifndef CDCR_OBJCOPY
-  GTEST_SKIP() << "objcopy not found";
+  FAIL() << "objcopy not found: install binutils (build-essential), which CMake finds as CDCR_OBJCOPY";
 #else
   const HexCase c = GetParam();
   const Bytes image = c.large ? large_image() : small_image();

@@ -8,11 +8,21 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cdcr/hal/nor_flash_model.hpp>
+
 namespace cdcr::linux_host {
 
 namespace {
 constexpr std::size_t kFileBytes = std::size_t(FileFlash::kSectorBytes) * FileFlash::kSectorCount;
-}
+
+// A copy of one sector of the file, changed under the NOR rules every flash
+// of the project shares; the worker writes the changed bytes back.
+class SectorCopy final : public hal::NorFlashModel {
+ public:
+  explicit SectorCopy(std::uint8_t* bytes)
+      : NorFlashModel(bytes, FileFlash::kSectorBytes, 1, FileFlash::kMaxProgramBytes, hal::NorFlashTiming{0, 0}) {}
+};
+}  // namespace
 
 FileFlash::~FileFlash() {
   if (worker_.joinable()) {
@@ -121,14 +131,15 @@ void FileFlash::work() {
     pending_ = false;
     const std::uint32_t offset = offset_;
     const std::uint32_t size = size_;
-    if (erase_) {
-      std::memset(bytes, 0xFF, size);
-    } else {
-      // NOR semantics: a program only clears bits.
-      for (std::uint32_t i = 0; i < size; ++i) bytes[i] = mapping_[offset + i] & data_[i];
-    }
+    const std::uint32_t sector_start = offset / kSectorBytes * kSectorBytes;
+    std::memcpy(bytes, mapping_ + sector_start, kSectorBytes);
+    SectorCopy sector(bytes);
+    const hal::FlashStatus applied =
+        erase_ ? sector.start_erase(0) : sector.start_program(offset - sector_start, data_, size);
     lock.unlock();
-    const bool ok = pwrite(fd_, bytes, size, off_t(offset)) == static_cast<ssize_t>(size) && fdatasync(fd_) == 0;
+    const bool ok = applied == hal::FlashStatus::ok &&
+                    pwrite(fd_, bytes + (offset - sector_start), size, off_t(offset)) == static_cast<ssize_t>(size) &&
+                    fdatasync(fd_) == 0;
     failed_ = !ok;
     running_ = false;
   }

@@ -4,7 +4,8 @@
 // that the runtime's cycle never waits on the disk. An operation reports
 // done only after fdatasync(): what the runtime acknowledged survives a
 // SIGKILL or a power loss. Same semantics as a NOR flash (hal/flash.hpp):
-// erase writes 0xFF, program ANDs its bytes into what is there.
+// erase writes 0xFF, program ANDs its bytes into what is there, applied by
+// the HAL's one NOR model (hal/nor_flash_model.hpp) to a copy of the sector.
 
 #include <atomic>
 #include <condition_variable>
