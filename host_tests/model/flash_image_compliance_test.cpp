@@ -128,6 +128,8 @@ TEST_F(FlashImageCompliance, EveryBadValueIsRefusedWithItsFindingUnderAValidCrc)
       {"negative ratio", 3, -0.5f, "compliance_ratio"},
       {"infinite softening", 5, inf, "compliance_softening"},
       {"softening turning the compliance negative within a quarter turn", 5, -0.65f, "compliance_softening"},
+      {"softening turning the compliance to zero at a quarter turn", 5,
+       static_cast<float>(-1.0 / kComplianceLargestBendRad), "compliance_softening"},
       {"NaN unloaded mass", 6, nan, "compliance_unloaded_mass"},
       {"negative unloaded mass", 6, -0.01f, "compliance_unloaded_mass"},
   };

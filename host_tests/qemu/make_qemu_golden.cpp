@@ -13,7 +13,9 @@
 //                                 the poses the host computes for them in
 //                                 double: compensated with the image, and
 //                                 nominal on the image's geometry (what a
-//                                 board falls back to without a usable image)
+//                                 board falls back to without a usable image),
+//                                 and compensated with PAYLOAD_IMAGE, its
+//                                 nominal pose sagged under its default payload
 //
 // The expected poses start from the image's float32 values widened to double
 // and from the float cable lengths the runtime decodes, so the comparison on
@@ -32,6 +34,7 @@
 
 #include "cdcr/firmware/protocol.hpp"
 #include "cdcr/model/compensated_kinematics.hpp"
+#include "cdcr/model/image_compliance.hpp"
 #include "export/binary_file.hpp"
 #include "export/c_source.hpp"
 #include "export/image_writer.hpp"
@@ -104,6 +107,7 @@ int main(int argc, char** argv) {
 
     std::ostringstream cables_text, joints_text;
     std::ostringstream compensated_position, compensated_rotation, nominal_position, nominal_rotation;
+    std::vector<cdcr::model::CableVector<double>> decoded_cables_mm;
     for (int c = 0; c < kCases; ++c) {
       cdcr::model::JointVector<double> joints(2 * segments);
       for (int s = 0; s < segments; ++s) {
@@ -133,6 +137,7 @@ int main(int argc, char** argv) {
         }
       }
       cables_text << "},\n";
+      decoded_cables_mm.push_back(cables_mm);
 
       cdcr::model::ForwardResult<double> result;
       if (cdcr::model::compensated_forward(cables_mm, geometry, correction, result) != Status::ok) {
@@ -190,6 +195,25 @@ int main(int argc, char** argv) {
       throw std::runtime_error(std::string(argv[3]) + ": no compliance block for the image's " +
                                std::to_string(segments) + " segments (cdcr train chose no sag)");
     }
+    cdcr::model::RobotGeometry<double> payload_geometry;
+    cdcr::model::GpCorrection<double, double> payload_correction;
+    cdcr::model::PayloadCompliance<double> compliance;
+    if (cdcr::model::geometry_from_image(payload_view, payload_geometry) != Status::ok ||
+        payload_correction.bind(payload_view) != Status::ok ||
+        !cdcr::model::compliance_from_image(payload_view, compliance)) {
+      throw std::runtime_error(std::string("cannot bind ") + argv[3]);
+    }
+    // A payload of zero would leave the payload's own sag unchecked.
+    if (!(payload_correction.payload_kg() > 0.0)) throw std::runtime_error(std::string(argv[3]) + ": no default payload");
+    std::ostringstream sagged_position, sagged_rotation;
+    for (const cdcr::model::CableVector<double>& cables_mm : decoded_cables_mm) {
+      cdcr::model::ForwardResult<double> result;
+      if (cdcr::model::compensated_forward(cables_mm, payload_geometry, payload_correction, compliance, result) !=
+          Status::ok) {
+        throw std::runtime_error("the payload model's compensated_forward failed on a golden input");
+      }
+      append_pose(result.compensated, sagged_position, sagged_rotation);
+    }
     c_options.description = std::string("a payload model with a compliance block, from ") + argv[3];
     write_text(dir + "/cdcr_model_image_compliance.cpp",
                cdcr::exporting::format_c_source(payload_image.data(), payload_image.size(), c_options));
@@ -220,6 +244,12 @@ int main(int argc, char** argv) {
            << "inline constexpr double kCompensatedRotation[kCases][9] = {\n" << compensated_rotation.str() << "};\n\n"
            << "inline constexpr double kNominalPositionMm[kCases][3] = {\n" << nominal_position.str() << "};\n\n"
            << "inline constexpr double kNominalRotation[kCases][9] = {\n" << nominal_rotation.str() << "};\n\n"
+           << "// The payload model of cdcr_model_image_compliance.cpp at the same cables: compensated,\n"
+           << "// its nominal pose sagged under the image's default payload.\n"
+           << "inline constexpr double kPayloadKg = " << exact(payload_correction.payload_kg()) << ";\n\n"
+           << "inline constexpr double kSaggedPositionMm[kCases][3] = {\n" << sagged_position.str() << "};\n\n"
+           << "// Row-major.\n"
+           << "inline constexpr double kSaggedRotation[kCases][9] = {\n" << sagged_rotation.str() << "};\n\n"
            << "}  // namespace cdcr::qemu_golden\n";
     write_text(dir + "/qemu_golden.hpp", header.str());
   } catch (const std::exception& error) {

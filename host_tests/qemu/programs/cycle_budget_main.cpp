@@ -24,7 +24,9 @@
 // (cdcr_qemu_cycle_budget_compliance, kExpectComplianceBlock), the runtime
 // sags the nominal pose under the payload in every cycle, and the program
 // reports what the sag costs: the forward path's sagged bends and the IK
-// correction's commanded bends, at most, in instructions.
+// correction's commanded bends, at most, in instructions. After the
+// measured cycles it checks the board's sagged pose at the golden cables
+// against the host's.
 
 #include <algorithm>
 #include <cmath>
@@ -345,6 +347,41 @@ void report_compliance_costs() {
   console::console_write(" units a cycle\n");
 }
 
+// The board's compensated pose at the golden cables, its nominal pose
+// sagged under the image's default payload, against the host's double one
+// (make_qemu_golden), within the replay's float32 fidelity targets.
+bool sagged_pose_matches_host() {
+  constexpr double kPositionToleranceMm = 0.01;
+  constexpr double kOrientationToleranceDeg = 0.001;
+  if (runtime.payload_kg() != float(cdcr::qemu_golden::kPayloadKg)) {
+    console::console_write("FAIL: the runtime's payload is not the image's default the host used\n");
+    return false;
+  }
+  cdcr::boards::mps2::PoseDeviation largest;
+  for (int c = 0; c < cdcr::qemu_golden::kCases; ++c) {
+    firmware::Cables cables_mm(4 * segments);
+    for (int i = 0; i < 4 * segments; ++i) cables_mm[i] = float(cdcr::qemu_golden::kCablesMm[c][i]);
+    firmware::PoseEstimate estimate;
+    if (runtime.estimate_pose(cables_mm, estimate) != model::Status::ok) {
+      console::console_write("FAIL: no sagged pose at a golden case\n");
+      return false;
+    }
+    const cdcr::boards::mps2::PoseDeviation d = cdcr::boards::mps2::deviation(
+        estimate.pose, cdcr::boards::mps2::golden_pose<double>(cdcr::qemu_golden::kSaggedPositionMm[c],
+                                                               cdcr::qemu_golden::kSaggedRotation[c]));
+    largest.position_mm = std::max(largest.position_mm, d.position_mm);
+    largest.orientation_deg = std::max(largest.orientation_deg, d.orientation_deg);
+  }
+  console::console_write("sagged pose, largest deviation from the host: ");
+  console::console_write_fixed(largest.position_mm, 6);
+  console::console_write(" mm, ");
+  console::console_write_fixed(largest.orientation_deg, 6);
+  console::console_write(" deg\n");
+  if (largest.position_mm <= kPositionToleranceMm && largest.orientation_deg <= kOrientationToleranceDeg) return true;
+  console::console_write("FAIL: the sagged pose beyond the float32 fidelity target\n");
+  return false;
+}
+
 }  // namespace
 
 int main() {
@@ -542,6 +579,7 @@ int main() {
     console::console_write("FAIL: the drives' moves did not make the hysteresis state known\n");
     ok = false;
   }
+  if (cdcr::qemu_programs::kExpectComplianceBlock && !sagged_pose_matches_host()) ok = false;
   if (cycles_run < 2000) {
     console::console_write("FAIL: fewer than 2,000 cycles\n");
     ok = false;

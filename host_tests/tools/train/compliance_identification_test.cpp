@@ -152,6 +152,31 @@ TEST(ComplianceIdentification, TheChoiceTakesTheSagWhereThereIsOneAndNoneWhereTh
   EXPECT_TRUE(without_sag.model.empty());
 }
 
+// A payload column that reads 0.5 kg over what the robot carries (a tare
+// left out): the sag fits best with a platform of -0.3 kg, which no robot
+// has. That candidate is reported, but the choice falls on a plausible one.
+TEST(ComplianceIdentification, AnImplausibleCandidateIsNeverChosenHoweverWellItFits) {
+  const auto design = model::RobotGeometry<double>::prototype();
+  TrainingOptions options;
+  options.search.restarts = 0;
+  std::vector<ComplianceStructure> structures(2);
+  structures[1].unloaded_mass = true;
+
+  sim::SimulatedRobot sagging(design, gravity_only());
+  dataset::Dataset data = recorded(sagging, 80, true);
+  data.payload_kg.array() += 0.5;
+  const TrainingSet set = make_training_set(data, design, model::InputEncoding::bend_vector);
+  const ComplianceChoice choice = choose_compliance(set, design, options, structures);
+  ASSERT_TRUE(choice.attempted);
+  ASSERT_EQ(choice.candidates.size(), 3u);
+  const ComplianceCandidate& negative_mass = choice.candidates[2];
+  EXPECT_LT(negative_mass.model.unloaded_mass_kg, -0.2);
+  EXPECT_FALSE(negative_mass.plausible);
+  EXPECT_GT(negative_mass.criterion, choice.candidates[1].criterion) << "it would win if it were allowed to";
+  EXPECT_FALSE(choice.structure.unloaded_mass);
+  EXPECT_GE(choice.model.unloaded_mass_kg, 0.0);
+}
+
 TEST(ComplianceIdentification, DataWithoutPayloadTrainsAsItAlwaysDid) {
   const auto design = model::RobotGeometry<double>::prototype();
   sim::SimulatedRobot robot(design, gravity_only());

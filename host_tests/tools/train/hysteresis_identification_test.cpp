@@ -89,6 +89,36 @@ TEST(HysteresisIdentification, RecoversKnownPerCableWidths) {
   }
 }
 
+// A sequence without play: "none" wins, every candidate's widths stay at
+// zero, and no model with a width below zero is evaluated. At zero the
+// split of an opposite pair (one width up, the other down) has no feasible
+// step, so the per-cable search evaluates only the pairs' sums and the
+// weight: once to start, then a first sweep and the refining sweeps each.
+TEST(HysteresisIdentification, WithoutPlayEveryWidthStaysAtZeroAndNoneIsSearchedBelowIt) {
+  const auto geometry = test::two_segment_geometry();
+  const test::SyntheticSequence s = test::synthetic_sequence(geometry, {}, {300, 200}, 11);
+  TrainingOptions options;
+  options.search.restarts = 0;
+  const HysteresisSearchOptions search;
+  const HysteresisIdentification id = identify_hysteresis(s.data, all_rows(500), geometry, options, true, search);
+  ASSERT_TRUE(id.attempted);
+  EXPECT_EQ(id.sharing, HysteresisSharing::none);
+  EXPECT_TRUE(id.model.empty());
+  const HysteresisCandidate* per_cable = nullptr;
+  for (const HysteresisCandidate& c : id.candidates) {
+    for (int cable = 0; cable < c.model.cables; ++cable) {
+      for (int k = 0; k < c.model.operators; ++k) {
+        EXPECT_EQ(c.model.widths_mm[cable][k], 0.0) << to_string(c.sharing) << ", K " << c.operators;
+      }
+    }
+    if (c.sharing == HysteresisSharing::per_cable && c.operators == 1) per_cable = &c;
+  }
+  ASSERT_NE(per_cable, nullptr);
+  const int sums_and_weight = 2 * geometry.segment_count + 1;
+  EXPECT_EQ(per_cable->likelihood_evaluations,
+            1 + sums_and_weight * (search.first_sweep_steps + search.refine_sweeps * search.refine_sweep_steps));
+}
+
 TEST(HysteresisIdentification, ASequenceTooShortIsNotIdentified) {
   const auto geometry = test::two_segment_geometry();
   const auto truth = test::known_hysteresis(geometry);
