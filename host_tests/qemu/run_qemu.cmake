@@ -10,7 +10,7 @@ if(DEFINED ICOUNT)
 endif()
 # A guard against a hung QEMU only (see run_r5f.cmake): the budgets count
 # instructions, and a busy host may take several times a quiet one's time.
-set(seconds 300)
+set(seconds 900)
 if(DEFINED RUN_SECONDS)
   set(seconds ${RUN_SECONDS})
 endif()
