@@ -124,12 +124,27 @@ TEST(ComplianceIdentification, AnErrorOfTheBendsAloneDoesNotMoveTheStiffness) {
   EXPECT_NEAR(c.unloaded_mass_kg, config.gravity.platform_mass_kg, 0.01);
 }
 
+// The choice between no sag and a sag with an unloaded mass, on the
+// prototype, with a single start of the search.
+struct ChoiceSetup {
+  model::RobotGeometry<double> design = model::RobotGeometry<double>::prototype();
+  TrainingOptions options = [] {
+    TrainingOptions o;
+    o.search.restarts = 0;
+    return o;
+  }();
+  std::vector<ComplianceStructure> structures = {ComplianceStructure{}, [] {
+                                                   ComplianceStructure with_mass;
+                                                   with_mass.unloaded_mass = true;
+                                                   return with_mass;
+                                                 }()};
+};
+
 TEST(ComplianceIdentification, TheChoiceTakesTheSagWhereThereIsOneAndNoneWhereThereIsNot) {
-  const auto design = model::RobotGeometry<double>::prototype();
-  TrainingOptions options;
-  options.search.restarts = 0;
-  std::vector<ComplianceStructure> structures(2);
-  structures[1].unloaded_mass = true;
+  const ChoiceSetup setup;
+  const auto& design = setup.design;
+  const auto& options = setup.options;
+  const auto& structures = setup.structures;
 
   sim::SimulatedRobot sagging(design, gravity_only());
   const TrainingSet loaded = make_training_set(recorded(sagging, 80, true), design, model::InputEncoding::bend_vector);
@@ -156,11 +171,10 @@ TEST(ComplianceIdentification, TheChoiceTakesTheSagWhereThereIsOneAndNoneWhereTh
 // left out): the sag fits best with a platform of -0.3 kg, which no robot
 // has. That candidate is reported, but the choice falls on a plausible one.
 TEST(ComplianceIdentification, AnImplausibleCandidateIsNeverChosenHoweverWellItFits) {
-  const auto design = model::RobotGeometry<double>::prototype();
-  TrainingOptions options;
-  options.search.restarts = 0;
-  std::vector<ComplianceStructure> structures(2);
-  structures[1].unloaded_mass = true;
+  const ChoiceSetup setup;
+  const auto& design = setup.design;
+  const auto& options = setup.options;
+  const auto& structures = setup.structures;
 
   sim::SimulatedRobot sagging(design, gravity_only());
   dataset::Dataset data = recorded(sagging, 80, true);
