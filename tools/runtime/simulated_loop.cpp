@@ -64,6 +64,48 @@ struct SimulatedLoop {
   sim::SimulatedRobot robot;
 };
 
+// The simulated drives on the loop's bus, the host's node that sends the
+// targets, and the lockstep timer at the cycle rate: what every closed-loop
+// run starts with.
+struct DrivenLoop {
+  DrivenLoop(SimulatedLoop& loop, const model::CableVector<double>& start_cables, double rate_hz)
+      : loop(loop),
+        drives(loop.platform.bus.node(1), start_cables, 50.0),
+        effective_cables(loop.robot.move_cables(drives.cables_mm())),
+        host(loop.platform.bus.node(2)),
+        period_ns(static_cast<std::int64_t>(std::llround(1e9 / rate_hz))),
+        dt_s(double(period_ns) * 1e-9) {
+    host.set_filters(&protocol::kIkReportFrames, 1);
+  }
+
+  void start_timer() { loop.platform.timer.start(period_ns); }
+
+  // Waits for the next tick and moves the drives, and the robot's cables
+  // with them, one period on.
+  cdcr::hal::TimerTick advance_drives() {
+    const cdcr::hal::TimerTick tick = loop.platform.timer.wait_next();
+    drives.step(dt_s);
+    effective_cables = loop.robot.move_cables(drives.cables_mm());
+    return tick;
+  }
+
+  // The host reads what the runtime sent, so that its queue never fills.
+  void drain_host() {
+    cdcr::hal::CanFrame frame;
+    while (host.receive(frame) == cdcr::hal::CanStatus::ok) {
+    }
+  }
+
+  SimulatedLoop& loop;
+  sim::SimulatedCableDrives drives;
+  // The lengths that bend the segments: the drives' through the friction,
+  // which follows every step of the drives (the drives' own with it off).
+  model::CableVector<double> effective_cables;
+  cdcr::hal::CanBus& host;
+  std::int64_t period_ns;
+  double dt_s;
+};
+
 // The sum and the largest of a run of errors, in mm.
 struct ErrorTally {
   double sum_mm = 0;
@@ -159,7 +201,6 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
     throw std::invalid_argument("--circle-speed must be in (0, 500] mm/s");
   }
   SimulatedLoop loop(image_path, robot_choice);
-  sim::SimulatedPlatform& platform = loop.platform;
   fw::Runtime& runtime = loop.runtime;
   const model::RobotGeometry<double>& geometry = loop.geometry;
   sim::SimulatedRobot& robot = loop.robot;
@@ -178,22 +219,14 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   const auto target_at = [&](double direction_rad) { return target_at_bend(bend_rad, direction_rad); };
   model::CableVector<double> start_cables;
   model::cables_from_joints(joints_at(0.5 * bend_rad, 0.0), geometry, start_cables);
-  sim::SimulatedCableDrives drives(platform.bus.node(1), start_cables, 50.0);
-  // The lengths that bend the segments: the drives' through the friction,
-  // which follows every step of the drives (the drives' own with it off).
-  model::CableVector<double> effective_cables = robot.move_cables(drives.cables_mm());
-  cdcr::hal::CanBus& host = platform.bus.node(2);
-  host.set_filters(&protocol::kIkReportFrames, 1);
-  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
-  const double dt_s = double(period_ns) * 1e-9;
-  platform.timer.start(period_ns);
+  DrivenLoop driven(loop, start_cables, rate_hz);
+  cdcr::hal::CanBus& host = driven.host;
+  driven.start_timer();
 
   long cycles = 0, poses_missing = 0;
   std::int64_t host_max_ns = 0;
   const auto cycle = [&] {
-    const cdcr::hal::TimerTick tick = platform.timer.wait_next();
-    drives.step(dt_s);
-    effective_cables = robot.move_cables(drives.cables_mm());
+    const cdcr::hal::TimerTick tick = driven.advance_drives();
     const std::uint32_t poses = runtime.statistics().poses_published;
     const auto begin = std::chrono::steady_clock::now();
     runtime.run_cycle(tick);
@@ -202,9 +235,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - begin).count());
     if (runtime.statistics().poses_published != poses + 1) ++poses_missing;
     ++cycles;
-    cdcr::hal::CanFrame frame;
-    while (host.receive(frame) == cdcr::hal::CanStatus::ok) {
-    }
+    driven.drain_host();
   };
 
   // Where the runtime's own compensated model puts the tip at the setpoints
@@ -217,7 +248,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   // where the drives stand to the circle's in half a second of streamed
   // targets, then half a second on the start to settle.
   // With the friction the robot first homes, and the ramp starts from home.
-  if (robot_choice.hysteresis) run_homing_move(geometry, drives, host, rate_hz, cycle);
+  if (robot_choice.hysteresis) run_homing_move(geometry, driven.drives, host, rate_hz, cycle);
   const double ramp_from = robot_choice.hysteresis ? 0.0 : 0.5;
   std::uint8_t sequence = 0;
   const long ramp_cycles = std::lround(0.5 * rate_hz);
@@ -250,7 +281,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
     cycle();
     // The first 3 cycles of the stream may still finish the settled request.
     if (k > 3 && runtime.setpoints_published() == setpoints) ++cycles_without_setpoints;
-    const double error_mm = (robot.true_pose(effective_cables).position_mm - target_mm).norm();
+    const double error_mm = (robot.true_pose(driven.effective_cables).position_mm - target_mm).norm();
     error.add(error_mm);
     const double following_mm = setpoints_to_target_mm(target);
     following.add(following_mm);
@@ -272,98 +303,27 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   return 0;
 }
 
-int simulate(const std::string& image_path, double rate_hz, double seconds, const SimulatedRobotChoice& robot_choice) {
-  require_rate(rate_hz);
-  if (!(seconds > 0) || !(seconds <= 3600)) throw std::invalid_argument("--seconds must be in (0, 3600]");
-  SimulatedLoop loop(image_path, robot_choice);
-  sim::SimulatedPlatform& platform = loop.platform;
-  fw::Runtime& runtime = loop.runtime;
-  const model::RobotGeometry<double>& geometry = loop.geometry;
-  sim::SimulatedRobot& robot = loop.robot;
+namespace {
 
-  std::mt19937 rng(7);
-  std::uniform_real_distribution<double> alpha(-M_PI, M_PI), theta(0.02, 0.2);
-  const auto random_joints = [&] {
-    model::JointVector<double> joints(2 * geometry.segment_count);
-    for (int s = 0; s < geometry.segment_count; ++s) {
-      joints[2 * s] = alpha(rng);
-      joints[2 * s + 1] = theta(rng);
-    }
-    return joints;
-  };
-  model::CableVector<double> start_cables;
-  model::cables_from_joints(random_joints(), geometry, start_cables);
-  sim::SimulatedCableDrives drives(platform.bus.node(1), start_cables, 50.0);
-  // The lengths that bend the segments: the drives' through the friction,
-  // which follows every step of the drives (the drives' own with it off).
-  model::CableVector<double> effective_cables = robot.move_cables(drives.cables_mm());
-  cdcr::hal::CanBus& host = platform.bus.node(2);
-  host.set_filters(&protocol::kIkReportFrames, 1);
+// A leg of the two-sided run: a via point, or a target approached from one
+// side.
+struct Leg {
+  model::Vec3<double> position_mm;
+  bool via;  // a via point: not checked
+  int side;  // 0: from the +45 degree side, 1: from the -45 degree side
+};
 
-  const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
-  const double dt_s = double(period_ns) * 1e-9;
-  const long cycles_per_target = std::max(1L, std::lround(0.5 * rate_hz));
-  platform.timer.start(period_ns);
-
-  // With the friction the robot first homes, as a real one starts up, and
-  // each target (one per half second of --seconds, as without it) is then
-  // approached from two sides, each side a leg of its own: first from a
-  // via point where every segment's bend direction is turned +45 degrees
-  // (same bend), then from one turned -45 degrees. The cables across the
-  // bend plane reach the target once lengthening and once shortening, so
-  // the tip's error shows whether the runtime knows which way each cable
-  // came. Every arrival at a target is checked, the last one included.
-  const bool two_sided = robot_choice.hysteresis;
-  struct Leg {
-    model::Vec3<double> position_mm;
-    bool via;  // a via point: not checked
-    int side;  // 0: from the +45 degree side, 1: from the -45 degree side
-  };
-  std::vector<Leg> legs;
-  if (two_sided) {
-    const auto plain_cycle = [&] {
-      const cdcr::hal::TimerTick tick = platform.timer.wait_next();
-      drives.step(dt_s);
-      effective_cables = robot.move_cables(drives.cables_mm());
-      runtime.run_cycle(tick);
-      cdcr::hal::CanFrame frame;
-      while (host.receive(frame) == cdcr::hal::CanStatus::ok) {
-      }
-    };
-    run_homing_move(geometry, drives, host, rate_hz, plain_cycle);
-    const auto reachable_position = [&](const model::JointVector<double>& joints) {
-      model::CableVector<double> cables;
-      model::cables_from_joints(joints, geometry, cables);
-      return robot.true_pose(cables).position_mm;
-    };
-    const long target_count = std::max(1L, std::lround(seconds * rate_hz) / cycles_per_target);
-    for (long t = 0; t < target_count; ++t) {
-      const model::JointVector<double> joints = random_joints();
-      const model::Vec3<double> target_mm = reachable_position(joints);
-      for (int side = 0; side < 2; ++side) {
-        model::JointVector<double> turned = joints;
-        for (int s = 0; s < geometry.segment_count; ++s) turned[2 * s] += (side == 0 ? 0.25 : -0.25) * M_PI;
-        legs.push_back({reachable_position(turned), true, side});
-        legs.push_back({target_mm, false, side});
-      }
-    }
-  }
-  const long cycles =
-      two_sided ? long(legs.size()) * cycles_per_target + 1 : std::lround(seconds * rate_hz);
-  std::size_t next_leg = 0;
-  ErrorTally side_error[2];
-  double first_arrival_mm = 0;  // the first target after homing: where a wrong homing state shows most
-  long side_checked[2] = {0, 0};
-
+// What the random-target run measures: the runtime's pose estimate and the
+// tip at its targets against the simulated robot, and the same for the
+// nominal model alone, computed alongside on the host (what compensation
+// gains).
+struct RandomTargetTallies {
   ErrorTally estimate_error;
   long estimate_samples = 0;
   ErrorTally target_error;
   long targets_sent = 0, targets_checked = 0, targets_converged = 0;
-  model::Vec3<double> target_mm = model::Vec3<double>::Zero();
   std::int64_t host_max_ns = 0, host_total_ns = 0;
   long host_overruns = 0;
-  // The same measures for the nominal model alone, computed alongside on the
-  // host: what compensation gains.
   ErrorTally nominal_estimate_error;
   ErrorTally nominal_target_error;
   long nominal_targets_reached = 0;
@@ -371,131 +331,241 @@ int simulate(const std::string& image_path, double rate_hz, double seconds, cons
   // against the nominal IK's.
   ErrorTally setpoint_target_error;
   long setpoints_checked = 0;
-  model::JointVector<double> nominal_ik_joints(2 * geometry.segment_count);
-  for (int s = 0; s < geometry.segment_count; ++s) {
-    nominal_ik_joints[2 * s] = 0.0;
-    nominal_ik_joints[2 * s + 1] = 0.1;
+  // With the friction: the arrivals from each side, and the first target
+  // after homing, where a wrong homing state shows most.
+  ErrorTally side_error[2];
+  long side_checked[2] = {0, 0};
+  double first_arrival_mm = 0;
+};
+
+double mean_mm(const ErrorTally& tally, long count) { return count > 0 ? tally.sum_mm / double(count) : 0.0; }
+
+// The closed loop with random reachable targets, one per half second. With
+// the friction the robot first homes, as a real one starts up, and each
+// target (one per half second of --seconds, as without it) is then
+// approached from two sides, each side a leg of its own: first from a via
+// point where every segment's bend direction is turned +45 degrees (same
+// bend), then from one turned -45 degrees. The cables across the bend plane
+// reach the target once lengthening and once shortening, so the tip's error
+// shows whether the runtime knows which way each cable came. Every arrival
+// at a target is checked, the last one included.
+class RandomTargetRun {
+ public:
+  RandomTargetRun(const std::string& image_path, double rate_hz, const SimulatedRobotChoice& robot_choice)
+      : loop_(image_path, robot_choice),
+        geometry_(loop_.geometry),
+        rate_hz_(rate_hz),
+        two_sided_(robot_choice.hysteresis),
+        driven_(loop_, random_cables(), rate_hz),
+        cycles_per_target_(std::max(1L, std::lround(0.5 * rate_hz))),
+        nominal_ik_joints_(2 * geometry_.segment_count) {
+    driven_.start_timer();
+    for (int s = 0; s < geometry_.segment_count; ++s) {
+      nominal_ik_joints_[2 * s] = 0.0;
+      nominal_ik_joints_[2 * s + 1] = 0.1;
+    }
   }
 
-  for (long k = 0; k < cycles; ++k) {
-    const cdcr::hal::TimerTick tick = platform.timer.wait_next();
-    drives.step(dt_s);
-    effective_cables = robot.move_cables(drives.cables_mm());
-    if (k % cycles_per_target == 0) {
-      const Leg* previous_leg = two_sided && next_leg > 0 ? &legs[next_leg - 1] : nullptr;
-      if (targets_sent > 0 && !(previous_leg != nullptr && previous_leg->via)) {
-        const double error_mm = (robot.true_pose(effective_cables).position_mm - target_mm).norm();
-        target_error.add(error_mm);
-        ++targets_checked;
-        if (previous_leg != nullptr) {
-          if (targets_checked == 1) first_arrival_mm = error_mm;
-          side_error[previous_leg->side].add(error_mm);
-          ++side_checked[previous_leg->side];
-        }
-        // The request spans cycles: its setpoints are checked when the next
-        // target is due. (Not with the friction: the setpoints are then
-        // commanded lengths, which the frictionless true pose misreads.)
-        if (!two_sided && runtime.has_setpoints() &&
-            runtime.last_ik_report().outcome == protocol::IkOutcome::converged) {
-          const model::CableVector<double> setpoints_mm = runtime.setpoints_mm().cast<double>();
-          const double setpoint_error_mm = (robot.true_pose(setpoints_mm).position_mm - target_mm).norm();
-          setpoint_target_error.add(setpoint_error_mm);
-          ++setpoints_checked;
-        }
+  void run(double seconds) {
+    if (two_sided_) {
+      run_homing_move(geometry_, driven_.drives, driven_.host, rate_hz_, [this] {
+        runtime().run_cycle(driven_.advance_drives());
+        driven_.drain_host();
+      });
+      plan_two_sided_legs(std::max(1L, std::lround(seconds * rate_hz_) / cycles_per_target_));
+    }
+    cycles_ = two_sided_ ? long(legs_.size()) * cycles_per_target_ + 1 : std::lround(seconds * rate_hz_);
+    for (long k = 0; k < cycles_; ++k) {
+      const cdcr::hal::TimerTick tick = driven_.advance_drives();
+      if (k % cycles_per_target_ == 0) {
+        check_arrival();
+        send_next_target();
       }
-      bool is_target = true;
-      if (two_sided) {
-        is_target = next_leg < legs.size() && !legs[next_leg].via;
-        if (next_leg < legs.size()) {
-          target_mm = legs[next_leg++].position_mm;
-          send_target(host, target_mm, static_cast<std::uint8_t>(targets_sent++));
-        }
-      } else {
-        // Targets the real robot can reach: where it goes for random cables.
-        model::CableVector<double> target_cables;
-        model::cables_from_joints(random_joints(), geometry, target_cables);
-        target_mm = robot.true_pose(target_cables).position_mm;
-        send_target(host, target_mm, static_cast<std::uint8_t>(targets_sent++));
-      }
-      const model::IkResult<double> nominal_ik =
-          is_target ? model::solve_ik_position(target_mm, geometry, nominal_ik_joints) : model::IkResult<double>{};
-      if (is_target && nominal_ik.converged()) {
-        nominal_ik_joints = nominal_ik.joints;
-        const double error_mm = (robot.true_pose(nominal_ik.cables_mm).position_mm - target_mm).norm();
-        nominal_target_error.add(error_mm);
-        ++nominal_targets_reached;
+      run_timed_cycle(tick);
+      if (runtime().has_pose()) sample_estimate();
+    }
+  }
+
+  void print_report() const;
+
+ private:
+  fw::Runtime& runtime() { return loop_.runtime; }
+  const fw::Runtime& runtime() const { return loop_.runtime; }
+  const sim::SimulatedRobot& robot() const { return loop_.robot; }
+
+  model::JointVector<double> random_joints() {
+    model::JointVector<double> joints(2 * geometry_.segment_count);
+    for (int s = 0; s < geometry_.segment_count; ++s) {
+      joints[2 * s] = alpha_(rng_);
+      joints[2 * s + 1] = theta_(rng_);
+    }
+    return joints;
+  }
+
+  model::CableVector<double> random_cables() {
+    model::CableVector<double> cables;
+    model::cables_from_joints(random_joints(), geometry_, cables);
+    return cables;
+  }
+
+  model::Vec3<double> reachable_position(const model::JointVector<double>& joints) const {
+    model::CableVector<double> cables;
+    model::cables_from_joints(joints, geometry_, cables);
+    return robot().true_pose(cables).position_mm;
+  }
+
+  void plan_two_sided_legs(long target_count) {
+    for (long t = 0; t < target_count; ++t) {
+      const model::JointVector<double> joints = random_joints();
+      const model::Vec3<double> target_mm = reachable_position(joints);
+      for (int side = 0; side < 2; ++side) {
+        model::JointVector<double> turned = joints;
+        for (int s = 0; s < geometry_.segment_count; ++s) turned[2 * s] += (side == 0 ? 0.25 : -0.25) * M_PI;
+        legs_.push_back({reachable_position(turned), true, side});
+        legs_.push_back({target_mm, false, side});
       }
     }
+  }
+
+  // The tip where the last target was due to be reached.
+  void check_arrival() {
+    const Leg* previous_leg = two_sided_ && next_leg_ > 0 ? &legs_[next_leg_ - 1] : nullptr;
+    if (tallies_.targets_sent == 0 || (previous_leg != nullptr && previous_leg->via)) return;
+    const double error_mm = (robot().true_pose(driven_.effective_cables).position_mm - target_mm_).norm();
+    tallies_.target_error.add(error_mm);
+    ++tallies_.targets_checked;
+    if (previous_leg != nullptr) {
+      if (tallies_.targets_checked == 1) tallies_.first_arrival_mm = error_mm;
+      tallies_.side_error[previous_leg->side].add(error_mm);
+      ++tallies_.side_checked[previous_leg->side];
+    }
+    // The request spans cycles: its setpoints are checked when the next
+    // target is due. (Not with the friction: the setpoints are then
+    // commanded lengths, which the frictionless true pose misreads.)
+    if (!two_sided_ && runtime().has_setpoints() &&
+        runtime().last_ik_report().outcome == protocol::IkOutcome::converged) {
+      const model::CableVector<double> setpoints_mm = runtime().setpoints_mm().cast<double>();
+      tallies_.setpoint_target_error.add((robot().true_pose(setpoints_mm).position_mm - target_mm_).norm());
+      ++tallies_.setpoints_checked;
+    }
+  }
+
+  void send_next_target() {
+    bool is_target = true;
+    if (two_sided_) {
+      is_target = next_leg_ < legs_.size() && !legs_[next_leg_].via;
+      if (next_leg_ < legs_.size()) {
+        target_mm_ = legs_[next_leg_++].position_mm;
+        send_target(driven_.host, target_mm_, static_cast<std::uint8_t>(tallies_.targets_sent++));
+      }
+    } else {
+      // Targets the real robot can reach: where it goes for random cables.
+      target_mm_ = robot().true_pose(random_cables()).position_mm;
+      send_target(driven_.host, target_mm_, static_cast<std::uint8_t>(tallies_.targets_sent++));
+    }
+    if (!is_target) return;
+    const model::IkResult<double> nominal_ik = model::solve_ik_position(target_mm_, geometry_, nominal_ik_joints_);
+    if (nominal_ik.converged()) {
+      nominal_ik_joints_ = nominal_ik.joints;
+      tallies_.nominal_target_error.add((robot().true_pose(nominal_ik.cables_mm).position_mm - target_mm_).norm());
+      ++tallies_.nominal_targets_reached;
+    }
+  }
+
+  void run_timed_cycle(cdcr::hal::TimerTick tick) {
     const auto begin = std::chrono::steady_clock::now();
-    runtime.run_cycle(tick);
+    runtime().run_cycle(tick);
     const std::int64_t elapsed_ns =
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - begin).count();
-    host_max_ns = std::max(host_max_ns, elapsed_ns);
-    host_total_ns += elapsed_ns;
+    tallies_.host_max_ns = std::max(tallies_.host_max_ns, elapsed_ns);
+    tallies_.host_total_ns += elapsed_ns;
     // Lockstep time charges the cycle nothing, so the runtime's own overrun
     // count stays zero; this is the count the host's speed would give.
-    if (elapsed_ns > period_ns) ++host_overruns;
+    if (elapsed_ns > driven_.period_ns) ++tallies_.host_overruns;
     cdcr::hal::CanFrame frame;
-    while (host.receive(frame) == cdcr::hal::CanStatus::ok) {
+    while (driven_.host.receive(frame) == cdcr::hal::CanStatus::ok) {
       protocol::IkReport report;
       if (protocol::decode(frame, report) == protocol::DecodeStatus::ok &&
           report.outcome == protocol::IkOutcome::converged) {
-        ++targets_converged;
-      }
-    }
-    if (runtime.has_pose()) {
-      const double error_mm =
-          (robot.true_pose(effective_cables).position_mm - runtime.latest_pose().pose.position_mm.cast<double>())
-              .norm();
-      estimate_error.add(error_mm);
-      ++estimate_samples;
-      model::JointVector<double> nominal_joints;
-      model::Pose<double> nominal_pose;
-      if (model::joints_from_cables(drives.cables_mm(), geometry, nominal_joints) == model::Status::ok &&
-          model::forward_kinematics(nominal_joints, geometry, nominal_pose) == model::Status::ok) {
-        const double nominal_error_mm =
-            (robot.true_pose(effective_cables).position_mm - nominal_pose.position_mm).norm();
-        nominal_estimate_error.add(nominal_error_mm);
+        ++tallies_.targets_converged;
       }
     }
   }
-  const fw::CycleStatistics& stats = runtime.statistics();
-  std::printf("state %s, fault: %s\n", fw::to_string(runtime.state()), fw::to_string(runtime.active_fault()));
+
+  void sample_estimate() {
+    const model::Vec3<double> true_mm = robot().true_pose(driven_.effective_cables).position_mm;
+    tallies_.estimate_error.add((true_mm - runtime().latest_pose().pose.position_mm.cast<double>()).norm());
+    ++tallies_.estimate_samples;
+    model::JointVector<double> nominal_joints;
+    model::Pose<double> nominal_pose;
+    if (model::joints_from_cables(driven_.drives.cables_mm(), geometry_, nominal_joints) == model::Status::ok &&
+        model::forward_kinematics(nominal_joints, geometry_, nominal_pose) == model::Status::ok) {
+      tallies_.nominal_estimate_error.add((true_mm - nominal_pose.position_mm).norm());
+    }
+  }
+
+  SimulatedLoop loop_;
+  const model::RobotGeometry<double>& geometry_;
+  double rate_hz_;
+  bool two_sided_;
+  std::mt19937 rng_{7};
+  std::uniform_real_distribution<double> alpha_{-M_PI, M_PI}, theta_{0.02, 0.2};
+  DrivenLoop driven_;
+  long cycles_per_target_;
+  long cycles_ = 0;
+  std::vector<Leg> legs_;
+  std::size_t next_leg_ = 0;
+  model::Vec3<double> target_mm_ = model::Vec3<double>::Zero();
+  model::JointVector<double> nominal_ik_joints_;
+  RandomTargetTallies tallies_;
+};
+
+void RandomTargetRun::print_report() const {
+  const RandomTargetTallies& t = tallies_;
+  const fw::CycleStatistics& stats = runtime().statistics();
+  std::printf("state %s, fault: %s\n", fw::to_string(runtime().state()), fw::to_string(runtime().active_fault()));
   std::printf("cycles %u at %.0f Hz (%.3f s simulated), overruns in simulated time %u, rejected frames %u, "
               "stale events %u\n",
-              stats.cycles, rate_hz, double(cycles) / rate_hz, stats.overruns, stats.rejected_frames,
+              stats.cycles, rate_hz_, double(cycles_) / rate_hz_, stats.overruns, stats.rejected_frames,
               stats.stale_events);
   std::printf("cycle execution on this host: max %.1f us, mean %.1f us (period %.1f us), %ld over the period\n",
-              host_max_ns * 1e-3, cycles > 0 ? double(host_total_ns) / double(cycles) * 1e-3 : 0.0,
-              double(period_ns) * 1e-3, host_overruns);
+              t.host_max_ns * 1e-3, cycles_ > 0 ? double(t.host_total_ns) / double(cycles_) * 1e-3 : 0.0,
+              double(driven_.period_ns) * 1e-3, t.host_overruns);
   std::printf("pose estimate vs simulated robot: mean %.3f mm, max %.3f mm over %ld cycles\n",
-              estimate_samples > 0 ? estimate_error.sum_mm / double(estimate_samples) : 0.0, estimate_error.max_mm,
-              estimate_samples);
+              mean_mm(t.estimate_error, t.estimate_samples), t.estimate_error.max_mm, t.estimate_samples);
   std::printf("targets: %ld sent, %ld converged; tip vs target after %.2f s: mean %.3f mm, max %.3f mm over %ld\n",
-              targets_sent, targets_converged, double(cycles_per_target) / rate_hz,
-              targets_checked > 0 ? target_error.sum_mm / double(targets_checked) : 0.0, target_error.max_mm,
-              targets_checked);
-  if (two_sided) {
+              t.targets_sent, t.targets_converged, double(cycles_per_target_) / rate_hz_,
+              mean_mm(t.target_error, t.targets_checked), t.target_error.max_mm, t.targets_checked);
+  if (two_sided_) {
     std::printf("each target approached from two sides (every bend direction turned +45 deg, then -45 deg): "
                 "tip vs target mean %.3f mm (max %.3f) from the first side, %.3f mm (max %.3f) from the second\n",
-                side_checked[0] > 0 ? side_error[0].sum_mm / double(side_checked[0]) : 0.0, side_error[0].max_mm,
-                side_checked[1] > 0 ? side_error[1].sum_mm / double(side_checked[1]) : 0.0, side_error[1].max_mm);
-    std::printf("first arrival after the homing move: tip vs target %.3f mm\n", first_arrival_mm);
+                mean_mm(t.side_error[0], t.side_checked[0]), t.side_error[0].max_mm,
+                mean_mm(t.side_error[1], t.side_checked[1]), t.side_error[1].max_mm);
+    std::printf("first arrival after the homing move: tip vs target %.3f mm\n", t.first_arrival_mm);
   }
   std::printf("accuracy, nominal model only -> %s runtime:\n",
-              runtime.latest_pose().compensated ? "compensated" : "uncompensated");
+              runtime().latest_pose().compensated ? "compensated" : "uncompensated");
   std::printf("  pose estimate vs robot: mean %.3f -> %.3f mm, max %.3f -> %.3f mm\n",
-              estimate_samples > 0 ? nominal_estimate_error.sum_mm / double(estimate_samples) : 0.0,
-              estimate_samples > 0 ? estimate_error.sum_mm / double(estimate_samples) : 0.0,
-              nominal_estimate_error.max_mm, estimate_error.max_mm);
-  if (!two_sided) {
+              mean_mm(t.nominal_estimate_error, t.estimate_samples), mean_mm(t.estimate_error, t.estimate_samples),
+              t.nominal_estimate_error.max_mm, t.estimate_error.max_mm);
+  if (!two_sided_) {
     std::printf("  tip vs target at the commanded cables (%ld and %ld of %ld solved): mean %.3f -> %.3f mm, "
                 "max %.3f -> %.3f mm\n",
-                nominal_targets_reached, setpoints_checked, targets_sent,
-                nominal_targets_reached > 0 ? nominal_target_error.sum_mm / double(nominal_targets_reached) : 0.0,
-                setpoints_checked > 0 ? setpoint_target_error.sum_mm / double(setpoints_checked) : 0.0,
-                nominal_target_error.max_mm, setpoint_target_error.max_mm);
+                t.nominal_targets_reached, t.setpoints_checked, t.targets_sent,
+                mean_mm(t.nominal_target_error, t.nominal_targets_reached),
+                mean_mm(t.setpoint_target_error, t.setpoints_checked), t.nominal_target_error.max_mm,
+                t.setpoint_target_error.max_mm);
   }
+}
+
+}  // namespace
+
+int simulate(const std::string& image_path, double rate_hz, double seconds, const SimulatedRobotChoice& robot_choice) {
+  require_rate(rate_hz);
+  if (!(seconds > 0) || !(seconds <= 3600)) throw std::invalid_argument("--seconds must be in (0, 3600]");
+  RandomTargetRun run(image_path, rate_hz, robot_choice);
+  run.run(seconds);
+  run.print_report();
   return 0;
 }
 

@@ -43,6 +43,73 @@
 
 namespace cdcr::model {
 
+namespace detail {
+
+// The per-point arithmetic of GpCorrection's loops, and how a block's sum
+// goes into the accumulator.
+template <typename S, typename Accumulator, typename Arch>
+struct GpPointTerms {
+  // The loops over a training point's inputs and outputs have a handful of
+  // iterations known at compile time; unrolled, their values stay in
+  // registers at any optimisation level a board build uses (-O2 does not
+  // unroll them). `#pragma GCC unroll` says so to GCC and clang alike and,
+  // unlike a macro, reaches no includer. (A template helper calling a lambda
+  // per iteration cost the Cortex-M4F 9 % more instructions in the mean:
+  // GCC then keeps the sums in memory.)
+
+  // One training point's six terms k(z, z_i) alpha_i, added to `block`;
+  // advances zi and a past the point and returns k(z, z_i).
+  template <int Dims>
+  static S add_point(const S* query, int dims, const float*& zi, const float*& a, S* block) {
+    S distance_sq = S(0);
+    if constexpr (Arch::kBlockLoads && std::is_same_v<S, float> && Dims > 0) {
+      float row[Dims];
+      Arch::template load_block<Dims>(zi, row);
+#pragma GCC unroll 16
+      for (int d = 0; d < Dims; ++d) {
+        const S difference = query[d] - row[d];
+        distance_sq = Arch::multiply_add(difference, difference, distance_sq);
+      }
+    } else {
+      for (int d = 0; d < dims; ++d) {
+        const S difference = query[d] - S(zi[d]);
+        distance_sq = Arch::multiply_add(difference, difference, distance_sq);
+      }
+      zi += dims;
+    }
+    const S r = Arch::gaussian(distance_sq);
+    if constexpr (Arch::kBlockLoads && std::is_same_v<S, float>) {
+      float alpha[kImageOutputs];
+      Arch::template load_block<kImageOutputs>(a, alpha);
+#pragma GCC unroll 16
+      for (int k = 0; k < kImageOutputs; ++k) block[k] = Arch::multiply_add(r, alpha[k], block[k]);
+    } else {
+#pragma GCC unroll 16
+      for (int k = 0; k < kImageOutputs; ++k) block[k] = Arch::multiply_add(r, S(a[k]), block[k]);
+      a += kImageOutputs;
+    }
+    return r;
+  }
+
+  static void accumulate(Accumulator& sum, S term) {
+    if constexpr (std::is_same_v<Accumulator, CompensatedFloat>) {
+      sum += static_cast<float>(term);
+    } else {
+      sum += static_cast<Accumulator>(term);
+    }
+  }
+
+  static S value_of(const Accumulator& sum) {
+    if constexpr (std::is_same_v<Accumulator, CompensatedFloat>) {
+      return S(sum.value());
+    } else {
+      return S(sum);
+    }
+  }
+};
+
+}  // namespace detail
+
 template <typename S, typename Accumulator = double, int MaxSegments = kMaxSegments, typename Arch = arch::Selected>
 class GpCorrection {
  public:
@@ -217,7 +284,7 @@ class GpCorrection {
     Eigen::Matrix<S, kImageOutputs, Eigen::Dynamic, Eigen::ColMajor, kImageOutputs, kMaxInputs> scaled(kImageOutputs,
                                                                                                       dims);
     for (int k = 0; k < kImageOutputs; ++k) {
-      const S total = value_of(evaluation.sums[k]);
+      const S total = Terms::value_of(evaluation.sums[k]);
       for (int d = 0; d < dims; ++d) {
         scaled(k, d) = (evaluation.weighted[k][d] - evaluation.z[d] * total) * output_gain_[k] * input_gain_[d];
       }
@@ -245,6 +312,8 @@ class GpCorrection {
   }
 
  private:
+  using Terms = detail::GpPointTerms<S, Accumulator, Arch>;
+
   // Calls work(std::integral_constant<int, D>) with the input count D as a
   // constant for the paper's robots (2 to 4 segments), which lets the
   // compiler unroll the distance, and with 0 (count read at run time)
@@ -289,56 +358,14 @@ class GpCorrection {
     } else {
       for (std::uint32_t b = 0; b < full_blocks; ++b) {
         S block[kImageOutputs] = {};
-        for (std::uint32_t j = 0; j < kBlockPoints; ++j) add_point<Dims>(query, dims, zi, a, block);
-        for (int k = 0; k < kImageOutputs; ++k) accumulate(sums[k], block[k]);
+        for (std::uint32_t j = 0; j < kBlockPoints; ++j) Terms::template add_point<Dims>(query, dims, zi, a, block);
+        for (int k = 0; k < kImageOutputs; ++k) Terms::accumulate(sums[k], block[k]);
       }
     }
     if (full_blocks * kBlockPoints == count) return;
     S rest[kImageOutputs] = {};
-    for (std::uint32_t i = full_blocks * kBlockPoints; i < count; ++i) add_point<Dims>(query, dims, zi, a, rest);
-    for (int k = 0; k < kImageOutputs; ++k) accumulate(sums[k], rest[k]);
-  }
-
-  // The loops over a training point's inputs and outputs have a handful of
-  // iterations known at compile time; unrolled, their values stay in
-  // registers at any optimisation level a board build uses (-O2 does not
-  // unroll them). `#pragma GCC unroll` says so to GCC and clang alike and,
-  // unlike a macro, reaches no includer. (A template helper calling a lambda
-  // per iteration cost the Cortex-M4F 9 % more instructions in the mean:
-  // GCC then keeps the sums in memory.)
-
-  // One training point's six terms k(z, z_i) alpha_i, added to `block`;
-  // advances zi and a past the point and returns k(z, z_i).
-  template <int Dims>
-  static S add_point(const S* query, int dims, const float*& zi, const float*& a, S* block) {
-    S distance_sq = S(0);
-    if constexpr (Arch::kBlockLoads && std::is_same_v<S, float> && Dims > 0) {
-      float row[Dims];
-      Arch::template load_block<Dims>(zi, row);
-#pragma GCC unroll 16
-      for (int d = 0; d < Dims; ++d) {
-        const S difference = query[d] - row[d];
-        distance_sq = Arch::multiply_add(difference, difference, distance_sq);
-      }
-    } else {
-      for (int d = 0; d < dims; ++d) {
-        const S difference = query[d] - S(zi[d]);
-        distance_sq = Arch::multiply_add(difference, difference, distance_sq);
-      }
-      zi += dims;
-    }
-    const S r = Arch::gaussian(distance_sq);
-    if constexpr (Arch::kBlockLoads && std::is_same_v<S, float>) {
-      float alpha[kImageOutputs];
-      Arch::template load_block<kImageOutputs>(a, alpha);
-#pragma GCC unroll 16
-      for (int k = 0; k < kImageOutputs; ++k) block[k] = Arch::multiply_add(r, alpha[k], block[k]);
-    } else {
-#pragma GCC unroll 16
-      for (int k = 0; k < kImageOutputs; ++k) block[k] = Arch::multiply_add(r, S(a[k]), block[k]);
-      a += kImageOutputs;
-    }
-    return r;
+    for (std::uint32_t i = full_blocks * kBlockPoints; i < count; ++i) Terms::template add_point<Dims>(query, dims, zi, a, rest);
+    for (int k = 0; k < kImageOutputs; ++k) Terms::accumulate(sums[k], rest[k]);
   }
 
   // The mean and the gradient's weighted sums over chunks of kChunkPoints
@@ -368,8 +395,8 @@ class GpCorrection {
       for (std::uint32_t j = 0; j < count; j += kBlockPoints) {
         S block[kImageOutputs] = {};
         const std::uint32_t end = j + kBlockPoints < count ? j + kBlockPoints : count;
-        for (std::uint32_t i = j; i < end; ++i) r[i] = add_point<Dims>(query, dims, zi, a, block);
-        for (int k = 0; k < kImageOutputs; ++k) accumulate(sums[k], block[k]);
+        for (std::uint32_t i = j; i < end; ++i) r[i] = Terms::template add_point<Dims>(query, dims, zi, a, block);
+        for (int k = 0; k < kImageOutputs; ++k) Terms::accumulate(sums[k], block[k]);
       }
       for (int pair = 0; pair < kImageOutputs; pair += 2) {
         S first[kMaxInputs];
@@ -408,25 +435,9 @@ class GpCorrection {
     }
   }
 
-  static void accumulate(Accumulator& sum, S term) {
-    if constexpr (std::is_same_v<Accumulator, CompensatedFloat>) {
-      sum += static_cast<float>(term);
-    } else {
-      sum += static_cast<Accumulator>(term);
-    }
-  }
-
-  static S value_of(const Accumulator& sum) {
-    if constexpr (std::is_same_v<Accumulator, CompensatedFloat>) {
-      return S(sum.value());
-    } else {
-      return S(sum);
-    }
-  }
-
   Twist<S> outputs(const Accumulator* sums) const {
     Twist<S> eps;
-    for (int k = 0; k < kImageOutputs; ++k) eps[k] = output_mean_[k] + output_gain_[k] * value_of(sums[k]);
+    for (int k = 0; k < kImageOutputs; ++k) eps[k] = output_mean_[k] + output_gain_[k] * Terms::value_of(sums[k]);
     return eps;
   }
 
