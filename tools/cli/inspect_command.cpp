@@ -88,10 +88,13 @@ std::string verdict(const ImageReport& r) {
 
 // --- text ----------------------------------------------------------------------
 
-std::string format_text(const std::string& path, const ImageReport& r) {
-  std::string t;
-  const auto row = [&t](const char* label, const std::string& value) { t += fmt::format("  {:<20}{}\n", label, value); };
-  t += fmt::format("{}: {} bytes\n", path, r.file_size);
+// One "label value" line of the text report.
+void add_row(std::string& t, const char* label, const std::string& value) {
+  t += fmt::format("  {:<20}{}\n", label, value);
+}
+
+void add_header_text(std::string& t, const ImageReport& r) {
+  const auto row = [&t](const char* label, const std::string& value) { add_row(t, label, value); };
 
   t += "header\n";
   if (r.magic) row("magic", fmt::format("0x{:08x}{}", *r.magic, *r.magic == model::kImageMagic ? " (CDGP)" : ""));
@@ -136,7 +139,9 @@ std::string format_text(const std::string& path, const ImageReport& r) {
   } else if (r.version_major) {
     row("version major", fmt::format("{}", *r.version_major));
   }
+}
 
+void add_geometry_and_parameters_text(std::string& t, const ImageReport& r) {
   if (r.geometry) {
     t += "geometry\n";
     t += fmt::format("  {:<9}{:>16}{:>16}{:>18}\n", "segment", "length (mm)", "radius (mm)", "theta max (rad)");
@@ -171,6 +176,10 @@ std::string format_text(const std::string& path, const ImageReport& r) {
                        p.output_mean[k], p.output_scale[k], p.signal_variance[k], p.noise_variance[k]);
     }
   }
+}
+
+void add_optional_blocks_text(std::string& t, const ImageReport& r) {
+  const auto row = [&t](const char* label, const std::string& value) { add_row(t, label, value); };
   if (r.hysteresis) {
     // effective length = commanded - sum_k weight_k lag_k, each lag within
     // +-width (model/include/cdcr/model/hysteresis.hpp).
@@ -216,7 +225,10 @@ std::string format_text(const std::string& path, const ImageReport& r) {
       t += fmt::format("  {:<12}{:>12}{:>12}{}\n", b.name, b.offset, b.size, b.inside_file ? "" : "  beyond the end of the file");
     }
   }
+}
 
+void add_metadata_and_checks_text(std::string& t, const ImageReport& r) {
+  const auto row = [&t](const char* label, const std::string& value) { add_row(t, label, value); };
   if (r.metadata) {
     const ImageMetadata& m = *r.metadata;
     const model::ImageMetrics& e = m.metrics;
@@ -253,6 +265,14 @@ std::string format_text(const std::string& path, const ImageReport& r) {
     t += line + "\n";
   }
   t += verdict(r) + "\n";
+}
+
+std::string format_text(const std::string& path, const ImageReport& r) {
+  std::string t = fmt::format("{}: {} bytes\n", path, r.file_size);
+  add_header_text(t, r);
+  add_geometry_and_parameters_text(t, r);
+  add_optional_blocks_text(t, r);
+  add_metadata_and_checks_text(t, r);
   return t;
 }
 
@@ -278,8 +298,7 @@ Json kind_json(std::uint8_t code, const char* name) {
   return j;
 }
 
-Json format_json(const std::string& path, const ImageReport& r) {
-  Json j;
+void add_header_json(Json& j, const std::string& path, const ImageReport& r) {
   j["file"] = path;
   j["file_size"] = r.file_size;
   j["valid"] = r.valid();
@@ -335,7 +354,9 @@ Json format_json(const std::string& path, const ImageReport& r) {
     j["kernel"] = nullptr;
     j["input_encoding"] = nullptr;
   }
+}
 
+void add_model_json(Json& j, const ImageReport& r) {
   if (r.geometry) {
     Json segments = Json::array();
     for (const auto& g : *r.geometry) {
@@ -386,6 +407,9 @@ Json format_json(const std::string& path, const ImageReport& r) {
                        {"softening_per_rad", float_json(c.softening_per_rad)},
                        {"unloaded_mass_kg", float_json(c.unloaded_mass_kg)}};
   }
+}
+
+void add_contents_json(Json& j, const ImageReport& r) {
   j["training_set"] = {{"max_abs_kernel_coordinate", r.max_abs_input ? float_json(*r.max_abs_input) : Json(nullptr)},
                        {"max_abs_alpha", r.max_abs_alpha ? float_json(*r.max_abs_alpha) : Json(nullptr)}};
 
@@ -424,6 +448,13 @@ Json format_json(const std::string& path, const ImageReport& r) {
     checks[c.name] = {{"passed", passed}, {"detail", c.detail}};
   }
   j["checks"] = checks;
+}
+
+Json format_json(const std::string& path, const ImageReport& r) {
+  Json j;
+  add_header_json(j, path, r);
+  add_model_json(j, r);
+  add_contents_json(j, r);
   return j;
 }
 
