@@ -305,6 +305,174 @@ Eigen::VectorXd coordinate_search(const Shape& shape, Eigen::VectorXd parameters
   return parameters;
 }
 
+// Akaike's penalty, one per parameter. Bayes' (log(6 N) / 2, 4.2 here)
+// chose shared widths on simulated robots where one width per cable was
+// the better model on another session's rows (0.98 against 1.02 mm, 0.93
+// against 0.97 mm); on a sequence without hysteresis Akaike's still
+// chooses none.
+constexpr double kPenaltyPerParameter = 1.0;
+
+// The candidates of identify_hysteresis(), searched in turn on one set of
+// likelihood rows; each adds itself to the result beside its structure,
+// parameters and hyperparameters.
+class CandidateSearch {
+ public:
+  CandidateSearch(Likelihood& likelihood, const model::RobotGeometry<double>& geometry,
+                  const SearchOptions& hyperparameter_search, const HysteresisSearchOptions& options,
+                  HysteresisIdentification& result)
+      : likelihood_(likelihood),
+        geometry_(geometry),
+        options_(options),
+        result_(result),
+        research_(hyperparameter_search),
+        segments_(geometry.segment_count) {
+    research_.restarts = 0;
+  }
+
+  // None: the commanded rows, hyperparameters re-searched on these rows.
+  void add_none(const KernelHyperparameters& joints_only_h) {
+    add_candidate(Shape{}, Eigen::VectorXd(), research_from({}, joints_only_h), likelihood_.evaluations());
+  }
+
+  // One width and weight for every cable, with the joints-only
+  // hyperparameters, then again with those of the effective rows, which
+  // the finer sharings then use.
+  void add_shared(const KernelHyperparameters& joints_only_h) {
+    const int before = likelihood_.evaluations();
+    const Shape shared{HysteresisSharing::all_cables, 1, segments_};
+    Eigen::VectorXd parameters(2);
+    parameters << 0.0, 1.0;
+    parameters = coordinate_search(shared, parameters, joints_only_h, likelihood_, geometry_, options_);
+    h_ = research_from(model_for(shared, parameters, geometry_), joints_only_h).hyperparameters;
+    parameters = coordinate_search(shared, parameters, h_, likelihood_, geometry_, options_, false);
+    add_candidate(shared, parameters, research_from(model_for(shared, parameters, geometry_), h_), before);
+    shared_parameters_ = parameters;
+  }
+
+  // Finer sharings start from the shared width and weight: one width per
+  // segment, then one per cable from the segments'.
+  void add_per_segment_and_per_cable() {
+    int before = likelihood_.evaluations();
+    const Shape per_segment{HysteresisSharing::per_segment, 1, segments_};
+    Eigen::VectorXd segment_parameters = Eigen::VectorXd::Constant(segments_ + 1, shared_width());
+    segment_parameters[segments_] = shared_weight();
+    segment_parameters = coordinate_search(per_segment, segment_parameters, h_, likelihood_, geometry_, options_);
+    add_searched(per_segment, segment_parameters, before);
+
+    before = likelihood_.evaluations();
+    const Shape per_cable{HysteresisSharing::per_cable, 1, segments_};
+    Eigen::VectorXd cable_parameters(4 * segments_ + 1);
+    for (int c = 0; c < 4 * segments_; ++c) cable_parameters[c] = segment_parameters[c / 4];
+    cable_parameters[4 * segments_] = segment_parameters[segments_];
+    cable_parameters_ = coordinate_search(per_cable, cable_parameters, h_, likelihood_, geometry_, options_);
+    add_searched(per_cable, cable_parameters_, before);
+  }
+
+  // Shapes: K operators of widths r/K .. r sharing the shared weight. A
+  // shape of several operators that explains the shared case better than
+  // one also gets one width per cable: the per-cable widths of one operator
+  // scaled by the ratio of the two shared widths, the shape's weights.
+  void add_operator_shapes() {
+    double best_shape_criterion = result_.candidates[1].criterion;
+    Eigen::VectorXd best_shape_parameters = shared_parameters_;
+    for (int k = 2; k <= std::min(options_.operators_max, model::kMaxHysteresisOperators); ++k) {
+      const int before = likelihood_.evaluations();
+      const Shape shape{HysteresisSharing::all_cables, k, segments_};
+      Eigen::VectorXd parameters = Eigen::VectorXd::Constant(1 + k, shared_weight() / double(k));
+      parameters[0] = shared_width();
+      parameters = coordinate_search(shape, parameters, h_, likelihood_, geometry_, options_);
+      add_searched(shape, parameters, before);
+      if (result_.candidates.back().criterion > best_shape_criterion) {
+        best_shape_criterion = result_.candidates.back().criterion;
+        best_shape_parameters = parameters;
+      }
+    }
+    const int best_operators = static_cast<int>(best_shape_parameters.size()) - 1;
+    if (best_operators <= 1) return;
+    const int before = likelihood_.evaluations();
+    const Shape shape{HysteresisSharing::per_cable, best_operators, segments_};
+    Eigen::VectorXd parameters(4 * segments_ + best_operators);
+    const double scale = shared_width() > 0.0 ? best_shape_parameters[0] / shared_width() : 1.0;
+    for (int c = 0; c < 4 * segments_; ++c) {
+      parameters[c] = std::min(model::kMaxHysteresisWidthMm, scale * cable_parameters_[c]);
+    }
+    parameters.tail(best_operators) = best_shape_parameters.tail(best_operators);
+    parameters = coordinate_search(shape, parameters, h_, likelihood_, geometry_, options_);
+    add_searched(shape, parameters, before);
+  }
+
+  // The winner was searched with the hyperparameters of one shared width,
+  // which take much of its hysteresis for noise: its parameters are refined
+  // once more with its own (then those searched again), kept if better.
+  HysteresisCandidate& refined_winner() {
+    const auto best = std::max_element(result_.candidates.begin(), result_.candidates.end(),
+                                       [](const HysteresisCandidate& a, const HysteresisCandidate& b) {
+                                         return a.criterion < b.criterion;
+                                       });
+    const Searched& winner = searched_[static_cast<std::size_t>(best - result_.candidates.begin())];
+    if (winner.shape.sharing == HysteresisSharing::none) return *best;
+    const int before_refinement = likelihood_.evaluations();
+    const Eigen::VectorXd refined = coordinate_search(winner.shape, winner.parameters, winner.hyperparameters,
+                                                      likelihood_, geometry_, options_, false);
+    const SearchResult search = research_from(model_for(winner.shape, refined, geometry_), winner.hyperparameters);
+    result_.refinement_evaluations = likelihood_.evaluations() - before_refinement;
+    if (search.log_marginal_likelihood > best->log_marginal_likelihood) {
+      result_.refinement_gain = search.log_marginal_likelihood - best->log_marginal_likelihood;
+      best->model = model_for(winner.shape, refined, geometry_);
+      best->log_marginal_likelihood = search.log_marginal_likelihood;
+      best->criterion = search.log_marginal_likelihood - kPenaltyPerParameter * double(best->parameters);
+    }
+    return *best;
+  }
+
+ private:
+  struct Searched {
+    Shape shape;
+    Eigen::VectorXd parameters;
+    KernelHyperparameters hyperparameters;
+  };
+
+  double shared_width() const { return shared_parameters_[0]; }
+  double shared_weight() const { return shared_parameters_[1]; }
+
+  SearchResult research_from(const model::HysteresisModel<double>& m, const KernelHyperparameters& start) {
+    ++result_.hyperparameter_searches;
+    const auto [x, y] = likelihood_.normalised_rows(m);
+    return maximise_likelihood(x, y, start, research_);
+  }
+
+  // A candidate searched with the effective rows' hyperparameters, which
+  // are then searched again on its rows.
+  void add_searched(const Shape& shape, const Eigen::VectorXd& parameters, int evaluations_before) {
+    add_candidate(shape, parameters, research_from(model_for(shape, parameters, geometry_), h_), evaluations_before);
+  }
+
+  void add_candidate(const Shape& shape, const Eigen::VectorXd& parameters, const SearchResult& search,
+                     int evaluations_before) {
+    HysteresisCandidate c;
+    c.sharing = shape.sharing;
+    c.operators = shape.operators;
+    c.parameters = shape.parameters();
+    c.model = model_for(shape, parameters, geometry_);
+    c.log_marginal_likelihood = search.log_marginal_likelihood;
+    c.criterion = search.log_marginal_likelihood - kPenaltyPerParameter * double(c.parameters);
+    c.likelihood_evaluations = likelihood_.evaluations() - evaluations_before;
+    result_.candidates.push_back(c);
+    searched_.push_back({shape, parameters, search.hyperparameters});
+  }
+
+  Likelihood& likelihood_;
+  const model::RobotGeometry<double>& geometry_;
+  const HysteresisSearchOptions& options_;
+  HysteresisIdentification& result_;
+  SearchOptions research_;
+  int segments_;
+  KernelHyperparameters h_;
+  Eigen::VectorXd shared_parameters_;
+  Eigen::VectorXd cable_parameters_;
+  std::vector<Searched> searched_;
+};
+
 }  // namespace
 
 HysteresisIdentification identify_hysteresis(const dataset::Dataset& data, const std::vector<int>& train_rows,
@@ -330,132 +498,14 @@ HysteresisIdentification identify_hysteresis(const dataset::Dataset& data, const
   Likelihood likelihood(data, likelihood_rows(train_rows, options.max_rows, training_options.search.seed), geometry,
                         training_options.encoding, with_payload);
   result.rows = likelihood.rows();
-  SearchOptions research = training_options.search;
-  research.restarts = 0;
-  const auto research_from = [&](const model::HysteresisModel<double>& m, const KernelHyperparameters& start) {
-    ++result.hyperparameter_searches;
-    const auto [x, y] = likelihood.normalised_rows(m);
-    return maximise_likelihood(x, y, start, research);
-  };
-  // Akaike's penalty, one per parameter. Bayes' (log(6 N) / 2, 4.2 here)
-  // chose shared widths on simulated robots where one width per cable was
-  // the better model on another session's rows (0.98 against 1.02 mm, 0.93
-  // against 0.97 mm); on a sequence without hysteresis Akaike's still
-  // chooses none.
-  constexpr double penalty_per_parameter = 1.0;
-  // Beside each candidate: its structure, parameters and hyperparameters.
-  struct Searched {
-    Shape shape;
-    Eigen::VectorXd parameters;
-    KernelHyperparameters hyperparameters;
-  };
-  std::vector<Searched> searched;
-  const auto add_candidate = [&](const Shape& shape, const Eigen::VectorXd& parameters, const SearchResult& search,
-                                 int evaluations_before) {
-    HysteresisCandidate c;
-    c.sharing = shape.sharing;
-    c.operators = shape.operators;
-    c.parameters = shape.parameters();
-    c.model = model_for(shape, parameters, geometry);
-    c.log_marginal_likelihood = search.log_marginal_likelihood;
-    c.criterion = search.log_marginal_likelihood - penalty_per_parameter * double(c.parameters);
-    c.likelihood_evaluations = likelihood.evaluations() - evaluations_before;
-    result.candidates.push_back(c);
-    searched.push_back({shape, parameters, search.hyperparameters});
-  };
-  const int segments = geometry.segment_count;
-
-  // None: the commanded rows, hyperparameters re-searched on these rows.
-  add_candidate(Shape{}, Eigen::VectorXd(), research_from({}, joints_only_h), likelihood.evaluations());
-
-  // One width and weight for every cable, with the joints-only
-  // hyperparameters, then again with those of the effective rows.
-  int before = likelihood.evaluations();
-  const Shape shared{HysteresisSharing::all_cables, 1, segments};
-  Eigen::VectorXd shared_parameters(2);
-  shared_parameters << 0.0, 1.0;
-  shared_parameters = coordinate_search(shared, shared_parameters, joints_only_h, likelihood, geometry, options);
-  const SearchResult first_research = research_from(model_for(shared, shared_parameters, geometry), joints_only_h);
-  const KernelHyperparameters h = first_research.hyperparameters;
-  shared_parameters = coordinate_search(shared, shared_parameters, h, likelihood, geometry, options, false);
-  add_candidate(shared, shared_parameters, research_from(model_for(shared, shared_parameters, geometry), h), before);
-
-  // Finer sharings start from the shared width and weight.
-  const double shared_width = shared_parameters[0];
-  const double shared_weight = shared_parameters[1];
-  before = likelihood.evaluations();
-  const Shape per_segment{HysteresisSharing::per_segment, 1, segments};
-  Eigen::VectorXd segment_parameters = Eigen::VectorXd::Constant(segments + 1, shared_width);
-  segment_parameters[segments] = shared_weight;
-  segment_parameters = coordinate_search(per_segment, segment_parameters, h, likelihood, geometry, options);
-  add_candidate(per_segment, segment_parameters, research_from(model_for(per_segment, segment_parameters, geometry), h),
-                before);
-
-  before = likelihood.evaluations();
-  const Shape per_cable{HysteresisSharing::per_cable, 1, segments};
-  Eigen::VectorXd cable_parameters(4 * segments + 1);
-  for (int c = 0; c < 4 * segments; ++c) cable_parameters[c] = segment_parameters[c / 4];
-  cable_parameters[4 * segments] = segment_parameters[segments];
-  cable_parameters = coordinate_search(per_cable, cable_parameters, h, likelihood, geometry, options);
-  add_candidate(per_cable, cable_parameters, research_from(model_for(per_cable, cable_parameters, geometry), h), before);
-
-  // Shapes: K operators of widths r/K .. r sharing the shared weight.
-  const double shared_criterion = result.candidates[1].criterion;
-  double best_shape_criterion = shared_criterion;
-  Eigen::VectorXd best_shape_parameters = shared_parameters;
-  for (int k = 2; k <= std::min(options.operators_max, model::kMaxHysteresisOperators); ++k) {
-    before = likelihood.evaluations();
-    const Shape shape{HysteresisSharing::all_cables, k, segments};
-    Eigen::VectorXd parameters = Eigen::VectorXd::Constant(1 + k, shared_weight / double(k));
-    parameters[0] = shared_width;
-    parameters = coordinate_search(shape, parameters, h, likelihood, geometry, options);
-    add_candidate(shape, parameters, research_from(model_for(shape, parameters, geometry), h), before);
-    if (result.candidates.back().criterion > best_shape_criterion) {
-      best_shape_criterion = result.candidates.back().criterion;
-      best_shape_parameters = parameters;
-    }
-  }
-
-  // A shape of several operators that explains the shared case better than
-  // one also gets one width per cable: the per-cable widths of one operator
-  // scaled by the ratio of the two shared widths, the shape's weights.
-  const int best_operators = static_cast<int>(best_shape_parameters.size()) - 1;
-  if (best_operators > 1) {
-    before = likelihood.evaluations();
-    const Shape shape{HysteresisSharing::per_cable, best_operators, segments};
-    Eigen::VectorXd parameters(4 * segments + best_operators);
-    const double scale = shared_width > 0.0 ? best_shape_parameters[0] / shared_width : 1.0;
-    for (int c = 0; c < 4 * segments; ++c) {
-      parameters[c] = std::min(model::kMaxHysteresisWidthMm, scale * cable_parameters[c]);
-    }
-    parameters.tail(best_operators) = best_shape_parameters.tail(best_operators);
-    parameters = coordinate_search(shape, parameters, h, likelihood, geometry, options);
-    add_candidate(shape, parameters, research_from(model_for(shape, parameters, geometry), h), before);
-  }
-
-  const auto best = std::max_element(result.candidates.begin(), result.candidates.end(),
-                                     [](const HysteresisCandidate& a, const HysteresisCandidate& b) {
-                                       return a.criterion < b.criterion;
-                                     });
-  // The winner was searched with the hyperparameters of one shared width,
-  // which take much of its hysteresis for noise: its parameters are refined
-  // once more with its own (then those searched again), kept if better.
-  const Searched& winner = searched[static_cast<std::size_t>(best - result.candidates.begin())];
-  if (winner.shape.sharing != HysteresisSharing::none) {
-    const int before_refinement = likelihood.evaluations();
-    const Eigen::VectorXd refined =
-        coordinate_search(winner.shape, winner.parameters, winner.hyperparameters, likelihood, geometry, options, false);
-    const SearchResult search = research_from(model_for(winner.shape, refined, geometry), winner.hyperparameters);
-    result.refinement_evaluations = likelihood.evaluations() - before_refinement;
-    if (search.log_marginal_likelihood > best->log_marginal_likelihood) {
-      result.refinement_gain = search.log_marginal_likelihood - best->log_marginal_likelihood;
-      best->model = model_for(winner.shape, refined, geometry);
-      best->log_marginal_likelihood = search.log_marginal_likelihood;
-      best->criterion = search.log_marginal_likelihood - penalty_per_parameter * double(best->parameters);
-    }
-  }
-  result.model = best->model;
-  result.sharing = best->sharing;
+  CandidateSearch search(likelihood, geometry, training_options.search, options, result);
+  search.add_none(joints_only_h);
+  search.add_shared(joints_only_h);
+  search.add_per_segment_and_per_cable();
+  search.add_operator_shapes();
+  const HysteresisCandidate& best = search.refined_winner();
+  result.model = best.model;
+  result.sharing = best.sharing;
   result.likelihood_evaluations = likelihood.evaluations();
   return result;
 }
