@@ -87,21 +87,31 @@ Eigen::MatrixXd effective_cables(const model::ImageView& image, const model::Hys
   return effective.cast<double>();
 }
 
-CommandOutput run_eval(const EvalCommandOptions& o) {
-  const LoadedImage image = load_image(o.model_path);
-  const dataset::Dataset data = load_dataset(o.data_path, true);
+// What the image and the rows hold, checked against each other before any
+// row is evaluated.
+struct EvalInputs {
+  LoadedImage image;
+  dataset::Dataset data;
   model::RobotGeometry<double> geometry;
-  if (const model::Status s = model::geometry_from_image(image.view, geometry); s != model::Status::ok) {
+  bool payload_input = false;
+  model::HysteresisModel<float> hysteresis;
+  bool with_hysteresis = false;
+};
+
+EvalInputs load_eval_inputs(const EvalCommandOptions& o) {
+  EvalInputs in{load_image(o.model_path), load_dataset(o.data_path, true)};
+  const dataset::Dataset& data = in.data;
+  if (const model::Status s = model::geometry_from_image(in.image.view, in.geometry); s != model::Status::ok) {
     throw InputError(fmt::format("{}: geometry: {}", o.model_path, model::to_string(s)));
   }
-  if (data.segment_count != geometry.segment_count) {
+  if (data.segment_count != in.geometry.segment_count) {
     throw InputError(fmt::format("{} has {} segments but the model has {}", o.data_path, data.segment_count,
-                                 geometry.segment_count));
+                                 in.geometry.segment_count));
   }
   // A payload model needs the column; a model without the input runs on
   // the cables alone and the column is ignored (the output says so).
-  const bool payload_input = image.view.extra_inputs > 0;
-  if (payload_input && !data.has_payload) {
+  in.payload_input = in.image.view.extra_inputs > 0;
+  if (in.payload_input && !data.has_payload) {
     throw InputError(fmt::format("{}: the model takes a payload input and the data have no payload_kg column",
                                  o.data_path));
   }
@@ -111,124 +121,149 @@ CommandOutput run_eval(const EvalCommandOptions& o) {
     throw InputError(fmt::format("{}: --from-power-up needs a motion sequence (a t_s column), but the rows have no time",
                                  o.data_path));
   }
-  model::HysteresisModel<float> hysteresis;
-  const bool with_hysteresis = model::hysteresis_from_image(image.view, hysteresis);
-  if (o.from_power_up && !with_hysteresis) {
+  in.with_hysteresis = model::hysteresis_from_image(in.image.view, in.hysteresis);
+  if (o.from_power_up && !in.with_hysteresis) {
     throw InputError(fmt::format("{}: --from-power-up needs an image with a hysteresis block", o.model_path));
   }
-  if (with_hysteresis && !data.has_time) {
+  if (in.with_hysteresis && !data.has_time) {
     throw InputError(fmt::format("{}: the model compensates the cables' hysteresis and needs a motion sequence (a t_s "
                                  "column), but the rows have no time",
                                  o.data_path));
   }
-  const char* payload_use = payload_input ? "used" : (data.has_payload ? "ignored" : "none");
+  return in;
+}
+
+// The rows through the board's path, and what is reported of them.
+struct EvalResults {
   training::TrainingSet set;
   std::vector<model::Pose<double>> compensated;
   std::vector<training::FirmwareEstimate> estimates;
   PowerUpEstimates power_up;
+  training::MeanErrors initial, after;
+  bool has_variance = false;
+  training::CoverageCheck coverage, first_coverage, rest_coverage;
+  bool report_power_up = false;
+};
+
+EvalResults evaluate(const EvalCommandOptions& o, const EvalInputs& in) {
+  EvalResults r;
+  const model::ImageView& view = in.image.view;
   try {
-    set = training::make_training_set(data, geometry, image.view.encoding, payload_input);
+    r.set = training::make_training_set(in.data, in.geometry, view.encoding, in.payload_input);
     // The nominal (initial) error stays that of the commanded lengths.
-    const Eigen::MatrixXd cables_mm =
-        with_hysteresis ? effective_cables(image.view, hysteresis, set.cables_mm, data.session_starts) : set.cables_mm;
-    compensated =
-        training::firmware_poses(image.view, cables_mm, training::FirmwareAccumulator::float64, set.payload_kg);
-    estimates = training::firmware_estimates(image.view, cables_mm, set.payload_kg);
+    const Eigen::MatrixXd cables_mm = in.with_hysteresis
+                                          ? effective_cables(view, in.hysteresis, r.set.cables_mm, in.data.session_starts)
+                                          : r.set.cables_mm;
+    r.compensated = training::firmware_poses(view, cables_mm, training::FirmwareAccumulator::float64, r.set.payload_kg);
+    r.estimates = training::firmware_estimates(view, cables_mm, r.set.payload_kg);
     if (o.from_power_up) {
       // The first session again, from power-up: the board's own path.
       const Eigen::Index first_session_rows =
-          data.session_starts.size() > 1 ? data.session_starts[1] : set.cables_mm.rows();
-      power_up = estimates_from_power_up(image.view, set.cables_mm.topRows(first_session_rows));
-      for (std::size_t i = 0; i < power_up.estimates.size(); ++i) {
-        estimates[i] = power_up.estimates[i];
-        compensated[i] = power_up.estimates[i].pose;
+          in.data.session_starts.size() > 1 ? in.data.session_starts[1] : r.set.cables_mm.rows();
+      r.power_up = estimates_from_power_up(view, r.set.cables_mm.topRows(first_session_rows));
+      for (std::size_t i = 0; i < r.power_up.estimates.size(); ++i) {
+        r.estimates[i] = r.power_up.estimates[i];
+        r.compensated[i] = r.power_up.estimates[i].pose;
       }
     }
   } catch (const std::invalid_argument& e) {
     throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
   }
-  const training::MeanErrors initial = training::mean_errors(set.measured, set.nominal);
-  const training::MeanErrors after = training::mean_errors(set.measured, compensated);
-  const bool has_variance = image.view.variance_rank > 0;
-  const training::CoverageCheck coverage = training::check_coverage(set.measured, estimates);
-  const int first_rows = std::min(o.first_rows, set.size());
-  const training::CoverageCheck first_coverage = coverage_of(set.measured, estimates, 0, first_rows);
-  const training::CoverageCheck rest_coverage = coverage_of(set.measured, estimates, first_rows, set.size());
-  const bool report_power_up = o.from_power_up && has_variance;
+  r.initial = training::mean_errors(r.set.measured, r.set.nominal);
+  r.after = training::mean_errors(r.set.measured, r.compensated);
+  r.has_variance = view.variance_rank > 0;
+  r.coverage = training::check_coverage(r.set.measured, r.estimates);
+  const int first_rows = std::min(o.first_rows, r.set.size());
+  r.first_coverage = coverage_of(r.set.measured, r.estimates, 0, first_rows);
+  r.rest_coverage = coverage_of(r.set.measured, r.estimates, first_rows, r.set.size());
+  r.report_power_up = o.from_power_up && r.has_variance;
+  return r;
+}
 
-  if (!o.rows_path.empty()) write_rows(o.rows_path, set, estimates);
+const char* payload_use(const EvalInputs& in) {
+  return in.payload_input ? "used" : (in.data.has_payload ? "ignored" : "none");
+}
 
-  CommandOutput output;
-  if (o.json) {
-    Json j;
-    j["n"] = set.size();
-    j["initial"] = {{"position_mm", initial.position_mm}, {"orientation_deg", initial.orientation_deg}};
-    j["compensated"] = {{"position_mm", after.position_mm}, {"orientation_deg", after.orientation_deg}};
-    j["extrapolating"] = coverage.extrapolating;
-    j["outside_range"] = coverage.outside_range;
-    j["payload"] = payload_use;
-    j["hysteresis"] = o.from_power_up     ? "carried over the sequence, the first session from power-up"
-                      : with_hysteresis ? "carried over the sequence"
-                                        : "none";
-    if (o.from_power_up) {
-      j["power_up"] = {{"unknown_rows", power_up.unknown_rows},
-                       {"first_rows", report_power_up ? coverage_json(first_coverage) : Json(nullptr)},
-                       {"later_rows", report_power_up && rest_coverage.samples > 0 ? coverage_json(rest_coverage)
-                                                                                 : Json(nullptr)}};
-    }
-    if (has_variance) {
-      j["coverage"] = {{"r95_mm", coverage.position_coverage},
-                       {"r95_deg", coverage.orientation_coverage},
-                       {"median_r95_mm", coverage.median_r95_mm},
-                       {"median_r95_deg", coverage.median_r95_deg},
-                       {"median_latent_share", coverage.median_latent_share}};
-    } else {
-      j["coverage"] = nullptr;
-    }
-    output.text = j.dump() + "\n";
-  } else {
-    output.text = fmt::format(
-        "{} samples                position (mm)   orientation (deg)\n"
-        "  initial (nominal)    {:13.4f}   {:17.4f}\n"
-        "  compensated          {:13.4f}   {:17.4f}\n",
-        set.size(), initial.position_mm, initial.orientation_deg, after.position_mm, after.orientation_deg);
-    if (has_variance) {
-      output.text += fmt::format(
-          "  within r95           {:12.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
-          100.0 * coverage.position_coverage, 100.0 * coverage.orientation_coverage, coverage.median_r95_mm,
-          coverage.median_r95_deg);
-    } else {
-      output.text += "  within r95           the image carries no variance\n";
-    }
-    output.text += fmt::format("  extrapolating        {} of {} samples ({} outside the fitted input range)\n",
-                               coverage.extrapolating, set.size(), coverage.outside_range);
-    if (o.from_power_up) {
-      output.text += fmt::format(
-          "  hysteresis           carried from row to row over {} session(s), the first from power-up (state unknown "
-          "for its first {} rows, r95 widened){}\n",
-          std::max<std::size_t>(1, data.session_starts.size()), power_up.unknown_rows,
-          data.session_starts.size() > 1 ? ", the others from home" : "");
-      if (report_power_up) {
-        output.text += fmt::format("  within r95, first {:3} rows {:6.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
-                                   first_coverage.samples, 100.0 * first_coverage.position_coverage,
-                                   100.0 * first_coverage.orientation_coverage, first_coverage.median_r95_mm,
-                                   first_coverage.median_r95_deg);
-      }
-      if (report_power_up && rest_coverage.samples > 0) {
-        output.text += fmt::format("  within r95, later rows  {:9.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
-                                   100.0 * rest_coverage.position_coverage, 100.0 * rest_coverage.orientation_coverage,
-                                   rest_coverage.median_r95_mm, rest_coverage.median_r95_deg);
-      }
-    } else if (with_hysteresis) {
-      output.text += fmt::format("  hysteresis           carried from row to row over {} session(s), each from home\n",
-                                 std::max<std::size_t>(1, data.session_starts.size()));
-    }
-    if (data.has_payload && !payload_input) {
-      output.text += "  payload              the payload_kg column is ignored: the model has no payload input\n";
-    } else if (payload_input) {
-      output.text += "  payload              each sample's payload_kg is the model's payload input\n";
-    }
+std::string eval_json(const EvalCommandOptions& o, const EvalInputs& in, const EvalResults& r) {
+  Json j;
+  j["n"] = r.set.size();
+  j["initial"] = {{"position_mm", r.initial.position_mm}, {"orientation_deg", r.initial.orientation_deg}};
+  j["compensated"] = {{"position_mm", r.after.position_mm}, {"orientation_deg", r.after.orientation_deg}};
+  j["extrapolating"] = r.coverage.extrapolating;
+  j["outside_range"] = r.coverage.outside_range;
+  j["payload"] = payload_use(in);
+  j["hysteresis"] = o.from_power_up      ? "carried over the sequence, the first session from power-up"
+                    : in.with_hysteresis ? "carried over the sequence"
+                                         : "none";
+  if (o.from_power_up) {
+    j["power_up"] = {{"unknown_rows", r.power_up.unknown_rows},
+                     {"first_rows", r.report_power_up ? coverage_json(r.first_coverage) : Json(nullptr)},
+                     {"later_rows", r.report_power_up && r.rest_coverage.samples > 0 ? coverage_json(r.rest_coverage)
+                                                                                     : Json(nullptr)}};
   }
+  if (r.has_variance) {
+    j["coverage"] = {{"r95_mm", r.coverage.position_coverage},
+                     {"r95_deg", r.coverage.orientation_coverage},
+                     {"median_r95_mm", r.coverage.median_r95_mm},
+                     {"median_r95_deg", r.coverage.median_r95_deg},
+                     {"median_latent_share", r.coverage.median_latent_share}};
+  } else {
+    j["coverage"] = nullptr;
+  }
+  return j.dump() + "\n";
+}
+
+std::string eval_text(const EvalCommandOptions& o, const EvalInputs& in, const EvalResults& r) {
+  const training::CoverageCheck& coverage = r.coverage;
+  std::string text = fmt::format(
+      "{} samples                position (mm)   orientation (deg)\n"
+      "  initial (nominal)    {:13.4f}   {:17.4f}\n"
+      "  compensated          {:13.4f}   {:17.4f}\n",
+      r.set.size(), r.initial.position_mm, r.initial.orientation_deg, r.after.position_mm, r.after.orientation_deg);
+  if (r.has_variance) {
+    text += fmt::format("  within r95           {:12.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
+                        100.0 * coverage.position_coverage, 100.0 * coverage.orientation_coverage,
+                        coverage.median_r95_mm, coverage.median_r95_deg);
+  } else {
+    text += "  within r95           the image carries no variance\n";
+  }
+  text += fmt::format("  extrapolating        {} of {} samples ({} outside the fitted input range)\n",
+                      coverage.extrapolating, r.set.size(), coverage.outside_range);
+  const std::size_t sessions = std::max<std::size_t>(1, in.data.session_starts.size());
+  if (o.from_power_up) {
+    text += fmt::format(
+        "  hysteresis           carried from row to row over {} session(s), the first from power-up (state unknown "
+        "for its first {} rows, r95 widened){}\n",
+        sessions, r.power_up.unknown_rows, in.data.session_starts.size() > 1 ? ", the others from home" : "");
+    if (r.report_power_up) {
+      text += fmt::format("  within r95, first {:3} rows {:6.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
+                          r.first_coverage.samples, 100.0 * r.first_coverage.position_coverage,
+                          100.0 * r.first_coverage.orientation_coverage, r.first_coverage.median_r95_mm,
+                          r.first_coverage.median_r95_deg);
+    }
+    if (r.report_power_up && r.rest_coverage.samples > 0) {
+      text += fmt::format("  within r95, later rows  {:9.1f}%   {:16.1f}%   (median r95 {:.3f} mm, {:.4f} deg)\n",
+                          100.0 * r.rest_coverage.position_coverage, 100.0 * r.rest_coverage.orientation_coverage,
+                          r.rest_coverage.median_r95_mm, r.rest_coverage.median_r95_deg);
+    }
+  } else if (in.with_hysteresis) {
+    text += fmt::format("  hysteresis           carried from row to row over {} session(s), each from home\n",
+                        sessions);
+  }
+  if (in.data.has_payload && !in.payload_input) {
+    text += "  payload              the payload_kg column is ignored: the model has no payload input\n";
+  } else if (in.payload_input) {
+    text += "  payload              each sample's payload_kg is the model's payload input\n";
+  }
+  return text;
+}
+
+CommandOutput run_eval(const EvalCommandOptions& o) {
+  const EvalInputs in = load_eval_inputs(o);
+  const EvalResults results = evaluate(o, in);
+  if (!o.rows_path.empty()) write_rows(o.rows_path, results.set, results.estimates);
+  CommandOutput output;
+  output.text = o.json ? eval_json(o, in, results) : eval_text(o, in, results);
   return output;
 }
 
