@@ -8,7 +8,7 @@
 set -euo pipefail
 
 declare -A package_groups=(
-  [base]="build-essential cmake pkg-config libeigen3-dev libopenblas-dev libcli11-dev nlohmann-json3-dev libfmt-dev liblbfgspp-dev libgtest-dev libgmock-dev libbenchmark-dev python3"
+  [base]="build-essential cmake pkg-config libeigen3-dev libopenblas-dev libcli11-dev nlohmann-json3-dev libfmt-dev liblbfgspp-dev libgtest-dev libgmock-dev libbenchmark-dev python3 universal-ctags"
   # The reference implementation the GP trainer is tested and benchmarked against.
   [sklearn]="python3-sklearn python3-numpy"
   # The libFuzzer targets (ctest -L fuzz). clang does not pull in the fuzzer

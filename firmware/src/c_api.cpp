@@ -12,6 +12,7 @@
 
 #include "cdcr/callbacks/callback_hal.hpp"
 #include "cdcr/firmware/runtime.hpp"
+#include "cdcr/model/unit_quaternion.hpp"
 
 namespace cdcr::firmware {
 namespace {
@@ -248,7 +249,7 @@ cdcr_result cdcr_set_target(cdcr_runtime* runtime, const cdcr_target* target) {
       if (!std::isfinite(q)) return CDCR_ERROR_OUT_OF_RANGE;
       norm2 += double(q) * q;
     }
-    if (std::fabs(std::sqrt(norm2) - 1.0) > protocol::kQuaternionNormTolerance) return CDCR_ERROR_INVALID_ARGUMENT;
+    if (!cdcr::model::is_unit_quaternion_norm(std::sqrt(norm2))) return CDCR_ERROR_INVALID_ARGUMENT;
   }
   if (!c->inputs.has_room(pose ? 3 : 2)) return CDCR_ERROR_QUEUE_FULL;
   c->inputs.push_target(*target);
@@ -267,13 +268,11 @@ cdcr_result cdcr_get_pose(const cdcr_runtime* runtime, cdcr_pose* pose) {
     pose->position_mm[i] = estimate.pose.position_mm[i];
     for (int j = 0; j < 3; ++j) pose->rotation[3 * i + j] = estimate.pose.rotation(i, j);
   }
-  Eigen::Quaternion<firmware::Scalar> q(estimate.pose.rotation);
-  q.normalize();
-  const float sign = q.w() < 0 ? -1.0f : 1.0f;
-  pose->quaternion[0] = sign * q.w();
-  pose->quaternion[1] = sign * q.x();
-  pose->quaternion[2] = sign * q.y();
-  pose->quaternion[3] = sign * q.z();
+  const Eigen::Quaternion<firmware::Scalar> q = cdcr::model::canonical_quaternion(estimate.pose.rotation);
+  pose->quaternion[0] = q.w();
+  pose->quaternion[1] = q.x();
+  pose->quaternion[2] = q.y();
+  pose->quaternion[3] = q.z();
   pose->segment_count = rt.geometry().segment_count;
   for (int i = 0; i < 2 * pose->segment_count; ++i) pose->joints[i] = estimate.joints[i];
   pose->compensated = estimate.compensated ? 1 : 0;

@@ -6,6 +6,7 @@
 
 #include "cdcr/firmware/console_line.hpp"
 #include "cdcr/firmware/model_loader.hpp"
+#include "cdcr/model/unit_quaternion.hpp"
 
 namespace cdcr::firmware {
 
@@ -13,12 +14,9 @@ namespace {
 
 std::int64_t to_us(std::int64_t ns) { return (ns + 500) / 1000; }
 
-// Hamilton quaternion, w first, with w >= 0 so each rotation has one encoding.
 protocol::PoseOrientation orientation_frame(const model::Mat3<Scalar>& rotation) {
-  Eigen::Quaternion<Scalar> quaternion(rotation);
-  quaternion.normalize();
-  const double sign = quaternion.w() < 0 ? -1.0 : 1.0;
-  return {sign * quaternion.w(), sign * quaternion.x(), sign * quaternion.y(), sign * quaternion.z()};
+  const Eigen::Quaternion<Scalar> quaternion = model::canonical_quaternion(rotation);
+  return {quaternion.w(), quaternion.x(), quaternion.y(), quaternion.z()};
 }
 
 }  // namespace
@@ -168,7 +166,7 @@ void Runtime::set_target(const TargetRequest& request) {
   const double* q = request.quaternion;
   const double norm = std::sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
   if (!request.well_formed ||
-      (request.mode == protocol::TargetMode::pose && !(std::abs(norm - 1.0) <= protocol::kQuaternionNormTolerance))) {
+      (request.mode == protocol::TargetMode::pose && !model::is_unit_quaternion_norm(norm))) {
     reject_input(FaultCode::target_malformed);
     ik_.refuse(request.sequence, protocol::IkOutcome::rejected_malformed);
     return;

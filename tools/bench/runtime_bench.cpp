@@ -34,6 +34,7 @@
 #include <memory>
 #include <random>
 #include <stdexcept>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -295,6 +296,155 @@ Interruptions measure_interruptions() {
   return Interruptions{double(count), count > 0 ? total_us / double(count) : 0.0};
 }
 
+// The image on the simulated board, parsed for the bare baselines too.
+struct BenchModel {
+  explicit BenchModel(const std::vector<std::uint8_t>& image, const Options& options)
+      : aligned(image), probe(boot(image)), workload(make_workload(probe, options)) {
+    model::ImageCapacity capacity;
+    capacity.max_training_points = fw::kMaxTrainingPoints;
+    capacity.max_segments = fw::kMaxSegments;
+    const auto region = aligned.model_region();
+    if (model::parse_image(region.data, region.size_bytes, view, capacity) != model::ImageStatus::ok) {
+      throw std::runtime_error("image does not parse");
+    }
+    if (correction.bind(view) != model::Status::ok) throw std::runtime_error("image does not bind");
+    if (portable_correction.bind(view) != model::Status::ok) throw std::runtime_error("image does not bind");
+  }
+
+  fw::Runtime& boot(const std::vector<std::uint8_t>& image) {
+    probe_platform.storage.assign(image);
+    probe_runtime.emplace(probe_platform.hal, fw::Geometry::prototype());
+    if (probe_runtime->init() != fw::RuntimeState::run) {
+      throw std::runtime_error(std::string("image does not boot: ") + fw::to_string(probe_runtime->boot_fault()));
+    }
+    return *probe_runtime;
+  }
+
+  const sim::MemoryModelStorage aligned;
+  sim::SimulatedPlatform probe_platform;
+  std::optional<fw::Runtime> probe_runtime;
+  fw::Runtime& probe;
+  const Workload workload;
+  model::ImageView view{};
+  fw::Correction correction;
+  // The plain C++ loops on the same image, for the ratio to the build's.
+  model::GpCorrection<float, fw::Accumulator, fw::kMaxSegments, model::arch::Portable> portable_correction;
+};
+
+// Every run's figures: the baselines' per-call times and, per kind of
+// cycle, the percentiles and the IK's requests.
+struct Measurements {
+  std::vector<double> fk_ns, gp_ns, portable_gp_ns, evaluation_ns;
+  std::vector<double> p50[kKindCount], p99[kKindCount], paced_p99[kKindCount], spin_p99[kKindCount];
+  std::vector<std::int64_t> all_iterations[kKindCount], all_request_cycles[kKindCount];
+  std::int64_t worst_ns[kKindCount] = {}, worst_cpu_ns[kKindCount] = {};
+  long converged[kKindCount] = {}, total[kKindCount] = {};
+};
+
+void measure_baselines(const BenchModel& m, Measurements& out) {
+  const Workload& w = m.workload;
+  const fw::Geometry& geometry = m.probe.geometry();
+  out.fk_ns.push_back(per_call_ns([&](std::size_t i) {
+    g_sink = g_sink + model::forward_kinematics_bend(w.bends[i], geometry).position_mm.x();
+  }));
+  out.gp_ns.push_back(per_call_ns([&](std::size_t i) { g_sink = g_sink + m.correction.predict(w.bends[i])[0]; }));
+  out.portable_gp_ns.push_back(
+      per_call_ns([&](std::size_t i) { g_sink = g_sink + m.portable_correction.predict(w.bends[i])[0]; }));
+  // What each IK iteration evaluates (see evaluate_model in inverse_kinematics.hpp).
+  out.evaluation_ns.push_back(per_call_ns([&](std::size_t i) {
+    model::Pose<float> tip;
+    model::Jacobian<float, fw::kMaxSegments> jacobian, d_eps;
+    model::Twist<float> eps;
+    model::tip_jacobian_bend(w.bends[i], geometry, tip, jacobian);
+    m.correction(w.bends[i], eps, d_eps);
+    const model::Pose<float> correction_pose = model::exp(eps);
+    model::apply_adjoint(correction_pose, jacobian);
+    jacobian.noalias() += model::left_jacobian(eps) * d_eps;
+    g_sink = g_sink + (correction_pose * tip).position_mm.x() + jacobian(0, 0);
+  }));
+}
+
+void measure_cycles(const std::vector<std::uint8_t>& image, const BenchModel& m, const Options& options,
+                    Measurements& out) {
+  for (int k = 0; k < kKindCount; ++k) {
+    const CycleKind kind = kKinds[k];
+    const int cycles = kind == CycleKind::forward ? options.forward_cycles : options.ik_cycles;
+    const CycleSamples s = run_cycles(image, m.workload, kind, cycles, Pace::back_to_back);
+    out.paced_p99[k].push_back(percentile(run_cycles(image, m.workload, kind, cycles, Pace::sleep).ns, 0.99));
+    out.spin_p99[k].push_back(percentile(run_cycles(image, m.workload, kind, cycles, Pace::spin).ns, 0.99));
+    out.p50[k].push_back(percentile(s.ns, 0.50));
+    out.p99[k].push_back(percentile(s.ns, 0.99));
+    out.worst_ns[k] = std::max(out.worst_ns[k], *std::max_element(s.ns.begin(), s.ns.end()));
+    out.worst_cpu_ns[k] = std::max(out.worst_cpu_ns[k], *std::max_element(s.cpu_ns.begin(), s.cpu_ns.end()));
+    out.all_iterations[k].insert(out.all_iterations[k].end(), s.iterations.begin(), s.iterations.end());
+    out.all_request_cycles[k].insert(out.all_request_cycles[k].end(), s.request_cycles.begin(),
+                                     s.request_cycles.end());
+    out.converged[k] += s.converged;
+    out.total[k] += long(s.iterations.size());
+  }
+}
+
+void print_table(const BenchModel& m, const Options& options, const Measurements& r) {
+  const model::ImageView& view = m.view;
+  const double fk_baseline_ns = median(r.fk_ns);
+  const double gp_baseline_ns = median(r.gp_ns);
+  const double portable_gp_baseline_ns = median(r.portable_gp_ns);
+  const double evaluation_baseline_ns = median(r.evaluation_ns);
+  std::printf("Image: %u training points, %d inputs (%s), %d segments; IK: %u work units per cycle, "
+              "at most %d cycles per request\n",
+              view.training_points, view.input_dims, model::to_string(view.encoding), view.segment_count,
+              m.probe.ik_units_per_cycle(), fw::kMaxIkCycles);
+  std::printf("%d runs; per run %d forward cycles and %d cycles of each IK kind, back to back and then at "
+              "1 kHz, sleeping and spinning to each release. p50/p99: median over runs; max: worst of all runs "
+              "back to back.\n\n",
+              options.repetitions, options.forward_cycles, options.ik_cycles);
+  std::printf("| cycle | p50 us | p99 us | max us | max us, thread CPU | p99 us at 1 kHz, sleeping | "
+              "p99 us at 1 kHz, spinning | p50 / FK | p99 / FK | requests | cycles per request p50 / p99 / max | "
+              "iterations p50 / p99 / max | converged |\n");
+  std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
+  double worst_p99_us = 0;
+  double worst_paced_p99_us = 0;
+  double worst_spin_p99_us = 0;
+  for (int k = 0; k < kKindCount; ++k) {
+    const double m50 = median(r.p50[k]), m99 = median(r.p99[k]), paced99 = median(r.paced_p99[k]);
+    const double spin99 = median(r.spin_p99[k]);
+    worst_p99_us = std::max(worst_p99_us, m99 * 1e-3);
+    worst_paced_p99_us = std::max(worst_paced_p99_us, paced99 * 1e-3);
+    worst_spin_p99_us = std::max(worst_spin_p99_us, spin99 * 1e-3);
+    std::printf("| %s | %.2f | %.2f | %.1f | %.1f | %.2f | %.2f | %.1f | %.1f |", label(kKinds[k]), m50 * 1e-3,
+                m99 * 1e-3, double(r.worst_ns[k]) * 1e-3, double(r.worst_cpu_ns[k]) * 1e-3, paced99 * 1e-3,
+                spin99 * 1e-3, m50 / fk_baseline_ns, m99 / fk_baseline_ns);
+    if (r.total[k] == 0) {
+      std::printf(" - | - | - | - |\n");
+    } else {
+      std::printf(" %ld | %.0f / %.0f / %.0f | %.0f / %.0f / %.0f | %.1f%% |\n", r.total[k],
+                  percentile(r.all_request_cycles[k], 0.5), percentile(r.all_request_cycles[k], 0.99),
+                  percentile(r.all_request_cycles[k], 1.0), percentile(r.all_iterations[k], 0.5),
+                  percentile(r.all_iterations[k], 0.99), percentile(r.all_iterations[k], 1.0),
+                  100.0 * double(r.converged[k]) / double(r.total[k]));
+    }
+  }
+  std::printf("| baseline: nominal FK (`forward_kinematics_bend`, float) | %.3f | | | | | | 1.0 | | | | | |\n",
+              fk_baseline_ns * 1e-3);
+  std::printf("| baseline: bare GP predict (%u points, %s loops) | %.2f | | | | | | %.1f | | | | | |\n",
+              view.training_points, kSelectedArchName, gp_baseline_ns * 1e-3, gp_baseline_ns / fk_baseline_ns);
+  std::printf("| baseline: bare GP predict (%u points, portable loops) | %.2f | | | | | | %.1f | | | | | |\n",
+              view.training_points, portable_gp_baseline_ns * 1e-3, portable_gp_baseline_ns / fk_baseline_ns);
+  std::printf("| one full model evaluation (FK, Jacobian, GP mean and gradient) | %.2f | | | | | | %.1f | | | | | "
+              "|\n",
+              evaluation_baseline_ns * 1e-3, evaluation_baseline_ns / fk_baseline_ns);
+  std::printf("\nHost goal p99 <= 15 us for every kind of cycle: %s back to back (worst p99 %.2f us), %s at 1 kHz "
+              "spinning to each release (%.2f us), %s at 1 kHz sleeping between cycles (%.2f us)\n",
+              worst_p99_us <= 15.0 ? "met" : "NOT met", worst_p99_us,
+              worst_spin_p99_us <= 15.0 ? "met" : "NOT met", worst_spin_p99_us,
+              worst_paced_p99_us <= 15.0 ? "met" : "NOT met", worst_paced_p99_us);
+  const Interruptions interruptions = measure_interruptions();
+  std::printf("This machine interrupts a busy thread %.0f times a second, for %.1f us on average: a %.1f us cycle "
+              "(the IK kinds' p50) is hit %.1f %% of the time.\n",
+              interruptions.per_second, interruptions.mean_us, median(r.p50[kKindCount - 1]) * 1e-3,
+              100.0 * interruptions.per_second * median(r.p50[kKindCount - 1]) * 1e-9);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -316,128 +466,13 @@ int main(int argc, char** argv) {
 
   try {
     const std::vector<std::uint8_t> image = cdcr::exporting::read_binary_file(options.image_path);
-    sim::SimulatedPlatform probe_platform;
-    probe_platform.storage.assign(image);
-    fw::Runtime probe(probe_platform.hal, fw::Geometry::prototype());
-    if (probe.init() != fw::RuntimeState::run) {
-      throw std::runtime_error(std::string("image does not boot: ") + fw::to_string(probe.boot_fault()));
-    }
-    const Workload w = make_workload(probe, options);
-
-    model::ImageView view{};
-    model::ImageCapacity capacity;
-    capacity.max_training_points = fw::kMaxTrainingPoints;
-    capacity.max_segments = fw::kMaxSegments;
-    const sim::MemoryModelStorage aligned(image);
-    const auto region = aligned.model_region();
-    if (model::parse_image(region.data, region.size_bytes, view, capacity) != model::ImageStatus::ok) {
-      throw std::runtime_error("image does not parse");
-    }
-    fw::Correction correction;
-    if (correction.bind(view) != model::Status::ok) throw std::runtime_error("image does not bind");
-    // The plain C++ loops on the same image, for the ratio to the build's.
-    model::GpCorrection<float, fw::Accumulator, fw::kMaxSegments, model::arch::Portable> portable_correction;
-    if (portable_correction.bind(view) != model::Status::ok) throw std::runtime_error("image does not bind");
-    const fw::Geometry& geometry = probe.geometry();
-
-    std::vector<double> fk_ns, gp_ns, portable_gp_ns, evaluation_ns;
-    std::vector<double> p50[kKindCount], p99[kKindCount], paced_p99[kKindCount], spin_p99[kKindCount];
-    std::vector<std::int64_t> all_iterations[kKindCount], all_request_cycles[kKindCount];
-    std::int64_t worst_ns[kKindCount] = {}, worst_cpu_ns[kKindCount] = {};
-    long converged[kKindCount] = {}, total[kKindCount] = {};
+    const BenchModel bench_model(image, options);
+    Measurements measurements;
     for (int r = 0; r < options.repetitions; ++r) {
-      fk_ns.push_back(per_call_ns([&](std::size_t i) {
-        g_sink = g_sink + model::forward_kinematics_bend(w.bends[i], geometry).position_mm.x();
-      }));
-      gp_ns.push_back(per_call_ns([&](std::size_t i) { g_sink = g_sink + correction.predict(w.bends[i])[0]; }));
-      portable_gp_ns.push_back(
-          per_call_ns([&](std::size_t i) { g_sink = g_sink + portable_correction.predict(w.bends[i])[0]; }));
-      // What each IK iteration evaluates (see evaluate_model in inverse_kinematics.hpp).
-      evaluation_ns.push_back(per_call_ns([&](std::size_t i) {
-        model::Pose<float> tip;
-        model::Jacobian<float, fw::kMaxSegments> jacobian, d_eps;
-        model::Twist<float> eps;
-        model::tip_jacobian_bend(w.bends[i], geometry, tip, jacobian);
-        correction(w.bends[i], eps, d_eps);
-        const model::Pose<float> correction_pose = model::exp(eps);
-        model::apply_adjoint(correction_pose, jacobian);
-        jacobian.noalias() += model::left_jacobian(eps) * d_eps;
-        g_sink = g_sink + (correction_pose * tip).position_mm.x() + jacobian(0, 0);
-      }));
-      for (int k = 0; k < kKindCount; ++k) {
-        const CycleKind kind = kKinds[k];
-        const int cycles = kind == CycleKind::forward ? options.forward_cycles : options.ik_cycles;
-        const CycleSamples s = run_cycles(image, w, kind, cycles, Pace::back_to_back);
-        paced_p99[k].push_back(percentile(run_cycles(image, w, kind, cycles, Pace::sleep).ns, 0.99));
-        spin_p99[k].push_back(percentile(run_cycles(image, w, kind, cycles, Pace::spin).ns, 0.99));
-        p50[k].push_back(percentile(s.ns, 0.50));
-        p99[k].push_back(percentile(s.ns, 0.99));
-        worst_ns[k] = std::max(worst_ns[k], *std::max_element(s.ns.begin(), s.ns.end()));
-        worst_cpu_ns[k] = std::max(worst_cpu_ns[k], *std::max_element(s.cpu_ns.begin(), s.cpu_ns.end()));
-        all_iterations[k].insert(all_iterations[k].end(), s.iterations.begin(), s.iterations.end());
-        all_request_cycles[k].insert(all_request_cycles[k].end(), s.request_cycles.begin(), s.request_cycles.end());
-        converged[k] += s.converged;
-        total[k] += long(s.iterations.size());
-      }
+      measure_baselines(bench_model, measurements);
+      measure_cycles(image, bench_model, options, measurements);
     }
-
-    const double fk_baseline_ns = median(fk_ns);
-    const double gp_baseline_ns = median(gp_ns);
-    const double portable_gp_baseline_ns = median(portable_gp_ns);
-    const double evaluation_baseline_ns = median(evaluation_ns);
-    std::printf("Image: %u training points, %d inputs (%s), %d segments; IK: %u work units per cycle, "
-                "at most %d cycles per request\n",
-                view.training_points, view.input_dims, model::to_string(view.encoding), view.segment_count,
-                probe.ik_units_per_cycle(), fw::kMaxIkCycles);
-    std::printf("%d runs; per run %d forward cycles and %d cycles of each IK kind, back to back and then at "
-                "1 kHz, sleeping and spinning to each release. p50/p99: median over runs; max: worst of all runs "
-                "back to back.\n\n",
-                options.repetitions, options.forward_cycles, options.ik_cycles);
-    std::printf("| cycle | p50 us | p99 us | max us | max us, thread CPU | p99 us at 1 kHz, sleeping | "
-                "p99 us at 1 kHz, spinning | p50 / FK | p99 / FK | requests | cycles per request p50 / p99 / max | "
-                "iterations p50 / p99 / max | converged |\n");
-    std::printf("|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|---:|\n");
-    double worst_p99_us = 0;
-    double worst_paced_p99_us = 0;
-    double worst_spin_p99_us = 0;
-    for (int k = 0; k < kKindCount; ++k) {
-      const double m50 = median(p50[k]), m99 = median(p99[k]), paced99 = median(paced_p99[k]);
-      const double spin99 = median(spin_p99[k]);
-      worst_p99_us = std::max(worst_p99_us, m99 * 1e-3);
-      worst_paced_p99_us = std::max(worst_paced_p99_us, paced99 * 1e-3);
-      worst_spin_p99_us = std::max(worst_spin_p99_us, spin99 * 1e-3);
-      std::printf("| %s | %.2f | %.2f | %.1f | %.1f | %.2f | %.2f | %.1f | %.1f |", label(kKinds[k]), m50 * 1e-3,
-                  m99 * 1e-3, double(worst_ns[k]) * 1e-3, double(worst_cpu_ns[k]) * 1e-3, paced99 * 1e-3,
-                  spin99 * 1e-3, m50 / fk_baseline_ns, m99 / fk_baseline_ns);
-      if (total[k] == 0) {
-        std::printf(" - | - | - | - |\n");
-      } else {
-        std::printf(" %ld | %.0f / %.0f / %.0f | %.0f / %.0f / %.0f | %.1f%% |\n", total[k],
-                    percentile(all_request_cycles[k], 0.5), percentile(all_request_cycles[k], 0.99),
-                    percentile(all_request_cycles[k], 1.0), percentile(all_iterations[k], 0.5),
-                    percentile(all_iterations[k], 0.99), percentile(all_iterations[k], 1.0),
-                    100.0 * double(converged[k]) / double(total[k]));
-      }
-    }
-    std::printf("| baseline: nominal FK (`forward_kinematics_bend`, float) | %.3f | | | | | | 1.0 | | | | | |\n",
-                fk_baseline_ns * 1e-3);
-    std::printf("| baseline: bare GP predict (%u points, %s loops) | %.2f | | | | | | %.1f | | | | | |\n",
-                view.training_points, kSelectedArchName, gp_baseline_ns * 1e-3, gp_baseline_ns / fk_baseline_ns);
-    std::printf("| baseline: bare GP predict (%u points, portable loops) | %.2f | | | | | | %.1f | | | | | |\n",
-                view.training_points, portable_gp_baseline_ns * 1e-3, portable_gp_baseline_ns / fk_baseline_ns);
-    std::printf("| one full model evaluation (FK, Jacobian, GP mean and gradient) | %.2f | | | | | | %.1f | | | | | "
-                "|\n",
-                evaluation_baseline_ns * 1e-3, evaluation_baseline_ns / fk_baseline_ns);
-    std::printf("\nHost goal p99 <= 15 us for every kind of cycle: %s back to back (worst p99 %.2f us), %s at 1 kHz "
-                "spinning to each release (%.2f us), %s at 1 kHz sleeping between cycles (%.2f us)\n",
-                worst_p99_us <= 15.0 ? "met" : "NOT met", worst_p99_us,
-                worst_spin_p99_us <= 15.0 ? "met" : "NOT met", worst_spin_p99_us,
-                worst_paced_p99_us <= 15.0 ? "met" : "NOT met", worst_paced_p99_us);
-    const Interruptions interruptions = measure_interruptions();
-    std::printf("This machine interrupts a busy thread %.0f times a second, for %.1f us on average: a %.1f us cycle "
-                "(the IK kinds' p50) is hit %.1f %% of the time.\n",
-                interruptions.per_second, interruptions.mean_us, median(p50[kKindCount - 1]) * 1e-3,
-                100.0 * interruptions.per_second * median(p50[kKindCount - 1]) * 1e-9);
+    print_table(bench_model, options, measurements);
     return 0;
   } catch (const std::exception& e) {
     std::fprintf(stderr, "cdcr-bench-runtime: error: %s\n", e.what());

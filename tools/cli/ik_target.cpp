@@ -22,9 +22,9 @@ model::Mat3<double> rotation_from_quaternion(const std::vector<double>& values) 
   require_finite(values, "--quaternion");
   Eigen::Quaterniond quaternion(values[0], values[1], values[2], values[3]);
   const double norm = quaternion.norm();
-  if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) {
+  if (!model::is_unit_quaternion_norm(norm)) {
     throw InputError(fmt::format("--quaternion: not a unit quaternion (norm {:g}, allowed deviation from 1 is {:g})",
-                                 norm, kQuaternionNormTolerance));
+                                 norm, model::kQuaternionNormTolerance));
   }
   quaternion.normalize();
   return quaternion.toRotationMatrix();

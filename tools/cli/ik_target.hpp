@@ -6,12 +6,10 @@
 #include <vector>
 
 #include <cdcr/model/se3.hpp>
+#include <cdcr/model/unit_quaternion.hpp>
 
 namespace cdcr::cli {
 
-// A quaternion whose norm differs from 1 by more than this is a mistake, not
-// rounding, and is refused rather than silently normalised.
-inline constexpr double kQuaternionNormTolerance = 1e-3;
 // Largest |R^T R - I| entry accepted for a rotation read from --pose. The
 // full-precision numbers of `fk --json` pass with a wide margin; a matrix
 // rounded to six decimals may not, and is better given as a quaternion.
@@ -21,7 +19,7 @@ inline constexpr double kRotationOrthonormalityTolerance = 1e-6;
 model::Vec3<double> position_from_values(const std::vector<double>& values);
 
 // QW,QX,QY,QZ (Hamilton convention, scalar first); normalised when within
-// kQuaternionNormTolerance of unit norm, otherwise an InputError.
+// model::kQuaternionNormTolerance of unit norm, otherwise an InputError.
 model::Mat3<double> rotation_from_quaternion(const std::vector<double>& values);
 
 // 12 or 16 row-major values of [R p; 0 0 0 1]. The rotation must be

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cdcr/model/limits.hpp"
+#include "cdcr/model/unit_quaternion.hpp"
 #include "dataset/field_parsing.hpp"
 
 namespace cdcr::dataset {
@@ -23,7 +24,6 @@ constexpr const char* kTimeColumn = "t_s";
 constexpr const char* kPayloadColumn = "payload_kg";
 constexpr const char* kPoseColumns[] = {"x", "y", "z", "qw", "qx", "qy", "qz"};
 constexpr int kPoseColumnCount = 7;
-constexpr double kQuaternionNormTolerance = 1e-3;
 
 std::string cable_column_name(int segment, int cable) {
   return "l" + std::to_string(segment + 1) + "_" + std::to_string(cable + 1);
@@ -148,9 +148,9 @@ Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
 model::Pose<double> pose_from_fields(const double* p, int line_number) {
   Eigen::Quaterniond q(p[3], p[4], p[5], p[6]);  // (w, x, y, z)
   const double norm = q.norm();
-  if (!(std::abs(norm - 1.0) <= kQuaternionNormTolerance)) {
+  if (!model::is_unit_quaternion_norm(norm)) {
     std::ostringstream message;
-    message << "quaternion norm " << norm << " is not 1 (tolerance " << kQuaternionNormTolerance << ")";
+    message << "quaternion norm " << norm << " is not 1 (tolerance " << model::kQuaternionNormTolerance << ")";
     throw DatasetError(line_number, message.str());
   }
   q.coeffs() /= norm;
@@ -339,8 +339,7 @@ std::string format_dataset_csv(const Dataset& data, const std::string& comment) 
     if (data.has_payload) out << ',' << data.payload_kg[r];
     if (data.has_poses) {
       const model::Pose<double>& pose = data.poses[static_cast<std::size_t>(r)];
-      Eigen::Quaterniond q(pose.rotation);
-      if (q.w() < 0) q.coeffs() = -q.coeffs();  // one canonical sign
+      const Eigen::Quaterniond q = model::with_positive_w(Eigen::Quaterniond(pose.rotation));
       out << ',' << pose.position_mm.x() << ',' << pose.position_mm.y() << ',' << pose.position_mm.z() << ','
           << q.w() << ',' << q.x() << ',' << q.y() << ',' << q.z();
     }

@@ -11,6 +11,7 @@
 
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/model/hysteresis_sequence.hpp>
+#include <cdcr/model/unit_quaternion.hpp>
 
 #include "cli/cli_errors.hpp"
 #include "dataset/csv_dataset.hpp"
@@ -90,9 +91,7 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
       throw InputError(cables_path + ": sample " + std::to_string(i + 1) + ": " + model::to_string(s));
     }
     const model::Pose<double> pose = estimate.pose.cast<double>();
-    Eigen::Quaterniond q(pose.rotation);
-    q.normalize();
-    if (q.w() < 0) q.coeffs() *= -1.0;
+    const Eigen::Quaterniond q = model::canonical_quaternion(pose.rotation);
     const model::PoseUncertainty<fw::Scalar> uncertainty = runtime.estimate_uncertainty(estimate);
     std::fprintf(out, "%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%.9g,%d\n", pose.position_mm.x(), pose.position_mm.y(),
                  pose.position_mm.z(), q.w(), q.x(), q.y(), q.z(), static_cast<double>(uncertainty.r95_mm),

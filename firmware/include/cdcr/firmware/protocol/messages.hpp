@@ -63,9 +63,7 @@ enum class IkOutcome : std::uint8_t {
 inline constexpr double kLengthScaleMm = 0.01;
 inline constexpr double kQuaternionScale = 1.0 / 32767.0;
 inline constexpr std::int64_t kCableNotAvailableRaw = 0xFFFF;
-// A received quaternion must have a norm within this of 1 (Q15 rounding
-// moves it by at most ~1e-4).
-inline constexpr double kQuaternionNormTolerance = 1e-2;
+// A received quaternion's norm: model/unit_quaternion.hpp.
 
 namespace values {
 inline constexpr ValueName kTargetMode[] = {{0, "position"}, {1, "pose"}};
