@@ -1,5 +1,5 @@
 #pragma once
-// Reading and writing the dataset CSV (layout in tools/README.md, "Dataset format").
+// Reading and writing the dataset CSV (layout in tools/dataset/format.md).
 //
 //   [t_s,]l1_1,l1_2,l1_3,l1_4,...,ln_4[,payload_kg][,x,y,z,qw,qx,qy,qz]
 //

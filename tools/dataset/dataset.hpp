@@ -1,7 +1,7 @@
 #pragma once
 // A dataset of the robot: commanded cable lengths, optionally the payload the
 // end platform carried, and, when measured, the end-platform pose in the base
-// frame. The CSV layout is documented in tools/README.md ("Dataset format").
+// frame. The CSV layout is documented in tools/dataset/format.md.
 
 #include <cstdint>
 #include <string>
@@ -16,8 +16,8 @@ namespace cdcr::dataset {
 
 // In a motion sequence, a pause longer than this between two rows starts a new
 // session: the robot may have been switched off or moved by hand, so the
-// session must start with a homing move like the first one (tools/README.md,
-// "Dataset format").
+// session must start with a homing move like the first one
+// (tools/dataset/format.md).
 inline constexpr double kSessionGapSeconds = 30.0;
 
 struct Dataset {

@@ -4,7 +4,7 @@
 // frames through. Acceptance filters, queue limits and error counters behave
 // as a controller's would, so the runtime cannot tell the difference; a
 // board with a real controller implements hal::CanBus on its peripheral
-// instead (hal/README.md, "On a real board").
+// instead (hal/porting.md).
 
 #include <cstddef>
 #include <cstdint>
