@@ -267,6 +267,28 @@ TEST_F(RuntimeTest, TargetWithoutItsPositionFrameIsMalformed) {
   EXPECT_FALSE(runtime->has_setpoints());
 }
 
+// The one quaternion rule (model/unit_quaternion.hpp): a norm within 1e-3
+// of 1 is rounding and is normalised; one further off is a mistake.
+TEST_F(RuntimeTest, PoseTargetQuaternionMustBeUnitWithinTheSharedTolerance) {
+  boot(test_support::small_image());
+  cycles(3);
+  const model::Vec3<Scalar> here = runtime->latest_pose().pose.position_mm;
+  const auto outcome_for_norm = [&](double norm, std::uint8_t sequence) {
+    const double c = 0.5 * norm;  // (0.5, 0.5, 0.5, 0.5) has unit norm
+    send_frame(protocol::TargetOrientation{c, c, c, c});
+    send_frame(protocol::TargetPositionXy{here.x(), here.y()});
+    send_frame(protocol::TargetPositionZ{here.z(), protocol::TargetMode::pose, false, sequence});
+    cycles_until_ik_done();
+    EXPECT_EQ(runtime->last_ik_report().sequence, sequence);
+    return runtime->last_ik_report().outcome;
+  };
+  EXPECT_NE(outcome_for_norm(1.0 + 0.6e-3, 31), protocol::IkOutcome::rejected_malformed);
+  EXPECT_NE(outcome_for_norm(1.0 - 0.6e-3, 32), protocol::IkOutcome::rejected_malformed);
+  EXPECT_EQ(outcome_for_norm(1.0 + 2e-3, 33), protocol::IkOutcome::rejected_malformed);
+  EXPECT_EQ(runtime->last_event(), FaultCode::target_malformed);
+  EXPECT_EQ(outcome_for_norm(1.0 - 2e-3, 34), protocol::IkOutcome::rejected_malformed);
+}
+
 TEST_F(RuntimeTest, TargetWithReservedBitsSetIsMalformed) {
   boot(test_support::small_image());
   cycles(3);
