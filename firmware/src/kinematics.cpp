@@ -1,38 +1,13 @@
 #include "cdcr/firmware/kinematics.hpp"
 
-#include "cdcr/firmware/protocol.hpp"
+#include "cdcr/firmware/compensated_pose.hpp"
 
 namespace cdcr::firmware {
 
-namespace {
-
-// The drives report cable lengths in the protocol's steps: a segment at its
-// bending limit may read one step beyond it.
-constexpr Scalar kCableResolutionMm = Scalar(protocol::kLengthScaleMm);
-
-}  // namespace
-
 model::Status estimate_pose(const RobotModel& model, const Cables& cables_mm, PoseEstimate& estimate) {
   if (model.compensated) {
-    model::ForwardResult<Scalar, kMaxSegments> result;
-    // With a compliance block the nominal pose is that of the sagged bends
-    // (sagged_bends_of, out of line).
-    const auto nominal_shape = [&model](const Joints& bend) {
-      return model.compliance.empty()
-                 ? bend
-                 : sagged_bends_of(model.compliance, model.geometry, model.correction.payload_kg(), bend);
-    };
-    if (const model::Status s = model::compensated_forward_with(cables_mm, model.geometry, model.correction, result,
-                                                                 kCableResolutionMm, nominal_shape);
-        s != model::Status::ok) {
-      return s;
-    }
-    estimate.pose = result.compensated;
-    estimate.joints = result.joints;
-    estimate.compensated = true;
-    model.correction.kernel_coordinates(model::bend_from_joints(result.joints), estimate.kernel_coordinates);
-    estimate.outside_range = model.uncertainty.outside_range(estimate.kernel_coordinates);
-    return model::Status::ok;
+    return estimate_compensated_pose(model.geometry, model.correction, model.uncertainty, model.compliance, cables_mm,
+                                     estimate);
   }
   Joints joints;
   if (const model::Status s = model::joints_from_cables(cables_mm, model.geometry, joints, kCableResolutionMm);

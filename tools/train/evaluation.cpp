@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "cdcr/firmware/compensated_pose.hpp"
 #include "cdcr/model/compensated_kinematics.hpp"
 #include "cdcr/model/image_compliance.hpp"
 #include "cdcr/model/pose_error_summary.hpp"
@@ -51,7 +52,8 @@ const char* to_string(FirmwareAccumulator accumulator) {
 
 namespace {
 
-// The firmware's path with the given accumulator: pose, radii and flags.
+// The board's path (firmware::estimate_compensated_pose) with the given
+// accumulator: pose, radii and flags.
 template <typename Accumulator>
 std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
                                              const Eigen::VectorXd& payload_kg) {
@@ -61,34 +63,33 @@ std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, cons
   if (image.extra_inputs > 0 && payload_kg.size() != cables_mm.rows()) {
     throw std::invalid_argument("one payload per sample is needed");
   }
-  model::RobotGeometry<float> geometry;
+  firmware::Geometry geometry;
   if (const model::Status s = model::geometry_from_image(image, geometry); s != model::Status::ok) {
     throw std::invalid_argument(std::string("image geometry: ") + model::to_string(s));
   }
-  model::GpCorrection<float, Accumulator> correction;
-  model::GpUncertainty<float> uncertainty;
+  model::GpCorrection<float, Accumulator, firmware::kMaxSegments> correction;
+  firmware::Uncertainty uncertainty;
   if (const model::Status s = correction.bind(image); s != model::Status::ok) {
     throw std::invalid_argument(std::string("image: ") + model::to_string(s));
   }
   if (const model::Status s = uncertainty.bind(image); s != model::Status::ok) {
     throw std::invalid_argument(std::string("image: ") + model::to_string(s));
   }
-  model::PayloadCompliance<float> compliance;
+  firmware::Compliance compliance;
   model::compliance_from_image(image, compliance);
   std::vector<FirmwareEstimate> estimates;
   estimates.reserve(static_cast<std::size_t>(cables_mm.rows()));
   for (Eigen::Index i = 0; i < cables_mm.rows(); ++i) {
-    const model::CableVector<float> cables = cables_mm.row(i).transpose().cast<float>();
+    const firmware::Cables cables = cables_mm.row(i).transpose().cast<float>();
     if (image.extra_inputs > 0) correction.set_payload_kg(static_cast<float>(payload_kg[i]));
-    model::ForwardResult<float> result;
-    if (const model::Status s = model::compensated_forward(cables, geometry, correction, compliance, result);
+    firmware::PoseEstimate estimate;
+    if (const model::Status s =
+            firmware::estimate_compensated_pose(geometry, correction, uncertainty, compliance, cables, estimate);
         s != model::Status::ok) {
       throw std::invalid_argument("sample " + std::to_string(i + 1) + ": " + model::to_string(s));
     }
-    float z[model::GpCorrection<float>::kMaxInputs];
-    correction.kernel_coordinates(model::bend_from_joints(result.joints), z);
-    const model::PoseUncertainty<float> u = uncertainty.evaluate(z, result.compensated.position_mm);
-    estimates.push_back(firmware_estimate(result.compensated, u));
+    const model::PoseUncertainty<float> u = uncertainty.evaluate(estimate.kernel_coordinates, estimate.pose.position_mm);
+    estimates.push_back(firmware_estimate(estimate.pose, u));
   }
   return estimates;
 }

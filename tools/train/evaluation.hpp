@@ -42,8 +42,8 @@ enum class FirmwareAccumulator {
 
 const char* to_string(FirmwareAccumulator accumulator);
 
-// The firmware's forward path in float32 (model::compensated_forward on the
-// parsed image) over the samples' commanded cables. An image with the
+// The board's forward path in float32 (firmware::estimate_compensated_pose
+// on the parsed image) over the samples' commanded cables. An image with the
 // payload input takes each sample's payload_kg, set on the correction before
 // the sample as the runtime sets a received one (throws
 // std::invalid_argument when there are none); other images ignore them. An
