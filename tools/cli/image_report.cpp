@@ -362,38 +362,38 @@ ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
   r.first_failure = findings.first_failure();
 
   // The fields, for display: whatever of them lies inside the file.
-  if (size >= 4) r.magic = read<std::uint32_t>(bytes, magic);
-  if (size >= 6) r.version_major = read<std::uint16_t>(bytes, version_major);
+  if (size >= 4) r.magic = read<std::uint32_t>(bytes, magic.offset);
+  if (size >= 6) r.version_major = read<std::uint16_t>(bytes, version_major.offset);
   if (size >= model::kImageHeaderSize) {
     ImageHeaderFields h;
     h.magic = *r.magic;
     h.version_major = *r.version_major;
-    h.version_minor = read<std::uint16_t>(bytes, version_minor);
-    h.header_size = read<std::uint32_t>(bytes, header_size);
-    h.total_size = read<std::uint32_t>(bytes, total_size);
-    h.training_points = read<std::uint32_t>(bytes, training_points);
-    h.input_dims = read<std::uint16_t>(bytes, input_dims);
-    h.output_dims = read<std::uint16_t>(bytes, output_dims);
-    h.segment_count = read<std::uint16_t>(bytes, segment_count);
-    h.scalar_type = bytes[scalar_type];
-    h.kernel_kind = bytes[kernel_kind];
-    h.input_encoding = bytes[input_encoding];
-    h.model_kind = bytes[model_kind];
-    h.extra_inputs = bytes[extra_inputs];
-    h.geometry_offset = read<std::uint32_t>(bytes, geometry_offset);
-    h.parameters_offset = read<std::uint32_t>(bytes, parameters_offset);
-    h.inputs_offset = read<std::uint32_t>(bytes, inputs_offset);
-    h.alpha_offset = read<std::uint32_t>(bytes, alpha_offset);
-    h.metadata_offset = read<std::uint32_t>(bytes, metadata_offset);
-    h.metadata_size = read<std::uint32_t>(bytes, metadata_size);
-    h.variance_offset = read<std::uint32_t>(bytes, variance_offset);
-    h.variance_rank = read<std::uint16_t>(bytes, variance_rank);
+    h.version_minor = read<std::uint16_t>(bytes, version_minor.offset);
+    h.header_size = read<std::uint32_t>(bytes, header_size.offset);
+    h.total_size = read<std::uint32_t>(bytes, total_size.offset);
+    h.training_points = read<std::uint32_t>(bytes, training_points.offset);
+    h.input_dims = read<std::uint16_t>(bytes, input_dims.offset);
+    h.output_dims = read<std::uint16_t>(bytes, output_dims.offset);
+    h.segment_count = read<std::uint16_t>(bytes, segment_count.offset);
+    h.scalar_type = bytes[scalar_type.offset];
+    h.kernel_kind = bytes[kernel_kind.offset];
+    h.input_encoding = bytes[input_encoding.offset];
+    h.model_kind = bytes[model_kind.offset];
+    h.extra_inputs = bytes[extra_inputs.offset];
+    h.geometry_offset = read<std::uint32_t>(bytes, geometry_offset.offset);
+    h.parameters_offset = read<std::uint32_t>(bytes, parameters_offset.offset);
+    h.inputs_offset = read<std::uint32_t>(bytes, inputs_offset.offset);
+    h.alpha_offset = read<std::uint32_t>(bytes, alpha_offset.offset);
+    h.metadata_offset = read<std::uint32_t>(bytes, metadata_offset.offset);
+    h.metadata_size = read<std::uint32_t>(bytes, metadata_size.offset);
+    h.variance_offset = read<std::uint32_t>(bytes, variance_offset.offset);
+    h.variance_rank = read<std::uint16_t>(bytes, variance_rank.offset);
     if (h.version_major >= 2 && h.version_minor >= model::kImageVersionMinorHysteresis) {
-      h.hysteresis_cables = bytes[hysteresis_cables];
-      h.hysteresis_operators = bytes[hysteresis_operators];
+      h.hysteresis_cables = bytes[hysteresis_cables.offset];
+      h.hysteresis_operators = bytes[hysteresis_operators.offset];
     }
     if (h.version_major >= 2 && h.version_minor >= model::kImageVersionMinorCompliance) {
-      h.compliance_segments = bytes[compliance_segments];
+      h.compliance_segments = bytes[compliance_segments.offset];
     }
     r.header = h;
   }

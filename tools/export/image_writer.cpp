@@ -59,9 +59,9 @@ std::uint32_t hysteresis_floats(const model::HysteresisModel<double>& hysteresis
 // The header's counts and the block, for a model with a hysteresis model.
 void put_hysteresis(ImageBuffer& image, std::uint32_t block, const model::HysteresisModel<double>& hysteresis) {
   if (hysteresis.empty()) return;
-  image.put<std::uint16_t>(model::image_field::version_minor, model::kImageVersionMinorHysteresis);
-  image.put<std::uint8_t>(model::image_field::hysteresis_cables, static_cast<std::uint8_t>(hysteresis.cables));
-  image.put<std::uint8_t>(model::image_field::hysteresis_operators, static_cast<std::uint8_t>(hysteresis.operators));
+  image.put<std::uint16_t>(model::image_field::version_minor.offset, model::kImageVersionMinorHysteresis);
+  image.put<std::uint8_t>(model::image_field::hysteresis_cables.offset, static_cast<std::uint8_t>(hysteresis.cables));
+  image.put<std::uint8_t>(model::image_field::hysteresis_operators.offset, static_cast<std::uint8_t>(hysteresis.operators));
   std::size_t at = block + 4 * model::image_hysteresis_field::widths;
   for (const auto* values : {&hysteresis.widths_mm, &hysteresis.weights, &hysteresis.homing_lag_mm}) {
     for (int c = 0; c < hysteresis.cables; ++c) {
@@ -92,8 +92,8 @@ std::uint32_t compliance_floats(const model::PayloadCompliance<double>& complian
 void put_compliance(ImageBuffer& image, std::uint32_t block, const model::PayloadCompliance<double>& compliance) {
   if (compliance.empty()) return;
   using namespace model::image_compliance_field;
-  image.put<std::uint16_t>(model::image_field::version_minor, model::kImageVersionMinorCompliance);
-  image.put<std::uint8_t>(model::image_field::compliance_segments, static_cast<std::uint8_t>(compliance.segments));
+  image.put<std::uint16_t>(model::image_field::version_minor.offset, model::kImageVersionMinorCompliance);
+  image.put<std::uint8_t>(model::image_field::compliance_segments.offset, static_cast<std::uint8_t>(compliance.segments));
   for (int k = 0; k < 3; ++k) image.put_float(block + 4 * (weighted_gravity + k), compliance.weighted_gravity[k]);
   std::size_t at = block + 4 * ratios;
   for (int i = 0; i < compliance.segments; ++i, at += 4) image.put_float(at, compliance.ratio[static_cast<std::size_t>(i)]);
@@ -159,28 +159,28 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
                           hysteresis_floats(model.hysteresis), compliance_floats(model.compliance));
   ImageBuffer image(layout.total_size);
 
-  image.put<std::uint32_t>(magic, model::kImageMagic);
-  image.put<std::uint16_t>(version_major, model::kImageVersionMajor);
-  image.put<std::uint16_t>(version_minor, model::kImageVersionMinor);
-  image.put<std::uint32_t>(header_size, model::kImageHeaderSize);
-  image.put<std::uint32_t>(total_size, layout.total_size);
-  image.put<std::uint32_t>(training_points, static_cast<std::uint32_t>(n));
-  image.put<std::uint16_t>(input_dims, static_cast<std::uint16_t>(d));
-  image.put<std::uint16_t>(output_dims, static_cast<std::uint16_t>(model::kImageOutputs));
-  image.put<std::uint16_t>(segment_count, static_cast<std::uint16_t>(segments));
-  image.put<std::uint8_t>(scalar_type, static_cast<std::uint8_t>(model::ImageScalar::float32));
-  image.put<std::uint8_t>(kernel_kind, static_cast<std::uint8_t>(model::ImageKernel::squared_exponential_ard));
-  image.put<std::uint8_t>(input_encoding, static_cast<std::uint8_t>(model.encoding));
-  image.put<std::uint8_t>(model_kind, static_cast<std::uint8_t>(model.kind));
-  image.put<std::uint8_t>(extra_inputs, static_cast<std::uint8_t>(extra));
-  image.put<std::uint32_t>(geometry_offset, layout.geometry_offset);
-  image.put<std::uint32_t>(parameters_offset, layout.parameters_offset);
-  image.put<std::uint32_t>(inputs_offset, layout.inputs_offset);
-  image.put<std::uint32_t>(alpha_offset, layout.alpha_offset);
-  image.put<std::uint32_t>(metadata_offset, layout.metadata_offset);
-  image.put<std::uint32_t>(metadata_size, model::kImageMetadataSize);
-  image.put<std::uint32_t>(variance_offset, layout.variance_offset);
-  image.put<std::uint16_t>(variance_rank, static_cast<std::uint16_t>(rank));
+  image.put<std::uint32_t>(magic.offset, model::kImageMagic);
+  image.put<std::uint16_t>(version_major.offset, model::kImageVersionMajor);
+  image.put<std::uint16_t>(version_minor.offset, model::kImageVersionMinor);
+  image.put<std::uint32_t>(header_size.offset, model::kImageHeaderSize);
+  image.put<std::uint32_t>(total_size.offset, layout.total_size);
+  image.put<std::uint32_t>(training_points.offset, static_cast<std::uint32_t>(n));
+  image.put<std::uint16_t>(input_dims.offset, static_cast<std::uint16_t>(d));
+  image.put<std::uint16_t>(output_dims.offset, static_cast<std::uint16_t>(model::kImageOutputs));
+  image.put<std::uint16_t>(segment_count.offset, static_cast<std::uint16_t>(segments));
+  image.put<std::uint8_t>(scalar_type.offset, static_cast<std::uint8_t>(model::ImageScalar::float32));
+  image.put<std::uint8_t>(kernel_kind.offset, static_cast<std::uint8_t>(model::ImageKernel::squared_exponential_ard));
+  image.put<std::uint8_t>(input_encoding.offset, static_cast<std::uint8_t>(model.encoding));
+  image.put<std::uint8_t>(model_kind.offset, static_cast<std::uint8_t>(model.kind));
+  image.put<std::uint8_t>(extra_inputs.offset, static_cast<std::uint8_t>(extra));
+  image.put<std::uint32_t>(geometry_offset.offset, layout.geometry_offset);
+  image.put<std::uint32_t>(parameters_offset.offset, layout.parameters_offset);
+  image.put<std::uint32_t>(inputs_offset.offset, layout.inputs_offset);
+  image.put<std::uint32_t>(alpha_offset.offset, layout.alpha_offset);
+  image.put<std::uint32_t>(metadata_offset.offset, layout.metadata_offset);
+  image.put<std::uint32_t>(metadata_size.offset, model::kImageMetadataSize);
+  image.put<std::uint32_t>(variance_offset.offset, layout.variance_offset);
+  image.put<std::uint16_t>(variance_rank.offset, static_cast<std::uint16_t>(rank));
 
   std::size_t at = layout.geometry_offset;
   for (int i = 0; i < segments; ++i) {
@@ -306,8 +306,8 @@ std::vector<std::uint8_t> with_blocks(const std::vector<std::uint8_t>& image,
   std::memcpy(out.data(), image.data(), old_layout.metadata_offset);
   std::memcpy(out.data() + layout.metadata_offset, image.data() + old_layout.metadata_offset,
               model::kImageMetadataSize);
-  out.put<std::uint32_t>(model::image_field::total_size, layout.total_size);
-  out.put<std::uint32_t>(model::image_field::metadata_offset, layout.metadata_offset);
+  out.put<std::uint32_t>(model::image_field::total_size.offset, layout.total_size);
+  out.put<std::uint32_t>(model::image_field::metadata_offset.offset, layout.metadata_offset);
   put_hysteresis(out, layout.hysteresis_offset, hysteresis);
   put_compliance(out, layout.compliance_offset, compliance);
   const std::uint32_t checksum = model::crc32(out.data(), layout.total_size - model::kImageTrailerSize);
