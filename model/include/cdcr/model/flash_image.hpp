@@ -329,16 +329,26 @@ constexpr const ImageBlockFormat& image_block(ImageBlockId block) {
   return kImageBlocks[static_cast<std::size_t>(block)];
 }
 
+// Calls visit(index) for each block, index a std::integral_constant, in
+// the order the blocks follow the header. Unrolled at compile time, each
+// block a constant: a firmware build keeps neither the table nor its names.
+template <typename Visit, std::size_t... I>
+constexpr void for_each_image_block(Visit&& visit, std::index_sequence<I...>) {
+  (visit(std::integral_constant<std::size_t, I>{}), ...);
+}
+
 // Where the dims put every block. 32-bit offsets, as in the header.
 constexpr ImageLayout image_layout(const ImageDims& dims) {
   ImageLayout layout{};
   std::uint32_t at = kImageHeaderSize;
-  for (const ImageBlockFormat& block : kImageBlocks) {
+  const auto place = [&](auto index) {
+    constexpr ImageBlockFormat block = kImageBlocks[decltype(index)::value];
     const std::uint64_t bytes = image_block_bytes(block.id, dims);
-    if (block.only_when_counted && bytes == 0) continue;
+    if (block.only_when_counted && bytes == 0) return;
     layout.*block.offset = at;
     at = align_up(at + static_cast<std::uint32_t>(bytes), kImageBlockAlignment);
-  }
+  };
+  for_each_image_block(place, std::make_index_sequence<std::size(kImageBlocks)>{});
   layout.total_size = at + kImageTrailerSize;
   return layout;
 }
@@ -464,6 +474,20 @@ constexpr bool image_header_fields_tile() {
   return at == kImageHeaderSize;
 }
 static_assert(image_header_fields_tile(), "the header fields must cover the header byte for byte");
+
+// Calls visit(index) for each header field, index a std::integral_constant,
+// in the order of the header's bytes, until visit returns false. Unrolled at
+// compile time, each field a constant: a firmware build keeps neither the
+// table nor its names.
+template <typename Visit, std::size_t... I>
+constexpr bool for_each_image_header_field(Visit&& visit, std::index_sequence<I...>) {
+  return (visit(std::integral_constant<std::size_t, I>{}) && ...);
+}
+
+template <typename Visit>
+constexpr bool for_each_image_header_field(Visit&& visit) {
+  return for_each_image_header_field(visit, std::make_index_sequence<std::size(kImageHeaderFields)>{});
+}
 
 // Whether an image of this version uses the field (gives it its meaning).
 // Minor versions count within any major version from the field's on.
@@ -753,18 +777,21 @@ class ImageScan {
                          major == 1 ? 0 : image_field_value(bytes, image_field::variance_rank)};
     // The float blocks the header locates: all but the metadata.
     int i = 0;
-    for (const ImageHeaderField& field : kImageHeaderFields) {
-      if (field.locates == ImageBlockId::none || field.locates == ImageBlockId::metadata) continue;
-      const std::uint64_t floats = image_block_bytes(field.locates, dims) / 4;
-      const std::uint32_t at = image_field_value(bytes, field);
-      // Blocks the scan cannot check (outside the bytes, misaligned) stay
-      // empty: parse_image() then checks them itself, or refuses the image.
-      if (floats != 0 && at % alignof(float) == 0 && at <= end_ && 4 * floats <= end_ - at) {
-        first_[i] = at;
-        floats_[i] = static_cast<std::uint32_t>(floats);
+    for_each_image_header_field([&](auto index) {
+      constexpr ImageHeaderField field = kImageHeaderFields[decltype(index)::value];
+      if constexpr (field.locates != ImageBlockId::none && field.locates != ImageBlockId::metadata) {
+        const std::uint64_t floats = image_block_bytes(field.locates, dims) / 4;
+        const std::uint32_t at = image_field_value(bytes, field);
+        // Blocks the scan cannot check (outside the bytes, misaligned) stay
+        // empty: parse_image() then checks them itself, or refuses the image.
+        if (floats != 0 && at % alignof(float) == 0 && at <= end_ && 4 * floats <= end_ - at) {
+          first_[i] = at;
+          floats_[i] = static_cast<std::uint32_t>(floats);
+        }
+        ++i;
       }
-      ++i;
-    }
+      return true;
+    });
   }
 
   // Up to max_bytes more; true once every byte is scanned. A slice ends on a
@@ -987,12 +1014,11 @@ bool check_older_version_field(Run& run, const std::uint8_t* bytes, const Declar
 }
 
 // Every field the image's version does not use holds what its rule says, in
-// the order of the header's bytes. The walk is unrolled at compile time, so
-// the fields' names stay out of a stopping run's code.
-template <typename Run, std::size_t... I>
-bool check_older_version_fields(Run& run, const std::uint8_t* bytes, const DeclaredImage& h,
-                                std::index_sequence<I...>) {
-  return (check_older_version_field<I>(run, bytes, h) && ...);
+// the order of the header's bytes.
+template <typename Run>
+bool check_older_version_fields(Run& run, const std::uint8_t* bytes, const DeclaredImage& h) {
+  return for_each_image_header_field(
+      [&](auto index) { return check_older_version_field<decltype(index)::value>(run, bytes, h); });
 }
 
 template <typename Run>
@@ -1092,15 +1118,16 @@ bool check_capacity(Run& run, const DeclaredImage& h, const ImageCapacity& capac
 // alignment (the fields in the order of the header's bytes).
 template <typename Run>
 bool check_block_alignment(Run& run, const std::uint8_t* bytes, const DeclaredImage& h) {
-  for (const ImageHeaderField& field : kImageHeaderFields) {
-    if (field.locates == ImageBlockId::none) continue;
-    const std::uint32_t offset = h.value(bytes, field);
-    if (!run.expect(offset % kImageBlockAlignment == 0, ImageCheckId::alignment, ImageStatus::misaligned, field.name,
-                    -1, offset, kImageBlockAlignment, ImageExpectation::multiple_of)) {
-      return false;
+  return for_each_image_header_field([&](auto index) {
+    constexpr ImageHeaderField field = kImageHeaderFields[decltype(index)::value];
+    if constexpr (field.locates == ImageBlockId::none) {
+      return true;
+    } else {
+      const std::uint32_t offset = h.value(bytes, field);
+      return run.expect(offset % kImageBlockAlignment == 0, ImageCheckId::alignment, ImageStatus::misaligned,
+                        Run::name(field.name), -1, offset, kImageBlockAlignment, ImageExpectation::multiple_of);
     }
-  }
-  return true;
+  });
 }
 
 // The bytes of the arrays the dims declare. Under a generous capacity the
@@ -1133,16 +1160,17 @@ bool check_layout(Run& run, const std::uint8_t* bytes, const DeclaredImage& h) {
                   "metadata_size", -1, declared_metadata_size, kImageMetadataSize, Expect::equal)) {
     return false;
   }
-  for (const ImageHeaderField& field : kImageHeaderFields) {
-    if (field.locates == ImageBlockId::none) continue;
-    const std::uint32_t offset = h.value(bytes, field);
-    const std::uint32_t expected_offset = expected.*image_block(field.locates).offset;
-    if (!run.expect(offset == expected_offset, ImageCheckId::layout, ImageStatus::size_mismatch, field.name, -1,
-                    offset, expected_offset, Expect::equal)) {
-      return false;
+  return for_each_image_header_field([&](auto index) {
+    constexpr ImageHeaderField field = kImageHeaderFields[decltype(index)::value];
+    if constexpr (field.locates == ImageBlockId::none) {
+      return true;
+    } else {
+      const std::uint32_t offset = h.value(bytes, field);
+      const std::uint32_t expected_offset = expected.*image_block(field.locates).offset;
+      return run.expect(offset == expected_offset, ImageCheckId::layout, ImageStatus::size_mismatch,
+                        Run::name(field.name), -1, offset, expected_offset, Expect::equal);
     }
-  }
-  return true;
+  });
 }
 
 // From here on a stopping run has verified every block to lie where the
@@ -1424,7 +1452,7 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   }
   h.minor = static_cast<std::uint16_t>(image_field_value(bytes, image_field::version_minor));
   h.rank = h.value(bytes, image_field::variance_rank);
-  if (!check_older_version_fields(run, bytes, h, std::make_index_sequence<std::size(kImageHeaderFields)>{}) ||
+  if (!check_older_version_fields(run, bytes, h) ||
       !check_kind(run, bytes, h) || !check_dims(run, bytes, h) || !check_hysteresis_counts(run, bytes, h) ||
       !check_compliance_counts(run, bytes, h) || !check_capacity(run, h, capacity) ||
       !check_block_alignment(run, bytes, h) || !check_layout(run, bytes, h)) {
