@@ -385,7 +385,7 @@ TEST_F(RefusedImageTest, AnotherSegmentCount) {
 
 TEST_F(RefusedImageTest, AnotherFormatVersion) {
   std::vector<std::uint8_t> image = new_image;
-  image[model::image_field::version_major] = 9;
+  image[model::image_field::version_major.offset] = 9;
   expect_refused(image, UpdateReason::unsupported_version);
 }
 

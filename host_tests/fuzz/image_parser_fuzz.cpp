@@ -124,7 +124,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   // mutations reach the checks behind the checksum.
   if (size >= kImageHeaderSize + kImageTrailerSize) {
     std::uint32_t total = 0;
-    std::memcpy(&total, image.data() + image_field::total_size, 4);
+    std::memcpy(&total, image.data() + image_field::total_size.offset, 4);
     if (total >= kImageHeaderSize + kImageTrailerSize && total <= size) {
       const std::uint32_t crc = crc32(image.data(), total - kImageTrailerSize);
       std::memcpy(image.data() + total - kImageTrailerSize, &crc, 4);

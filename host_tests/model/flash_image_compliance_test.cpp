@@ -67,7 +67,7 @@ TEST_F(FlashImageCompliance, AGoodBlockParsesIntoTheViewAndAModel) {
   ImageView view{};
   ASSERT_EQ(parse_image(image.data(), image.size(), view), ImageStatus::ok);
   EXPECT_EQ(view.version_minor, kImageVersionMinorCompliance);
-  EXPECT_EQ(image[image_field::compliance_segments], 2);
+  EXPECT_EQ(image[image_field::compliance_segments.offset], 2);
   EXPECT_EQ(view.total_size, layout().total_size);
   ASSERT_EQ(view.compliance_segments, 2);
   EXPECT_EQ(reinterpret_cast<const std::uint8_t*>(view.compliance_weighted_gravity), image.data() + at(0));
@@ -83,7 +83,7 @@ TEST_F(FlashImageCompliance, AGoodBlockParsesIntoTheViewAndAModel) {
   EXPECT_EQ(from_image.ratio[1], 0.85f);
   EXPECT_EQ(from_image.softening_per_rad, 0.4f);
   EXPECT_EQ(from_image.unloaded_mass_kg, 0.18f);
-  EXPECT_EQ(get<std::uint32_t>(image, image_field::metadata_offset), layout().metadata_offset);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::metadata_offset.offset), layout().metadata_offset);
 
   Findings findings;
   ASSERT_EQ(parse_image(image.data(), image.size(), view, ImageCapacity{}, &findings), ImageStatus::ok);
@@ -93,8 +93,8 @@ TEST_F(FlashImageCompliance, AGoodBlockParsesIntoTheViewAndAModel) {
 
 TEST_F(FlashImageCompliance, AModelWithoutItIsWrittenAsBeforeAndAddingTheBlockMovesOnlyTheMetadata) {
   const Bytes old_image = exporting::write_image(payload_model);
-  EXPECT_EQ(get<std::uint16_t>(old_image, image_field::version_minor), kImageVersionMinor);
-  EXPECT_EQ(old_image[image_field::reserved_a], 0);
+  EXPECT_EQ(get<std::uint16_t>(old_image, image_field::version_minor.offset), kImageVersionMinor);
+  EXPECT_EQ(old_image[image_field::compliance_segments.offset], 0);
   const ImageLayout old_layout = image_layout(static_cast<std::uint32_t>(model.training_points()),
                                               static_cast<std::uint32_t>(model.input_dims()), 2, kImageVersionMajor,
                                               0, 1);
@@ -155,7 +155,7 @@ TEST_F(FlashImageCompliance, ABlockWithoutThePayloadInputForOtherSegmentsOrInAnO
   // The count byte set by hand, under a valid CRC: the field that fails
   // first, of a bad_header refusal.
   const auto refused_field = [](Bytes bytes, std::uint8_t count) {
-    put<std::uint8_t>(bytes, image_field::compliance_segments, count);
+    put<std::uint8_t>(bytes, image_field::compliance_segments.offset, count);
     reseal(bytes);
     ImageFinding first;
     EXPECT_EQ(parse_all_ways(bytes, first), ImageStatus::bad_header);
@@ -180,10 +180,10 @@ TEST_F(FlashImageCompliance, ABlockWithoutThePayloadInputForOtherSegmentsOrInAnO
   std::copy(plain.begin(), plain.begin() + old_layout.metadata_offset, forged.begin());
   std::copy(plain.begin() + old_layout.metadata_offset, plain.begin() + old_layout.metadata_offset + kImageMetadataSize,
             forged.begin() + new_layout.metadata_offset);
-  put<std::uint16_t>(forged, image_field::version_minor, kImageVersionMinorCompliance);
-  put<std::uint8_t>(forged, image_field::compliance_segments, 2);
-  put<std::uint32_t>(forged, image_field::total_size, new_layout.total_size);
-  put<std::uint32_t>(forged, image_field::metadata_offset, new_layout.metadata_offset);
+  put<std::uint16_t>(forged, image_field::version_minor.offset, kImageVersionMinorCompliance);
+  put<std::uint8_t>(forged, image_field::compliance_segments.offset, 2);
+  put<std::uint32_t>(forged, image_field::total_size.offset, new_layout.total_size);
+  put<std::uint32_t>(forged, image_field::metadata_offset.offset, new_layout.metadata_offset);
   for (int i = 0; i < 7; ++i) put<float>(forged, new_layout.compliance_offset + 4 * i, 1e-4f);
   reseal(forged);
   EXPECT_EQ(parse_all_ways(forged, first), ImageStatus::bad_header);

@@ -52,8 +52,8 @@ TEST_F(FlashImageHysteresis, AGoodBlockParsesIntoTheViewAndAModel) {
   ImageView view{};
   ASSERT_EQ(parse_image(image.data(), image.size(), view), ImageStatus::ok);
   EXPECT_EQ(view.version_minor, kImageVersionMinorHysteresis);
-  EXPECT_EQ(image[image_field::hysteresis_cables], 8);
-  EXPECT_EQ(image[image_field::hysteresis_operators], 2);
+  EXPECT_EQ(image[image_field::hysteresis_cables.offset], 8);
+  EXPECT_EQ(image[image_field::hysteresis_operators.offset], 2);
   EXPECT_EQ(view.total_size, layout().total_size);
   ASSERT_EQ(view.hysteresis_cables, 8);
   ASSERT_EQ(view.hysteresis_operators, 2);
@@ -71,7 +71,7 @@ TEST_F(FlashImageHysteresis, AGoodBlockParsesIntoTheViewAndAModel) {
     }
   }
   // The rest of the model is where it was: the metadata follows the block.
-  EXPECT_EQ(get<std::uint32_t>(image, image_field::metadata_offset), layout().metadata_offset);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::metadata_offset.offset), layout().metadata_offset);
   EXPECT_EQ(view.created_unix_s, model.created_unix_s);
 
   Findings findings;
@@ -84,9 +84,9 @@ TEST_F(FlashImageHysteresis, AJointsOnlyModelIsWrittenAsBeforeAndAddingTheBlockM
   training::TrainedModel joints_only = model;
   joints_only.hysteresis = HysteresisModel<double>{};
   const Bytes old_image = exporting::write_image(joints_only);
-  EXPECT_EQ(get<std::uint16_t>(old_image, image_field::version_minor), kImageVersionMinor);
-  EXPECT_EQ(old_image[image_field::reserved_b], 0);
-  EXPECT_EQ(old_image[image_field::reserved_b + 1], 0);
+  EXPECT_EQ(get<std::uint16_t>(old_image, image_field::version_minor.offset), kImageVersionMinor);
+  EXPECT_EQ(old_image[image_field::hysteresis_cables.offset], 0);
+  EXPECT_EQ(old_image[image_field::hysteresis_operators.offset], 0);
   const ImageLayout old_layout =
       image_layout(static_cast<std::uint32_t>(model.training_points()),
                    static_cast<std::uint32_t>(model.input_dims()), 2);
@@ -116,7 +116,7 @@ TEST_F(FlashImageHysteresis, AV21ImageMustKeepTheCountBytesZero) {
   training::TrainedModel joints_only = model;
   joints_only.hysteresis = HysteresisModel<double>{};
   Bytes old_image = exporting::write_image(joints_only);
-  put<std::uint8_t>(old_image, image_field::hysteresis_operators, 2);
+  put<std::uint8_t>(old_image, image_field::hysteresis_operators.offset, 2);
   reseal(old_image);
   ImageFinding first;
   EXPECT_EQ(parse_all_ways(old_image, first), ImageStatus::bad_header);
@@ -183,8 +183,8 @@ TEST_F(FlashImageHysteresis, BadCountsAreRefusedBeforeTheLayout) {
   for (const BadCounts& bad : cases) {
     SCOPED_TRACE(bad.field);
     Bytes damaged = image;
-    damaged[image_field::hysteresis_cables] = bad.cables;
-    damaged[image_field::hysteresis_operators] = bad.operators;
+    damaged[image_field::hysteresis_cables.offset] = bad.cables;
+    damaged[image_field::hysteresis_operators.offset] = bad.operators;
     reseal(damaged);
     ImageFinding first;
     EXPECT_EQ(parse_all_ways(damaged, first), bad.status);
@@ -192,7 +192,7 @@ TEST_F(FlashImageHysteresis, BadCountsAreRefusedBeforeTheLayout) {
   }
   // Counts that are valid but not this image's: the layout no longer matches.
   Bytes other = image;
-  other[image_field::hysteresis_operators] = 1;
+  other[image_field::hysteresis_operators.offset] = 1;
   reseal(other);
   ImageFinding first;
   EXPECT_EQ(parse_all_ways(other, first), ImageStatus::size_mismatch);

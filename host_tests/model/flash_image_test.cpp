@@ -101,12 +101,12 @@ class FlashImage : public ::testing::Test {
 TEST_F(FlashImage, LayoutIsTheOneTheDimsImply) {
   ASSERT_EQ(image.size(), layout.total_size);
   EXPECT_EQ(std::memcmp(image.data(), "CDGP", 4), 0);
-  EXPECT_EQ(get<std::uint32_t>(image, image_field::total_size), layout.total_size);
-  EXPECT_EQ(get<std::uint32_t>(image, image_field::geometry_offset), 64u);
-  EXPECT_EQ(get<std::uint32_t>(image, image_field::parameters_offset), layout.parameters_offset);
-  EXPECT_EQ(get<std::uint32_t>(image, image_field::inputs_offset), layout.inputs_offset);
-  EXPECT_EQ(get<std::uint32_t>(image, image_field::alpha_offset), layout.alpha_offset);
-  EXPECT_EQ(get<std::uint32_t>(image, image_field::metadata_offset), layout.metadata_offset);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::total_size.offset), layout.total_size);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::geometry_offset.offset), 64u);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::parameters_offset.offset), layout.parameters_offset);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::inputs_offset.offset), layout.inputs_offset);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::alpha_offset.offset), layout.alpha_offset);
+  EXPECT_EQ(get<std::uint32_t>(image, image_field::metadata_offset.offset), layout.metadata_offset);
   // Each block at the next multiple of 8 after the previous one, padding zero.
   const std::uint32_t ends[] = {64 + 4 * geometry_floats(), layout.parameters_offset + 4 * parameter_floats(),
                                 layout.inputs_offset + 4 * input_floats(), layout.alpha_offset + 4 * alpha_floats(),
@@ -240,7 +240,7 @@ TEST_F(FlashImage, SparseModelRoundTrip) {
   sparse.input_max = Eigen::VectorXd::Constant(4, 1.5);
   const Bytes sparse_image = exporting::write_image(sparse);
   ASSERT_EQ(sparse_image.size(), image.size());
-  EXPECT_EQ(sparse_image[image_field::model_kind], 2);
+  EXPECT_EQ(sparse_image[image_field::model_kind.offset], 2);
   EXPECT_EQ(get<std::uint32_t>(sparse_image, layout.metadata_offset + image_metadata_field::fitted_rows), 1200u);
 
   ImageView view{};
@@ -327,16 +327,16 @@ TEST_F(FlashImageV1, IsLaidOutByItsOwnVersion) {
   // v1 bytes labelled v2 lack the input ranges; a v2 image labelled v1 has
   // 32 bytes too many.
   Bytes relabelled = v1;
-  put<std::uint16_t>(relabelled, image_field::version_major, 2);
+  put<std::uint16_t>(relabelled, image_field::version_major.offset, 2);
   test_support::reseal_v1_image(relabelled);
   EXPECT_EQ(parse(relabelled), ImageStatus::unsupported_kind) << "v2 reads model_kind 0 first";
-  relabelled[image_field::model_kind] = 1;
+  relabelled[image_field::model_kind.offset] = 1;
   test_support::reseal_v1_image(relabelled);
   EXPECT_EQ(parse_failing(relabelled, ImageCheckId::layout), ImageStatus::size_mismatch);
 
   Bytes v2_as_v1 = image;
-  put<std::uint16_t>(v2_as_v1, image_field::version_major, 1);
-  v2_as_v1[image_field::model_kind] = 0;
+  put<std::uint16_t>(v2_as_v1, image_field::version_major.offset, 1);
+  v2_as_v1[image_field::model_kind.offset] = 0;
   reseal(v2_as_v1);
   EXPECT_EQ(parse_failing(v2_as_v1, ImageCheckId::layout), ImageStatus::size_mismatch);
 }
@@ -359,7 +359,7 @@ TEST_F(FlashImageV1, EveryDamagedByteIsRejected) {
 // first, the reporting parse names both and returns the same status.
 TEST_F(FlashImage, ReportingModeFindsEveryIndependentFault) {
   Bytes bad = image;
-  bad[image_field::model_kind] = 3;
+  bad[image_field::model_kind.offset] = 3;
   put<float>(bad, layout.alpha_offset + 4 * 7, std::numeric_limits<float>::quiet_NaN());
   put<float>(bad, layout.parameters_offset + 4 * (12 + 6 + 1), -1.0f);  // output_scale[1]
   reseal(bad);
@@ -463,7 +463,7 @@ TEST_F(FlashImage, BadMagic) {
 TEST_F(FlashImage, UnknownMajorVersion) {
   for (std::uint16_t major : {0, 3, 0xFFFF}) {
     Bytes bad = image;
-    put<std::uint16_t>(bad, image_field::version_major, major);
+    put<std::uint16_t>(bad, image_field::version_major.offset, major);
     reseal(bad);
     EXPECT_EQ(parse(bad), ImageStatus::unsupported_version) << major;
   }
@@ -471,7 +471,7 @@ TEST_F(FlashImage, UnknownMajorVersion) {
 
 TEST_F(FlashImage, NewerMinorVersionIsAccepted) {
   Bytes newer = image;
-  put<std::uint16_t>(newer, image_field::version_minor, 3);
+  put<std::uint16_t>(newer, image_field::version_minor.offset, 3);
   reseal(newer);
   ImageView view{};
   ASSERT_EQ(parse_image(newer.data(), newer.size(), view), ImageStatus::ok);
@@ -481,7 +481,7 @@ TEST_F(FlashImage, NewerMinorVersionIsAccepted) {
 TEST_F(FlashImage, WrongHeaderSize) {
   for (std::uint32_t size : {0u, 60u, 65u, 128u}) {
     Bytes bad = image;
-    put<std::uint32_t>(bad, image_field::header_size, size);
+    put<std::uint32_t>(bad, image_field::header_size.offset, size);
     reseal(bad);
     EXPECT_EQ(parse(bad), ImageStatus::bad_header) << size;
   }
@@ -490,14 +490,14 @@ TEST_F(FlashImage, WrongHeaderSize) {
 TEST_F(FlashImage, TotalSizeTooSmallForHeaderAndTrailer) {
   for (std::uint32_t total : {0u, 4u, 64u, 67u}) {
     Bytes bad = image;
-    put<std::uint32_t>(bad, image_field::total_size, total);
+    put<std::uint32_t>(bad, image_field::total_size.offset, total);
     EXPECT_EQ(parse(bad), ImageStatus::bad_header) << total;
   }
 }
 
 TEST_F(FlashImage, TotalSizeBeyondTheBufferIsTruncated) {
   Bytes bad = image;
-  put<std::uint32_t>(bad, image_field::total_size, static_cast<std::uint32_t>(image.size() + 8));
+  put<std::uint32_t>(bad, image_field::total_size.offset, static_cast<std::uint32_t>(image.size() + 8));
   EXPECT_EQ(parse(bad), ImageStatus::truncated);
 }
 
@@ -529,7 +529,7 @@ TEST_F(FlashImage, EveryDamagedByteIsRejected) {
 }
 
 TEST_F(FlashImage, ReservedHeaderBytesMustBeZero) {
-  for (std::size_t offset : {image_field::reserved_a, image_field::reserved_b, image_field::reserved_b + 1}) {
+  for (std::size_t offset : {image_field::compliance_segments.offset, image_field::hysteresis_cables.offset, image_field::hysteresis_operators.offset}) {
     Bytes bad = image;
     bad[offset] = 1;
     EXPECT_EQ(parse(bad), ImageStatus::checksum_mismatch) << offset;
@@ -547,9 +547,9 @@ TEST_F(FlashImage, ReservedHeaderBytesMustBeZero) {
 TEST_F(FlashImage, VarianceFactorFieldsMustBeZeroInVersion20) {
   for (std::size_t byte = 0; byte < 6; ++byte) {
     Bytes bad = image;
-    bad[image_field::version_minor] = 0;
-    bad[image_field::version_minor + 1] = 0;
-    bad[image_field::variance_offset + byte] = 8;
+    bad[image_field::version_minor.offset] = 0;
+    bad[image_field::version_minor.offset + 1] = 0;
+    bad[image_field::variance_offset.offset + byte] = 8;
     reseal(bad);
     EXPECT_EQ(parse_failing(bad, ImageCheckId::header), ImageStatus::bad_header) << "byte " << byte;
     Findings findings;
@@ -563,11 +563,11 @@ TEST_F(FlashImage, VarianceFactorFieldsMustBeZeroInVersion20) {
 }
 
 TEST_F(FlashImage, UnknownModelKindOrExtraInputs) {
-  const std::pair<std::size_t, std::uint8_t> cases[] = {{image_field::model_kind, 0},
-                                                        {image_field::model_kind, 3},
-                                                        {image_field::model_kind, 0xFF},
-                                                        {image_field::extra_inputs, 2},
-                                                        {image_field::extra_inputs, 0xFF}};
+  const std::pair<std::size_t, std::uint8_t> cases[] = {{image_field::model_kind.offset, 0},
+                                                        {image_field::model_kind.offset, 3},
+                                                        {image_field::model_kind.offset, 0xFF},
+                                                        {image_field::extra_inputs.offset, 2},
+                                                        {image_field::extra_inputs.offset, 0xFF}};
   for (const auto& [offset, value] : cases) {
     Bytes bad = image;
     bad[offset] = value;
@@ -576,7 +576,7 @@ TEST_F(FlashImage, UnknownModelKindOrExtraInputs) {
     Findings findings;
     parse_reporting(bad, findings);
     const ImageFinding* failure =
-        findings.failure_of(offset == image_field::model_kind ? "model_kind" : "extra_inputs");
+        findings.failure_of(offset == image_field::model_kind.offset ? "model_kind" : "extra_inputs");
     ASSERT_NE(failure, nullptr);
     EXPECT_EQ(failure->value, value);
   }
@@ -587,10 +587,10 @@ TEST_F(FlashImage, UnknownModelKindOrExtraInputs) {
 // blocks is inconsistent, not unsupported.
 TEST_F(FlashImage, OnePayloadInputNeedsItsDimsAndBlocks) {
   Bytes bad = image;
-  bad[image_field::extra_inputs] = 1;
+  bad[image_field::extra_inputs.offset] = 1;
   reseal(bad);
   EXPECT_EQ(parse_failing(bad, ImageCheckId::header), ImageStatus::bad_header);
-  put<std::uint16_t>(bad, image_field::input_dims, 5);
+  put<std::uint16_t>(bad, image_field::input_dims.offset, 5);
   reseal(bad);
   EXPECT_EQ(parse_failing(bad, ImageCheckId::layout), ImageStatus::size_mismatch);
 }
@@ -614,7 +614,7 @@ TEST_F(FlashImage, PayloadModelRoundTrip) {
   EXPECT_EQ(view.segment_count, 2);
   ASSERT_NE(view.extra_input_default, nullptr);
   EXPECT_EQ(*view.extra_input_default, 0.375f);
-  EXPECT_EQ(get<std::uint8_t>(payload_image, image_field::extra_inputs), 1);
+  EXPECT_EQ(get<std::uint8_t>(payload_image, image_field::extra_inputs.offset), 1);
   EXPECT_EQ(view.extra_input_default, view.input_max + 5);
   EXPECT_EQ(view.input_min[4], static_cast<float>(payload_model.inputs.col(4).minCoeff()));
   EXPECT_EQ(view.input_max[4], static_cast<float>(payload_model.inputs.col(4).maxCoeff()));
@@ -642,9 +642,9 @@ TEST_F(FlashImage, PayloadModelRoundTrip) {
 
 TEST_F(FlashImage, UnsupportedScalarKernelOrEncoding) {
   const std::pair<std::size_t, std::uint8_t> cases[] = {
-      {image_field::scalar_type, 0},    {image_field::scalar_type, 2},  {image_field::kernel_kind, 0},
-      {image_field::kernel_kind, 2},    {image_field::input_encoding, 0}, {image_field::input_encoding, 3},
-      {image_field::input_encoding, 0xFF}};
+      {image_field::scalar_type.offset, 0},    {image_field::scalar_type.offset, 2},  {image_field::kernel_kind.offset, 0},
+      {image_field::kernel_kind.offset, 2},    {image_field::input_encoding.offset, 0}, {image_field::input_encoding.offset, 3},
+      {image_field::input_encoding.offset, 0xFF}};
   for (const auto& [offset, value] : cases) {
     Bytes bad = image;
     bad[offset] = value;
@@ -664,13 +664,13 @@ TEST_F(FlashImage, InconsistentDims) {
     reseal(bad);
     return parse(bad);
   };
-  EXPECT_EQ(edit(image_field::training_points, 0, true), ImageStatus::bad_header);
-  EXPECT_EQ(edit(image_field::segment_count, 0, false), ImageStatus::bad_header);
-  EXPECT_EQ(edit(image_field::input_dims, 5, false), ImageStatus::bad_header);
-  EXPECT_EQ(edit(image_field::input_dims, 0, false), ImageStatus::bad_header);
-  EXPECT_EQ(edit(image_field::segment_count, 3, false), ImageStatus::bad_header);
-  EXPECT_EQ(edit(image_field::output_dims, 5, false), ImageStatus::bad_header);
-  EXPECT_EQ(edit(image_field::output_dims, 7, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::training_points.offset, 0, true), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::segment_count.offset, 0, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::input_dims.offset, 5, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::input_dims.offset, 0, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::segment_count.offset, 3, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::output_dims.offset, 5, false), ImageStatus::bad_header);
+  EXPECT_EQ(edit(image_field::output_dims.offset, 7, false), ImageStatus::bad_header);
 }
 
 TEST_F(FlashImage, OverCapacity) {
@@ -681,8 +681,8 @@ TEST_F(FlashImage, OverCapacity) {
 }
 
 TEST_F(FlashImage, MisalignedBlockOffset) {
-  for (std::size_t field : {image_field::geometry_offset, image_field::parameters_offset, image_field::inputs_offset,
-                            image_field::alpha_offset, image_field::metadata_offset}) {
+  for (std::size_t field : {image_field::geometry_offset.offset, image_field::parameters_offset.offset, image_field::inputs_offset.offset,
+                            image_field::alpha_offset.offset, image_field::metadata_offset.offset}) {
     for (std::uint32_t shift : {1u, 4u}) {
       Bytes bad = image;
       put<std::uint32_t>(bad, field, get<std::uint32_t>(bad, field) + shift);
@@ -693,8 +693,8 @@ TEST_F(FlashImage, MisalignedBlockOffset) {
 }
 
 TEST_F(FlashImage, OffsetOrSizeDisagreeingWithTheDims) {
-  for (std::size_t field : {image_field::geometry_offset, image_field::parameters_offset, image_field::inputs_offset,
-                            image_field::alpha_offset, image_field::metadata_offset}) {
+  for (std::size_t field : {image_field::geometry_offset.offset, image_field::parameters_offset.offset, image_field::inputs_offset.offset,
+                            image_field::alpha_offset.offset, image_field::metadata_offset.offset}) {
     for (std::int64_t shift : {-8, 8}) {
       Bytes bad = image;
       put<std::uint32_t>(bad, field, static_cast<std::uint32_t>(get<std::uint32_t>(bad, field) + shift));
@@ -704,7 +704,7 @@ TEST_F(FlashImage, OffsetOrSizeDisagreeingWithTheDims) {
   }
   {
     Bytes bad = image;
-    put<std::uint32_t>(bad, image_field::metadata_size, kImageMetadataSize + 8);
+    put<std::uint32_t>(bad, image_field::metadata_size.offset, kImageMetadataSize + 8);
     reseal(bad);
     EXPECT_EQ(parse(bad), ImageStatus::size_mismatch) << "metadata_size";
   }
@@ -712,14 +712,14 @@ TEST_F(FlashImage, OffsetOrSizeDisagreeingWithTheDims) {
     // A consistent-looking image eight bytes longer than its dims imply.
     Bytes longer = image;
     longer.insert(longer.end() - kImageTrailerSize, 8, 0);
-    put<std::uint32_t>(longer, image_field::total_size, static_cast<std::uint32_t>(longer.size()));
+    put<std::uint32_t>(longer, image_field::total_size.offset, static_cast<std::uint32_t>(longer.size()));
     reseal(longer);
     EXPECT_EQ(parse(longer), ImageStatus::size_mismatch) << "total_size";
   }
   {
     // One training point fewer: the arrays no longer fill the blocks.
     Bytes bad = image;
-    put<std::uint32_t>(bad, image_field::training_points, 4);
+    put<std::uint32_t>(bad, image_field::training_points.offset, 4);
     reseal(bad);
     EXPECT_EQ(parse(bad), ImageStatus::size_mismatch) << "training_points";
   }
@@ -730,7 +730,7 @@ TEST_F(FlashImage, DimsThatWrapTheLayoutArithmeticAreASizeMismatch) {
   // in 32-bit arithmetic the very same layout. A parser given room for such
   // an N must not trust the wrapped sizes and read past the image.
   Bytes bad = image;
-  put<std::uint32_t>(bad, image_field::training_points, 5u + (1u << 29));
+  put<std::uint32_t>(bad, image_field::training_points.offset, 5u + (1u << 29));
   reseal(bad);
   const ImageCapacity unlimited{std::numeric_limits<std::uint32_t>::max(), std::numeric_limits<std::uint16_t>::max()};
   EXPECT_EQ(parse(bad, unlimited), ImageStatus::size_mismatch);
@@ -809,7 +809,7 @@ TEST_F(FlashImage, FittedRows) {
     EXPECT_EQ(parse_failing(bad, ImageCheckId::fitted_rows), ImageStatus::invalid_parameters) << rows;
   }
   Bytes sparse = image;
-  sparse[image_field::model_kind] = static_cast<std::uint8_t>(ImageModelKind::sparse_gp);
+  sparse[image_field::model_kind.offset] = static_cast<std::uint8_t>(ImageModelKind::sparse_gp);
   for (std::uint32_t rows : {1u, 4u, 6u, 1000u}) {
     put<std::uint32_t>(sparse, fitted_rows, rows);
     reseal(sparse);
@@ -995,7 +995,7 @@ namespace {
 TEST_F(FlashImage, AHugeVarianceRankIsRefusedWithoutReadingPastTheImage) {
   for (const std::uint16_t rank : {std::uint16_t{65535}, std::uint16_t{65534}, std::uint16_t{4096}}) {
     Bytes bad = image;
-    std::memcpy(bad.data() + image_field::variance_rank, &rank, 2);
+    std::memcpy(bad.data() + image_field::variance_rank.offset, &rank, 2);
     reseal(bad);
     EXPECT_NE(parse(bad, ImageCapacity{1024, 8, 65535}), ImageStatus::ok) << rank;
     EXPECT_EQ(parse(bad), ImageStatus::over_capacity) << rank;

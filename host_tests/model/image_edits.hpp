@@ -34,7 +34,7 @@ void put(Bytes& image, std::size_t offset, T value) {
 
 // Recomputes the trailer for the total_size the header declares.
 inline void reseal(Bytes& image) {
-  const auto total = get<std::uint32_t>(image, model::image_field::total_size);
+  const auto total = get<std::uint32_t>(image, model::image_field::total_size.offset);
   put<std::uint32_t>(image, total - model::kImageTrailerSize,
                      reference_crc32(image.data(), total - model::kImageTrailerSize));
 }

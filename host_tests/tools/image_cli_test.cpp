@@ -65,7 +65,7 @@ T get(const Bytes& image, std::size_t offset) {
 
 // Recomputes the trailer where the header puts it, if that is inside the bytes.
 void reseal(Bytes& image) {
-  const auto total = get<std::uint32_t>(image, model::image_field::total_size);
+  const auto total = get<std::uint32_t>(image, model::image_field::total_size.offset);
   if (total < 8 || total > image.size()) return;
   put<std::uint32_t>(image, total - 4, model::crc32(image.data(), total - 4));
 }
@@ -292,26 +292,26 @@ void PrintTo(const Damage& d, std::ostream* os) { *os << d.name; }
 class ImageReportDamage : public ImageCli, public ::testing::WithParamInterface<Damage> {
  protected:
   Bytes damaged(const std::string& name) const {
-    using namespace model::image_field;
+    namespace field = model::image_field;
     const model::ImageLayout layout = model::image_layout(5, 4, 2);
     Bytes bad = image;
     if (name == "short") return Bytes(image.begin(), image.begin() + 40);
     if (name == "truncated") return Bytes(image.begin(), image.end() - 1);
     if (name == "magic") bad[0] = 'X';
-    if (name == "version") put<std::uint16_t>(bad, version_major, 3);
-    if (name == "header_size") put<std::uint32_t>(bad, header_size, 32);
-    if (name == "reserved") bad[reserved_b + 1] = 7;
+    if (name == "version") put<std::uint16_t>(bad, field::version_major.offset, 3);
+    if (name == "header_size") put<std::uint32_t>(bad, field::header_size.offset, 32);
+    if (name == "reserved") bad[field::hysteresis_operators.offset] = 7;
     if (name == "variance") {  // a variance block in a v2.0 image
-      put<std::uint16_t>(bad, version_minor, 0);
-      put<std::uint32_t>(bad, variance_offset, layout.metadata_offset);
+      put<std::uint16_t>(bad, field::version_minor.offset, 0);
+      put<std::uint32_t>(bad, field::variance_offset.offset, layout.metadata_offset);
     }
-    if (name == "model_kind") bad[model_kind] = 3;
-    if (name == "extra_inputs") bad[extra_inputs] = 2;  // one is the payload input
-    if (name == "dims") put<std::uint16_t>(bad, input_dims, 3);
-    if (name == "offset_alignment") put<std::uint32_t>(bad, alpha_offset, layout.alpha_offset + 4);
+    if (name == "model_kind") bad[field::model_kind.offset] = 3;
+    if (name == "extra_inputs") bad[field::extra_inputs.offset] = 2;  // one is the payload input
+    if (name == "dims") put<std::uint16_t>(bad, field::input_dims.offset, 3);
+    if (name == "offset_alignment") put<std::uint32_t>(bad, field::alpha_offset.offset, layout.alpha_offset + 4);
     if (name == "checksum") bad[layout.inputs_offset] ^= 1;
-    if (name == "kind") bad[kernel_kind] = 9;
-    if (name == "layout") put<std::uint32_t>(bad, metadata_offset, layout.metadata_offset + 8);
+    if (name == "kind") bad[field::kernel_kind.offset] = 9;
+    if (name == "layout") put<std::uint32_t>(bad, field::metadata_offset.offset, layout.metadata_offset + 8);
     if (name == "nan") put<float>(bad, layout.inputs_offset + 8, std::numeric_limits<float>::quiet_NaN());
     if (name == "zero_scale") put<float>(bad, layout.parameters_offset + 4 * 5, 0.0f);
     if (name == "negative_radius") put<float>(bad, 64 + 4, -67.0f);
@@ -323,7 +323,7 @@ class ImageReportDamage : public ImageCli, public ::testing::WithParamInterface<
     }
     if (name == "v1_reserved") {
       bad = test_support::v1_image(model);
-      bad[model_kind] = 2;  // a v2 field in a v1 image: reserved there
+      bad[field::model_kind.offset] = 2;  // a v2 field in a v1 image: reserved there
     }
     if (name != "checksum") reseal(bad);
     return bad;
@@ -423,7 +423,7 @@ TEST_F(ImageCli, ReportAgreesWithTheParserOnEveryDamage) {
 TEST_F(ImageCli, InspectShowsEveryIndependentFault) {
   const model::ImageLayout layout = model::image_layout(5, 4, 2);
   Bytes bad = image;
-  bad[model::image_field::model_kind] = 7;
+  bad[model::image_field::model_kind.offset] = 7;
   put<float>(bad, layout.inputs_offset + 4 * 3, std::numeric_limits<float>::infinity());
   reseal(bad);
   const CliResult run = cdcr("inspect --json " + quoted(save("two_faults.img", bad)));

@@ -58,7 +58,7 @@ int main(int argc, char** argv) {
 
     std::vector<std::uint8_t> flipped = image;
     std::uint32_t alpha_offset;
-    std::memcpy(&alpha_offset, image.data() + cdcr::model::image_field::alpha_offset, 4);
+    std::memcpy(&alpha_offset, image.data() + cdcr::model::image_field::alpha_offset.offset, 4);
     flipped[alpha_offset + 5] ^= 0xFF;
     write(dir + "/flipped.img", flipped);
 

@@ -322,9 +322,220 @@ std::string capacity_text(const Findings& findings) {
                      number(segments->expected));
 }
 
+// The header's fields, for display, from a file that holds the whole header.
+// A field a version does not use reads as zero.
+ImageHeaderFields read_header(const std::uint8_t* bytes) {
+  namespace field = model::image_field;
+  const auto value = [bytes](const model::ImageHeaderField& f) { return model::image_field_value(bytes, f); };
+  ImageHeaderFields h;
+  h.magic = value(field::magic);
+  h.version_major = static_cast<std::uint16_t>(value(field::version_major));
+  h.version_minor = static_cast<std::uint16_t>(value(field::version_minor));
+  const auto used = [&h, &value](const model::ImageHeaderField& f) {
+    return model::image_field_in_use(f, h.version_major, h.version_minor) ? value(f) : 0;
+  };
+  h.header_size = value(field::header_size);
+  h.total_size = value(field::total_size);
+  h.training_points = value(field::training_points);
+  h.input_dims = static_cast<std::uint16_t>(value(field::input_dims));
+  h.output_dims = static_cast<std::uint16_t>(value(field::output_dims));
+  h.segment_count = static_cast<std::uint16_t>(value(field::segment_count));
+  h.scalar_type = static_cast<std::uint8_t>(value(field::scalar_type));
+  h.kernel_kind = static_cast<std::uint8_t>(value(field::kernel_kind));
+  h.input_encoding = static_cast<std::uint8_t>(value(field::input_encoding));
+  h.model_kind = static_cast<std::uint8_t>(value(field::model_kind));
+  h.extra_inputs = static_cast<std::uint8_t>(value(field::extra_inputs));
+  h.geometry_offset = value(field::geometry_offset);
+  h.parameters_offset = value(field::parameters_offset);
+  h.inputs_offset = value(field::inputs_offset);
+  h.alpha_offset = value(field::alpha_offset);
+  h.metadata_offset = value(field::metadata_offset);
+  h.metadata_size = value(field::metadata_size);
+  h.variance_offset = value(field::variance_offset);
+  h.variance_rank = static_cast<std::uint16_t>(value(field::variance_rank));
+  h.hysteresis_cables = static_cast<std::uint8_t>(used(field::hysteresis_cables));
+  h.hysteresis_operators = static_cast<std::uint8_t>(used(field::hysteresis_operators));
+  h.compliance_segments = static_cast<std::uint8_t>(used(field::compliance_segments));
+  return h;
+}
+
+// The dims a damaged header declares, as the layout reads them.
+model::ImageDims declared_dims(const ImageHeaderFields& h) {
+  const bool v1 = h.version_major == 1;
+  model::ImageDims dims{h.training_points, h.input_dims, h.segment_count, h.version_major};
+  dims.extra_inputs = v1 ? 0 : h.extra_inputs;
+  dims.hysteresis_floats = model::image_hysteresis_floats(h.hysteresis_cables, h.hysteresis_operators);
+  dims.compliance_floats = model::image_compliance_floats(h.compliance_segments);
+  return dims;
+}
+
+bool inside(std::size_t size, std::uint64_t offset, std::uint64_t length) {
+  return offset <= size && length <= size - offset;
+}
+
+// The blocks as the header places them, sized by its dims (64-bit: the dims
+// of a damaged header can be anything), and the hysteresis and compliance
+// blocks' values where they lie inside the file.
+void read_blocks(ImageReport& r, const std::uint8_t* bytes, std::size_t size) {
+  const ImageHeaderFields& h = *r.header;
+  const model::ImageDims dims = declared_dims(h);
+  r.blocks.push_back({"header", 0, model::kImageHeaderSize, true});
+  for (const model::ImageBlockFormat& block : model::kImageBlocks) {
+    if (block.only_when_counted) continue;
+    const std::uint64_t offset = model::image_field_value(bytes, *model::image_block_offset_field(block.id));
+    const std::uint64_t length = model::image_block_bytes(block.id, dims);
+    r.blocks.push_back({block.name, offset, length, inside(size, offset, length)});
+  }
+  const auto span = [](std::uint64_t bytes_of_block) {
+    return (bytes_of_block + model::kImageBlockAlignment - 1) / model::kImageBlockAlignment *
+           model::kImageBlockAlignment;
+  };
+  // The compliance block (v2.3) lies just before the metadata.
+  const std::uint64_t compliance_bytes = model::image_block_bytes(model::ImageBlockId::compliance, dims);
+  const std::uint64_t compliance_span = span(compliance_bytes);
+  if (compliance_bytes > 0 && h.metadata_offset >= compliance_span) {
+    const std::uint64_t at = h.metadata_offset - compliance_span;
+    const bool readable = inside(size, at, compliance_bytes);
+    r.blocks.insert(r.blocks.end() - 1, {"compliance", at, compliance_bytes, readable});
+    if (readable) {
+      const std::vector<float> values = read_floats(bytes, at, compliance_bytes / 4);
+      ImageCompliance block;
+      std::copy(values.begin(), values.begin() + 3, block.weighted_gravity.begin());
+      block.ratios.assign(values.begin() + model::image_compliance_field::ratios,
+                          values.begin() + model::image_compliance_field::ratios + h.compliance_segments);
+      block.softening_per_rad = values[values.size() - 2];
+      block.unloaded_mass_kg = values[values.size() - 1];
+      r.compliance = std::move(block);
+    }
+  }
+  // The hysteresis block (v2.2) lies before them.
+  const std::uint64_t hysteresis_bytes = model::image_block_bytes(model::ImageBlockId::hysteresis, dims);
+  const std::uint64_t hysteresis_span = span(hysteresis_bytes);
+  const std::uint64_t hysteresis_end = compliance_bytes > 0 && h.metadata_offset >= compliance_span
+                                           ? h.metadata_offset - compliance_span
+                                           : h.metadata_offset;
+  if (hysteresis_bytes > 0 && hysteresis_end >= hysteresis_span) {
+    const std::uint64_t at = hysteresis_end - hysteresis_span;
+    const bool readable = inside(size, at, hysteresis_bytes);
+    r.blocks.insert(r.blocks.end() - 1, {"hysteresis", at, hysteresis_bytes, readable});
+    if (readable) {
+      const std::uint64_t count = std::uint64_t{h.hysteresis_cables} * h.hysteresis_operators;
+      ImageHysteresis block;
+      block.cables = h.hysteresis_cables;
+      block.operators = h.hysteresis_operators;
+      block.widths_mm = read_floats(bytes, at, count);
+      block.weights = read_floats(bytes, at + 4 * count, count);
+      block.homing_lags_mm = read_floats(bytes, at + 8 * count, count);
+      r.hysteresis = std::move(block);
+    }
+  }
+  if (h.total_size >= model::kImageTrailerSize) {
+    r.blocks.push_back({"crc32", h.total_size - model::kImageTrailerSize, model::kImageTrailerSize,
+                        inside(size, h.total_size - model::kImageTrailerSize, model::kImageTrailerSize)});
+  }
+}
+
+ImageParameters read_parameters(const std::uint8_t* bytes, const ImageHeaderFields& h, std::uint64_t count) {
+  const bool v1 = h.version_major == 1;
+  const std::uint64_t d = h.input_dims;
+  const std::vector<float> values = read_floats(bytes, h.parameters_offset, count);
+  const auto slice = [&values](std::uint64_t from, std::uint64_t length) {
+    return std::vector<float>(values.begin() + static_cast<std::ptrdiff_t>(from),
+                              values.begin() + static_cast<std::ptrdiff_t>(from + length));
+  };
+  ImageParameters p;
+  p.input_mean = slice(0, d);
+  p.input_scale = slice(d, d);
+  p.length_scale = slice(2 * d, d);
+  p.output_mean = slice(3 * d, 6);
+  p.output_scale = slice(3 * d + 6, 6);
+  p.signal_variance = slice(3 * d + 12, 6);
+  p.noise_variance = slice(3 * d + 18, 6);
+  if (!v1) {
+    p.input_min = slice(3 * d + 24, d);
+    p.input_max = slice(4 * d + 24, d);
+    p.extra_input_default = slice(5 * d + 24, h.extra_inputs);
+  }
+  return p;
+}
+
+ImageMetadata read_metadata(const std::uint8_t* m) {
+  using namespace model::image_metadata_field;
+  ImageMetadata meta;
+  meta.dataset_hash = read<std::uint64_t>(m, dataset_hash);
+  meta.created_unix_s = read<std::int64_t>(m, created_unix_s);
+  meta.validation_samples = read<std::uint32_t>(m, validation_samples);
+  meta.fitted_rows = read<std::uint32_t>(m, fitted_rows);
+  std::memcpy(&meta.metrics, m + metrics, sizeof(model::ImageMetrics));
+  meta.trainer = escaped_text(m + trainer, 32);
+  return meta;
+}
+
+// The geometry, parameters and metadata, and the largest inputs and weights,
+// where they lie inside the file.
+void read_payload(ImageReport& r, const std::uint8_t* bytes, std::size_t size) {
+  const ImageHeaderFields& h = *r.header;
+  const bool v1 = h.version_major == 1;
+  const model::ImageDims dims = declared_dims(h);
+  const std::uint64_t n = h.training_points;
+  const std::uint64_t d = h.input_dims;
+  const std::uint64_t segments = h.segment_count;
+  const auto block_inside = [&](model::ImageBlockId block, std::uint64_t offset) {
+    return inside(size, offset, model::image_block_bytes(block, dims));
+  };
+  if (block_inside(model::ImageBlockId::geometry, h.geometry_offset) && segments > 0) {
+    const std::vector<float> values = read_floats(bytes, h.geometry_offset, 3 * segments);
+    std::vector<std::array<float, 3>> geometry(static_cast<std::size_t>(segments));
+    for (std::size_t s = 0; s < geometry.size(); ++s) geometry[s] = {values[3 * s], values[3 * s + 1], values[3 * s + 2]};
+    r.geometry = std::move(geometry);
+  }
+  if (block_inside(model::ImageBlockId::parameters, h.parameters_offset)) {
+    r.parameters = read_parameters(bytes, h, model::image_block_bytes(model::ImageBlockId::parameters, dims) / 4);
+  }
+  const auto max_abs = [bytes](std::uint64_t offset, std::uint64_t count) {
+    float largest = 0.0f;
+    for (std::uint64_t i = 0; i < count; ++i) {
+      const float value = std::abs(read<float>(bytes, static_cast<std::size_t>(offset + 4 * i)));
+      if (!(value <= largest)) largest = value;  // NaN sticks
+    }
+    return largest;
+  };
+  if (block_inside(model::ImageBlockId::inputs, h.inputs_offset) && n * d > 0) {
+    r.max_abs_input = max_abs(h.inputs_offset, n * d);
+  }
+  if (block_inside(model::ImageBlockId::alpha, h.alpha_offset) && n > 0) {
+    r.max_abs_alpha = max_abs(h.alpha_offset, 6 * n);
+  }
+  if (block_inside(model::ImageBlockId::metadata, h.metadata_offset)) {
+    r.metadata = read_metadata(bytes + h.metadata_offset);
+    if (!v1) r.fitted_rows = r.metadata->fitted_rows;
+  }
+  if (v1) r.fitted_rows = h.training_points;
+}
+
+// The checks, in the parser's order, in words.
+std::vector<ImageCheck> describe_checks(const Findings& findings, const ImageReport& r) {
+  std::vector<ImageCheck> checks;
+  for (int c = 0; c < model::kImageCheckCount; ++c) {
+    const auto id = static_cast<ImageCheckId>(c);
+    ImageCheck check{id, model::to_string(id), CheckResult::not_checked, {}};
+    const Findings::PerCheck& per_check = findings.of(id);
+    if (per_check.failures > 0) {
+      check.result = CheckResult::failed;
+      check.detail = failures_text(per_check);
+    } else {
+      describe_unfailed(check, findings, r);
+    }
+    if (id == ImageCheckId::capacity && !per_check.kept.empty()) check.detail = capacity_text(findings);
+    checks.push_back(std::move(check));
+  }
+  return checks;
+}
+
 }  // namespace
 
 const char* image_status_name(ImageStatus status) {
+
   switch (status) {
     case ImageStatus::ok: return "ok";
     case ImageStatus::truncated: return "truncated";
@@ -351,7 +562,7 @@ const ImageCheck* ImageReport::failed_check() const {
 }
 
 ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
-  using namespace model::image_field;
+  namespace field = model::image_field;
   ImageReport r;
   r.file_size = size;
   Findings findings;
@@ -362,41 +573,11 @@ ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
   r.first_failure = findings.first_failure();
 
   // The fields, for display: whatever of them lies inside the file.
-  if (size >= 4) r.magic = read<std::uint32_t>(bytes, magic);
-  if (size >= 6) r.version_major = read<std::uint16_t>(bytes, version_major);
-  if (size >= model::kImageHeaderSize) {
-    ImageHeaderFields h;
-    h.magic = *r.magic;
-    h.version_major = *r.version_major;
-    h.version_minor = read<std::uint16_t>(bytes, version_minor);
-    h.header_size = read<std::uint32_t>(bytes, header_size);
-    h.total_size = read<std::uint32_t>(bytes, total_size);
-    h.training_points = read<std::uint32_t>(bytes, training_points);
-    h.input_dims = read<std::uint16_t>(bytes, input_dims);
-    h.output_dims = read<std::uint16_t>(bytes, output_dims);
-    h.segment_count = read<std::uint16_t>(bytes, segment_count);
-    h.scalar_type = bytes[scalar_type];
-    h.kernel_kind = bytes[kernel_kind];
-    h.input_encoding = bytes[input_encoding];
-    h.model_kind = bytes[model_kind];
-    h.extra_inputs = bytes[extra_inputs];
-    h.geometry_offset = read<std::uint32_t>(bytes, geometry_offset);
-    h.parameters_offset = read<std::uint32_t>(bytes, parameters_offset);
-    h.inputs_offset = read<std::uint32_t>(bytes, inputs_offset);
-    h.alpha_offset = read<std::uint32_t>(bytes, alpha_offset);
-    h.metadata_offset = read<std::uint32_t>(bytes, metadata_offset);
-    h.metadata_size = read<std::uint32_t>(bytes, metadata_size);
-    h.variance_offset = read<std::uint32_t>(bytes, variance_offset);
-    h.variance_rank = read<std::uint16_t>(bytes, variance_rank);
-    if (h.version_major >= 2 && h.version_minor >= model::kImageVersionMinorHysteresis) {
-      h.hysteresis_cables = bytes[hysteresis_cables];
-      h.hysteresis_operators = bytes[hysteresis_operators];
-    }
-    if (h.version_major >= 2 && h.version_minor >= model::kImageVersionMinorCompliance) {
-      h.compliance_segments = bytes[compliance_segments];
-    }
-    r.header = h;
+  if (size >= field::magic.offset + field::magic.size()) r.magic = model::image_field_value(bytes, field::magic);
+  if (size >= field::version_major.offset + field::version_major.size()) {
+    r.version_major = static_cast<std::uint16_t>(model::image_field_value(bytes, field::version_major));
   }
+  if (size >= model::kImageHeaderSize) r.header = read_header(bytes);
   if (const ImageFinding* f = findings.find(ImageCheckId::size, "total_size"); f != nullptr && f->passed) {
     r.trailing_bytes = size - r.header->total_size;
   }
@@ -404,146 +585,11 @@ ImageReport inspect_image(const std::uint8_t* bytes, std::size_t size) {
     r.stored_crc = static_cast<std::uint32_t>(f->value);
     r.computed_crc = static_cast<std::uint32_t>(f->expected);
   }
-
   if (r.header) {
-    const ImageHeaderFields& h = *r.header;
-    const bool v1 = h.version_major == 1;
-    // Blocks as the header places them, sized by its dims. 64-bit
-    // arithmetic: the dims of a damaged header can be anything.
-    const std::uint64_t n = h.training_points;
-    const std::uint64_t d = h.input_dims;
-    const std::uint64_t segments = h.segment_count;
-    const std::uint64_t extra = v1 ? 0 : h.extra_inputs;
-    const std::uint64_t parameter_floats = model::image_parameter_floats(
-        static_cast<std::uint32_t>(d), h.version_major, static_cast<std::uint32_t>(extra));
-    const std::uint64_t offsets[] = {h.geometry_offset, h.parameters_offset, h.inputs_offset, h.alpha_offset,
-                                     h.metadata_offset};
-    const std::uint64_t block_sizes[] = {12 * segments, 4 * parameter_floats, 4 * n * d, 4 * n * model::kImageOutputs,
-                                         model::kImageMetadataSize};
-    const char* block_names[] = {"geometry", "parameters", "inputs", "alpha", "metadata"};
-    const auto inside = [size](std::uint64_t offset, std::uint64_t length) {
-      return offset <= size && length <= size - offset;
-    };
-    r.blocks.push_back({"header", 0, model::kImageHeaderSize, true});
-    for (int i = 0; i < 5; ++i) {
-      r.blocks.push_back({block_names[i], offsets[i], block_sizes[i], inside(offsets[i], block_sizes[i])});
-    }
-    const auto span = [](std::uint64_t bytes_of_block) {
-      return (bytes_of_block + model::kImageBlockAlignment - 1) / model::kImageBlockAlignment *
-             model::kImageBlockAlignment;
-    };
-    // The compliance block (v2.3) lies just before the metadata.
-    const std::uint64_t compliance_bytes = 4 * std::uint64_t{model::image_compliance_floats(h.compliance_segments)};
-    const std::uint64_t compliance_span = span(compliance_bytes);
-    if (compliance_bytes > 0 && h.metadata_offset >= compliance_span) {
-      const std::uint64_t at = h.metadata_offset - compliance_span;
-      const bool readable = inside(at, compliance_bytes);
-      r.blocks.insert(r.blocks.end() - 1, {"compliance", at, compliance_bytes, readable});
-      if (readable) {
-        const std::vector<float> values = read_floats(bytes, at, compliance_bytes / 4);
-        ImageCompliance block;
-        std::copy(values.begin(), values.begin() + 3, block.weighted_gravity.begin());
-        block.ratios.assign(values.begin() + model::image_compliance_field::ratios,
-                            values.begin() + model::image_compliance_field::ratios + h.compliance_segments);
-        block.softening_per_rad = values[values.size() - 2];
-        block.unloaded_mass_kg = values[values.size() - 1];
-        r.compliance = std::move(block);
-      }
-    }
-    // The hysteresis block (v2.2) lies before them.
-    const std::uint64_t hysteresis_bytes =
-        4 * std::uint64_t{model::image_hysteresis_floats(h.hysteresis_cables, h.hysteresis_operators)};
-    const std::uint64_t hysteresis_span = span(hysteresis_bytes);
-    const std::uint64_t hysteresis_end = compliance_bytes > 0 && h.metadata_offset >= compliance_span
-                                             ? h.metadata_offset - compliance_span
-                                             : h.metadata_offset;
-    if (hysteresis_bytes > 0 && hysteresis_end >= hysteresis_span) {
-      const std::uint64_t at = hysteresis_end - hysteresis_span;
-      const bool readable = inside(at, hysteresis_bytes);
-      r.blocks.insert(r.blocks.end() - 1, {"hysteresis", at, hysteresis_bytes, readable});
-      if (readable) {
-        const std::uint64_t count = std::uint64_t{h.hysteresis_cables} * h.hysteresis_operators;
-        ImageHysteresis block;
-        block.cables = h.hysteresis_cables;
-        block.operators = h.hysteresis_operators;
-        block.widths_mm = read_floats(bytes, at, count);
-        block.weights = read_floats(bytes, at + 4 * count, count);
-        block.homing_lags_mm = read_floats(bytes, at + 8 * count, count);
-        r.hysteresis = std::move(block);
-      }
-    }
-    if (h.total_size >= model::kImageTrailerSize) {
-      r.blocks.push_back({"crc32", h.total_size - model::kImageTrailerSize, model::kImageTrailerSize,
-                          inside(h.total_size - model::kImageTrailerSize, model::kImageTrailerSize)});
-    }
-
-    if (inside(h.geometry_offset, block_sizes[0]) && segments > 0) {
-      const std::vector<float> values = read_floats(bytes, h.geometry_offset, 3 * segments);
-      std::vector<std::array<float, 3>> geometry(static_cast<std::size_t>(segments));
-      for (std::size_t s = 0; s < geometry.size(); ++s) geometry[s] = {values[3 * s], values[3 * s + 1], values[3 * s + 2]};
-      r.geometry = std::move(geometry);
-    }
-    if (inside(h.parameters_offset, block_sizes[1])) {
-      const std::vector<float> values = read_floats(bytes, h.parameters_offset, parameter_floats);
-      const auto slice = [&values](std::uint64_t from, std::uint64_t count) {
-        return std::vector<float>(values.begin() + static_cast<std::ptrdiff_t>(from),
-                                  values.begin() + static_cast<std::ptrdiff_t>(from + count));
-      };
-      ImageParameters p;
-      p.input_mean = slice(0, d);
-      p.input_scale = slice(d, d);
-      p.length_scale = slice(2 * d, d);
-      p.output_mean = slice(3 * d, 6);
-      p.output_scale = slice(3 * d + 6, 6);
-      p.signal_variance = slice(3 * d + 12, 6);
-      p.noise_variance = slice(3 * d + 18, 6);
-      if (!v1) {
-        p.input_min = slice(3 * d + 24, d);
-        p.input_max = slice(4 * d + 24, d);
-        p.extra_input_default = slice(5 * d + 24, extra);
-      }
-      r.parameters = std::move(p);
-    }
-    const auto max_abs = [bytes](std::uint64_t offset, std::uint64_t count) {
-      float largest = 0.0f;
-      for (std::uint64_t i = 0; i < count; ++i) {
-        const float value = std::abs(read<float>(bytes, static_cast<std::size_t>(offset + 4 * i)));
-        if (!(value <= largest)) largest = value;  // NaN sticks
-      }
-      return largest;
-    };
-    if (inside(h.inputs_offset, block_sizes[2]) && n * d > 0) r.max_abs_input = max_abs(h.inputs_offset, n * d);
-    if (inside(h.alpha_offset, block_sizes[3]) && n > 0) r.max_abs_alpha = max_abs(h.alpha_offset, 6 * n);
-    if (inside(h.metadata_offset, model::kImageMetadataSize)) {
-      using namespace model::image_metadata_field;
-      const std::uint8_t* m = bytes + h.metadata_offset;
-      ImageMetadata meta;
-      meta.dataset_hash = read<std::uint64_t>(m, dataset_hash);
-      meta.created_unix_s = read<std::int64_t>(m, created_unix_s);
-      meta.validation_samples = read<std::uint32_t>(m, validation_samples);
-      meta.fitted_rows = read<std::uint32_t>(m, fitted_rows);
-      std::memcpy(&meta.metrics, m + metrics, sizeof(model::ImageMetrics));
-      meta.trainer = escaped_text(m + trainer, 32);
-      r.metadata = std::move(meta);
-      if (!v1) r.fitted_rows = r.metadata->fitted_rows;
-    }
-    if (v1) r.fitted_rows = h.training_points;
+    read_blocks(r, bytes, size);
+    read_payload(r, bytes, size);
   }
-
-  // The checks, in the parser's order, in words.
-  for (int c = 0; c < model::kImageCheckCount; ++c) {
-    const auto id = static_cast<ImageCheckId>(c);
-    ImageCheck check{id, model::to_string(id), CheckResult::not_checked, {}};
-    const Findings::PerCheck& per_check = findings.of(id);
-    if (per_check.failures > 0) {
-      check.result = CheckResult::failed;
-      check.detail = failures_text(per_check);
-    } else {
-      describe_unfailed(check, findings, r);
-    }
-    if (id == ImageCheckId::capacity && !per_check.kept.empty()) check.detail = capacity_text(findings);
-    r.checks.push_back(std::move(check));
-  }
+  r.checks = describe_checks(findings, r);
   return r;
 }
 

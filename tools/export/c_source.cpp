@@ -67,8 +67,8 @@ std::string format_c_source(const std::uint8_t* bytes, std::size_t size, const C
   out.reserve(size * 6 + 1024);
   // The bytes are exported as they are, so the comment names their version.
   std::uint16_t version_major = 0;
-  if (size >= model::image_field::version_major + 2) {
-    std::memcpy(&version_major, bytes + model::image_field::version_major, 2);
+  if (size >= model::image_field::version_major.offset + 2) {
+    std::memcpy(&version_major, bytes + model::image_field::version_major.offset, 2);
   }
   const std::string version = std::to_string(version_major);
   out += "/* Trained CDCR compensation model, flash image v" + version + " (model/flash-image-v" + version + ".md).\n";

@@ -23,6 +23,11 @@ class ImageBuffer {
     std::memcpy(bytes_.data() + offset, &value, sizeof(T));
   }
 
+  // A header field, in the field's own size (little-endian: the low bytes).
+  void put_field(const model::ImageHeaderField& field, std::uint32_t value) {
+    std::memcpy(bytes_.data() + field.offset, &value, field.size());
+  }
+
   void put_float(std::size_t offset, double value) {
     const auto f = static_cast<float>(value);
     if (!std::isfinite(f)) throw std::invalid_argument("model value does not fit in float32: " + std::to_string(value));
@@ -59,9 +64,10 @@ std::uint32_t hysteresis_floats(const model::HysteresisModel<double>& hysteresis
 // The header's counts and the block, for a model with a hysteresis model.
 void put_hysteresis(ImageBuffer& image, std::uint32_t block, const model::HysteresisModel<double>& hysteresis) {
   if (hysteresis.empty()) return;
-  image.put<std::uint16_t>(model::image_field::version_minor, model::kImageVersionMinorHysteresis);
-  image.put<std::uint8_t>(model::image_field::hysteresis_cables, static_cast<std::uint8_t>(hysteresis.cables));
-  image.put<std::uint8_t>(model::image_field::hysteresis_operators, static_cast<std::uint8_t>(hysteresis.operators));
+  image.put_field(model::image_field::version_minor,
+                  model::image_block(model::ImageBlockId::hysteresis).version_minor);
+  image.put_field(model::image_field::hysteresis_cables, static_cast<std::uint32_t>(hysteresis.cables));
+  image.put_field(model::image_field::hysteresis_operators, static_cast<std::uint32_t>(hysteresis.operators));
   std::size_t at = block + 4 * model::image_hysteresis_field::widths;
   for (const auto* values : {&hysteresis.widths_mm, &hysteresis.weights, &hysteresis.homing_lag_mm}) {
     for (int c = 0; c < hysteresis.cables; ++c) {
@@ -92,8 +98,9 @@ std::uint32_t compliance_floats(const model::PayloadCompliance<double>& complian
 void put_compliance(ImageBuffer& image, std::uint32_t block, const model::PayloadCompliance<double>& compliance) {
   if (compliance.empty()) return;
   using namespace model::image_compliance_field;
-  image.put<std::uint16_t>(model::image_field::version_minor, model::kImageVersionMinorCompliance);
-  image.put<std::uint8_t>(model::image_field::compliance_segments, static_cast<std::uint8_t>(compliance.segments));
+  image.put_field(model::image_field::version_minor,
+                  model::image_block(model::ImageBlockId::compliance).version_minor);
+  image.put_field(model::image_field::compliance_segments, static_cast<std::uint32_t>(compliance.segments));
   for (int k = 0; k < 3; ++k) image.put_float(block + 4 * (weighted_gravity + k), compliance.weighted_gravity[k]);
   std::size_t at = block + 4 * ratios;
   for (int i = 0; i < compliance.segments; ++i, at += 4) image.put_float(at, compliance.ratio[static_cast<std::size_t>(i)]);
@@ -115,14 +122,21 @@ void check_parses(ImageBuffer& image, std::uint32_t size) {
   }
 }
 
-}  // namespace
+// The counts the image is laid out for, once the model has them consistently.
+struct ModelDims {
+  int points;
+  int input_dims;
+  int segments;
+  int extra_inputs;  // 1: the payload input
+  int variance_rank;
+  std::uint32_t rows_fitted;
+};
 
-std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
-  using namespace model::image_field;
+ModelDims checked_dims(const training::TrainedModel& model) {
   const int n = model.training_points();
   const int d = model.input_dims();
   const int segments = model.geometry.segment_count;
-  const int extra = d - 2 * segments;  // 1: the payload input
+  const int extra = d - 2 * segments;
   if (n < 1 || extra < 0 || extra > model::kMaxExtraInputs || model.alpha.rows() != n || model.alpha.cols() != model::kImageOutputs ||
       model.input_mean.size() != d || model.input_scale.size() != d || model.length_scales.size() != d) {
     throw std::invalid_argument("trained model has inconsistent dimensions");
@@ -152,46 +166,48 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   if (rank > 0xFFFF) throw std::invalid_argument("trained model's variance factor is too large for a flash image");
   check_hysteresis_counts(model.hysteresis, segments);
   check_compliance_counts(model.compliance, segments, extra);
-  const model::ImageLayout layout =
-      model::image_layout(static_cast<std::uint32_t>(n), static_cast<std::uint32_t>(d),
-                          static_cast<std::uint32_t>(segments), model::kImageVersionMajor,
-                          static_cast<std::uint32_t>(rank), static_cast<std::uint32_t>(extra),
-                          hysteresis_floats(model.hysteresis), compliance_floats(model.compliance));
-  ImageBuffer image(layout.total_size);
+  return ModelDims{n, d, segments, extra, rank, rows_fitted};
+}
 
-  image.put<std::uint32_t>(magic, model::kImageMagic);
-  image.put<std::uint16_t>(version_major, model::kImageVersionMajor);
-  image.put<std::uint16_t>(version_minor, model::kImageVersionMinor);
-  image.put<std::uint32_t>(header_size, model::kImageHeaderSize);
-  image.put<std::uint32_t>(total_size, layout.total_size);
-  image.put<std::uint32_t>(training_points, static_cast<std::uint32_t>(n));
-  image.put<std::uint16_t>(input_dims, static_cast<std::uint16_t>(d));
-  image.put<std::uint16_t>(output_dims, static_cast<std::uint16_t>(model::kImageOutputs));
-  image.put<std::uint16_t>(segment_count, static_cast<std::uint16_t>(segments));
-  image.put<std::uint8_t>(scalar_type, static_cast<std::uint8_t>(model::ImageScalar::float32));
-  image.put<std::uint8_t>(kernel_kind, static_cast<std::uint8_t>(model::ImageKernel::squared_exponential_ard));
-  image.put<std::uint8_t>(input_encoding, static_cast<std::uint8_t>(model.encoding));
-  image.put<std::uint8_t>(model_kind, static_cast<std::uint8_t>(model.kind));
-  image.put<std::uint8_t>(extra_inputs, static_cast<std::uint8_t>(extra));
-  image.put<std::uint32_t>(geometry_offset, layout.geometry_offset);
-  image.put<std::uint32_t>(parameters_offset, layout.parameters_offset);
-  image.put<std::uint32_t>(inputs_offset, layout.inputs_offset);
-  image.put<std::uint32_t>(alpha_offset, layout.alpha_offset);
-  image.put<std::uint32_t>(metadata_offset, layout.metadata_offset);
-  image.put<std::uint32_t>(metadata_size, model::kImageMetadataSize);
-  image.put<std::uint32_t>(variance_offset, layout.variance_offset);
-  image.put<std::uint16_t>(variance_rank, static_cast<std::uint16_t>(rank));
+// The header of a 2.1 image; put_hysteresis() and put_compliance() raise
+// the minor version for their blocks.
+void put_header(ImageBuffer& image, const training::TrainedModel& model, const ModelDims& dims,
+                const model::ImageLayout& layout) {
+  namespace field = model::image_field;
+  const auto count = [](int value) { return static_cast<std::uint32_t>(value); };
+  image.put_field(field::magic, model::kImageMagic);
+  image.put_field(field::version_major, model::kImageVersionMajor);
+  image.put_field(field::version_minor, model::kImageVersionMinor);
+  image.put_field(field::header_size, model::kImageHeaderSize);
+  image.put_field(field::total_size, layout.total_size);
+  image.put_field(field::training_points, count(dims.points));
+  image.put_field(field::input_dims, count(dims.input_dims));
+  image.put_field(field::output_dims, count(model::kImageOutputs));
+  image.put_field(field::segment_count, count(dims.segments));
+  image.put_field(field::scalar_type, static_cast<std::uint32_t>(model::ImageScalar::float32));
+  image.put_field(field::kernel_kind, static_cast<std::uint32_t>(model::ImageKernel::squared_exponential_ard));
+  image.put_field(field::input_encoding, static_cast<std::uint32_t>(model.encoding));
+  image.put_field(field::model_kind, static_cast<std::uint32_t>(model.kind));
+  image.put_field(field::extra_inputs, count(dims.extra_inputs));
+  // Every block offset the header holds, where the layout puts the block.
+  for (const model::ImageHeaderField& f : model::kImageHeaderFields) {
+    if (f.locates != model::ImageBlockId::none) image.put_field(f, layout.*model::image_block(f.locates).offset);
+  }
+  image.put_field(field::metadata_size, model::kImageMetadataSize);
+  image.put_field(field::variance_rank, count(dims.variance_rank));
+}
 
-  std::size_t at = layout.geometry_offset;
-  for (int i = 0; i < segments; ++i) {
-    const auto& s = model.geometry.segments[i];
+void put_geometry(ImageBuffer& image, std::size_t at, const model::RobotGeometry<double>& geometry) {
+  for (int i = 0; i < geometry.segment_count; ++i) {
+    const auto& s = geometry.segments[i];
     for (double v : {s.backbone_length_mm, s.anchor_radius_mm, s.theta_max_rad}) {
       image.put_float(at, v);
       at += 4;
     }
   }
+}
 
-  at = layout.parameters_offset;
+void put_parameters(ImageBuffer& image, std::size_t at, const training::TrainedModel& model, const ModelDims& dims) {
   const auto put_all = [&](const auto& values) {
     for (Eigen::Index i = 0; i < values.size(); ++i) {
       image.put_float(at, values[i]);
@@ -205,72 +221,98 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   put_all(model.output_scale);
   put_all(model.signal_variance);
   put_all(model.noise_variance);
-  if (range_given) {
+  if (model.input_min.size() > 0 || model.input_max.size() > 0) {
     put_all(model.input_min);
     put_all(model.input_max);
   } else {
     put_all(Eigen::VectorXd(model.inputs.colwise().minCoeff().transpose()));
     put_all(Eigen::VectorXd(model.inputs.colwise().maxCoeff().transpose()));
   }
-  if (extra > 0) put_all(Eigen::VectorXd::Constant(1, model.default_payload_kg));
+  if (dims.extra_inputs > 0) put_all(Eigen::VectorXd::Constant(1, model.default_payload_kg));
+}
 
-  // Training inputs go in as kernel coordinates, computed in double and
-  // rounded once.
-  at = layout.inputs_offset;
-  for (int i = 0; i < n; ++i) {
-    for (int k = 0; k < d; ++k) {
+// Training inputs go in as kernel coordinates, computed in double and
+// rounded once; then the weights.
+void put_points(ImageBuffer& image, const model::ImageLayout& layout, const training::TrainedModel& model,
+                const ModelDims& dims) {
+  std::size_t at = layout.inputs_offset;
+  for (int i = 0; i < dims.points; ++i) {
+    for (int k = 0; k < dims.input_dims; ++k) {
       image.put_float(at, (model.inputs(i, k) - model.input_mean[k]) / (model.input_scale[k] * model.length_scales[k]));
       at += 4;
     }
   }
   at = layout.alpha_offset;
-  for (int i = 0; i < n; ++i) {
+  for (int i = 0; i < dims.points; ++i) {
     for (int k = 0; k < model::kImageOutputs; ++k) {
       image.put_float(at, model.alpha(i, k));
       at += 4;
     }
   }
+}
 
-  if (rank > 0) {
-    using namespace model::image_variance_field;
-    const std::size_t block = layout.variance_offset;
-    image.put_float(block + 4 * position_scale, variance.position_scale);
-    image.put_float(block + 4 * orientation_scale, variance.orientation_scale);
-    image.put_float(block + 4 * extrapolation_variance, variance.extrapolation_variance);
-    at = block + 4 * points;
+void put_variance(ImageBuffer& image, std::size_t block, const training::VarianceFactor& variance, int input_dims) {
+  const int rank = variance.rank();
+  if (rank == 0) return;
+  using namespace model::image_variance_field;
+  image.put_float(block + 4 * position_scale, variance.position_scale);
+  image.put_float(block + 4 * orientation_scale, variance.orientation_scale);
+  image.put_float(block + 4 * extrapolation_variance, variance.extrapolation_variance);
+  std::size_t at = block + 4 * points;
+  for (int i = 0; i < rank; ++i) {
+    for (int k = 0; k < input_dims; ++k) {
+      image.put_float(at, variance.points(i, k));
+      at += 4;
+    }
+  }
+  for (const Eigen::MatrixXd* factor : {&variance.inducing_factor, &variance.posterior_factor}) {
     for (int i = 0; i < rank; ++i) {
-      for (int k = 0; k < d; ++k) {
-        image.put_float(at, variance.points(i, k));
+      for (int j = 0; j <= i; ++j) {
+        image.put_float(at, (*factor)(i, j));
         at += 4;
       }
     }
-    for (const Eigen::MatrixXd* factor : {&variance.inducing_factor, &variance.posterior_factor}) {
-      for (int i = 0; i < rank; ++i) {
-        for (int j = 0; j <= i; ++j) {
-          image.put_float(at, (*factor)(i, j));
-          at += 4;
-        }
-      }
-    }
   }
+}
 
-  // Without a hysteresis or compliance model the image is a 2.1 image,
-  // byte for byte.
-  put_hysteresis(image, layout.hysteresis_offset, model.hysteresis);
-  put_compliance(image, layout.compliance_offset, model.compliance);
-
+void put_metadata(ImageBuffer& image, std::size_t meta, const training::TrainedModel& model,
+                  std::uint32_t rows_fitted) {
   using namespace model::image_metadata_field;
-  const std::size_t meta = layout.metadata_offset;
   image.put<std::uint64_t>(meta + dataset_hash, model.dataset_hash);
   image.put<std::int64_t>(meta + created_unix_s, model.created_unix_s);
   image.put<std::uint32_t>(meta + validation_samples, model.validation_samples);
   image.put<std::uint32_t>(meta + fitted_rows, rows_fitted);
   image.put<model::ImageMetrics>(meta + metrics, model.metrics);
   std::memcpy(image.data() + meta + trainer, model.trainer.data(), std::min<std::size_t>(model.trainer.size(), 32));
+}
 
-  const std::uint32_t checksum = model::crc32(image.data(), layout.total_size - model::kImageTrailerSize);
-  image.put<std::uint32_t>(layout.total_size - model::kImageTrailerSize, checksum);
+// The CRC-32 trailer over everything before it.
+void put_checksum(ImageBuffer& image, std::uint32_t total_size) {
+  const std::uint32_t checksum = model::crc32(image.data(), total_size - model::kImageTrailerSize);
+  image.put<std::uint32_t>(total_size - model::kImageTrailerSize, checksum);
+}
 
+}  // namespace
+
+std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
+  const ModelDims dims = checked_dims(model);
+  const model::ImageLayout layout =
+      model::image_layout(static_cast<std::uint32_t>(dims.points), static_cast<std::uint32_t>(dims.input_dims),
+                          static_cast<std::uint32_t>(dims.segments), model::kImageVersionMajor,
+                          static_cast<std::uint32_t>(dims.variance_rank), static_cast<std::uint32_t>(dims.extra_inputs),
+                          hysteresis_floats(model.hysteresis), compliance_floats(model.compliance));
+  ImageBuffer image(layout.total_size);
+  put_header(image, model, dims, layout);
+  put_geometry(image, layout.geometry_offset, model.geometry);
+  put_parameters(image, layout.parameters_offset, model, dims);
+  put_points(image, layout, model, dims);
+  put_variance(image, layout.variance_offset, model.variance, dims.input_dims);
+  // Without a hysteresis or compliance model the image is a 2.1 image,
+  // byte for byte.
+  put_hysteresis(image, layout.hysteresis_offset, model.hysteresis);
+  put_compliance(image, layout.compliance_offset, model.compliance);
+  put_metadata(image, layout.metadata_offset, model, dims.rows_fitted);
+  put_checksum(image, layout.total_size);
   check_parses(image, layout.total_size);
   return image.take();
 }
@@ -306,12 +348,11 @@ std::vector<std::uint8_t> with_blocks(const std::vector<std::uint8_t>& image,
   std::memcpy(out.data(), image.data(), old_layout.metadata_offset);
   std::memcpy(out.data() + layout.metadata_offset, image.data() + old_layout.metadata_offset,
               model::kImageMetadataSize);
-  out.put<std::uint32_t>(model::image_field::total_size, layout.total_size);
-  out.put<std::uint32_t>(model::image_field::metadata_offset, layout.metadata_offset);
+  out.put_field(model::image_field::total_size, layout.total_size);
+  out.put_field(model::image_field::metadata_offset, layout.metadata_offset);
   put_hysteresis(out, layout.hysteresis_offset, hysteresis);
   put_compliance(out, layout.compliance_offset, compliance);
-  const std::uint32_t checksum = model::crc32(out.data(), layout.total_size - model::kImageTrailerSize);
-  out.put<std::uint32_t>(layout.total_size - model::kImageTrailerSize, checksum);
+  put_checksum(out, layout.total_size);
   check_parses(out, layout.total_size);
   return out.take();
 }

@@ -140,7 +140,7 @@ hal::Hal hal_with_flash(Board& board, hal::Flash& flash) {
 inline void copy_with_other_creation_time(const std::uint8_t* image, std::uint32_t size, std::uint8_t* other) {
   std::memcpy(other, image, size);
   std::uint32_t metadata = 0;
-  std::memcpy(&metadata, other + model::image_field::metadata_offset, 4);
+  std::memcpy(&metadata, other + model::image_field::metadata_offset.offset, 4);
   other[metadata + model::image_metadata_field::created_unix_s] ^= 0x01;
   const std::uint32_t crc = model::crc32(other, size - model::kImageTrailerSize);
   std::memcpy(other + size - model::kImageTrailerSize, &crc, 4);

@@ -238,7 +238,7 @@ TEST(PredictiveVariance, TheParserRefusesABlockItCannotTrust) {
 
   // A v2.0 image has no variance block.
   const std::uint16_t minor_zero = 0;
-  EXPECT_EQ(parse(resealed(image, model::image_field::version_minor, &minor_zero, 2)),
+  EXPECT_EQ(parse(resealed(image, model::image_field::version_minor.offset, &minor_zero, 2)),
             model::ImageStatus::bad_header);
   // More points than the build holds.
   EXPECT_EQ(parse(image, model::ImageCapacity{1024, 8, 4}), model::ImageStatus::over_capacity);
@@ -260,7 +260,7 @@ TEST(PredictiveVariance, TheParserRefusesABlockItCannotTrust) {
   EXPECT_EQ(parse(resealed(image, signal, &two, 4)), model::ImageStatus::invalid_parameters);
   // The offset must be where the layout puts the block.
   const std::uint32_t moved = static_cast<std::uint32_t>(block_bytes + 8);
-  EXPECT_EQ(parse(resealed(image, model::image_field::variance_offset, &moved, 4)),
+  EXPECT_EQ(parse(resealed(image, model::image_field::variance_offset.offset, &moved, 4)),
             model::ImageStatus::size_mismatch);
 }
 

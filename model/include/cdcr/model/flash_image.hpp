@@ -14,6 +14,8 @@
 #include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <iterator>
+#include <utility>
 
 #include "cdcr/model/crc32.hpp"
 #include "cdcr/model/input_encoding.hpp"
@@ -151,37 +153,6 @@ constexpr std::uint64_t image_variance_floats(std::uint32_t rank, std::uint32_t 
   return r == 0 ? 0 : image_variance_field::points + r * input_dims + r * (r + 1);
 }
 
-// Byte offsets of the header fields (all little-endian).
-namespace image_field {
-inline constexpr std::size_t magic = 0;             // u32
-inline constexpr std::size_t version_major = 4;     // u16
-inline constexpr std::size_t version_minor = 6;     // u16
-inline constexpr std::size_t header_size = 8;       // u32
-inline constexpr std::size_t total_size = 12;       // u32, including the CRC trailer
-inline constexpr std::size_t training_points = 16;  // u32, the points: N training inputs or M inducing inputs
-inline constexpr std::size_t input_dims = 20;       // u16, D = 2 * segments + extra_inputs
-inline constexpr std::size_t output_dims = 22;      // u16, always 6
-inline constexpr std::size_t segment_count = 24;    // u16
-inline constexpr std::size_t scalar_type = 26;      // u8, ImageScalar
-inline constexpr std::size_t kernel_kind = 27;      // u8, ImageKernel
-inline constexpr std::size_t input_encoding = 28;   // u8, InputEncoding
-inline constexpr std::size_t model_kind = 29;       // u8, ImageModelKind (v1: reserved, zero)
-inline constexpr std::size_t extra_inputs = 30;     // u8, inputs after the joint encoding: 0, or 1 the payload (v1: reserved)
-inline constexpr std::size_t reserved_a = 31;       // 1 byte, zero before v2.3 (v1: bytes 29..31)
-inline constexpr std::size_t compliance_segments = 31;  // u8, v2.3: segments of the compliance block; zero without
-inline constexpr std::size_t geometry_offset = 32;  // u32
-inline constexpr std::size_t parameters_offset = 36;
-inline constexpr std::size_t inputs_offset = 40;
-inline constexpr std::size_t alpha_offset = 44;
-inline constexpr std::size_t metadata_offset = 48;
-inline constexpr std::size_t metadata_size = 52;    // u32, kImageMetadataSize
-inline constexpr std::size_t variance_offset = 56;  // u32, the variance block; zero without one (v1: reserved)
-inline constexpr std::size_t variance_rank = 60;    // u16, R, the variance points; zero without (v1: reserved)
-inline constexpr std::size_t reserved_b = 62;       // 2 bytes, zero before v2.2 (v1: bytes 56..63)
-inline constexpr std::size_t hysteresis_cables = 62;     // u8, v2.2: cables of the hysteresis block; zero without
-inline constexpr std::size_t hysteresis_operators = 63;  // u8, v2.2: play operators per cable; zero without
-}  // namespace image_field
-
 // Byte offsets inside the metadata block.
 namespace image_metadata_field {
 inline constexpr std::size_t dataset_hash = 0;        // u64, FNV-1a of the training data file
@@ -257,6 +228,12 @@ struct ImageView {
   const char* trainer;  // up to 32 bytes, not necessarily NUL-terminated
 };
 
+// --- the format, described once -----------------------------------------------
+//
+// Two tables: the blocks after the header in the order they follow it, and
+// the header's fields. The parser, the exporter (tools/export) and
+// `cdcr inspect` take offsets, sizes, names and versions from them.
+
 // Layout that the dims imply: where each block starts and the total size.
 struct ImageLayout {
   std::uint32_t geometry_offset;
@@ -284,38 +261,252 @@ constexpr std::uint32_t image_parameter_floats(std::uint32_t input_dims,
                             : 5 * input_dims + 4 * kImageOutputs + extra_inputs;
 }
 
-// Blocks follow the header in this order, each 8-byte aligned, then the CRC.
+// The blocks, in the order they follow the header.
+enum class ImageBlockId : std::uint8_t {
+  geometry,
+  parameters,
+  inputs,
+  alpha,
+  variance,
+  hysteresis,
+  compliance,
+  metadata,
+  none,  // a header field that locates no block
+};
+
+// The counts a block's size follows from.
+struct ImageDims {
+  std::uint32_t training_points;
+  std::uint32_t input_dims;
+  std::uint32_t segment_count;
+  std::uint16_t version_major = kImageVersionMajor;
+  std::uint32_t variance_rank = 0;
+  std::uint32_t extra_inputs = 0;
+  std::uint32_t hysteresis_floats = 0;
+  std::uint32_t compliance_floats = 0;
+};
+
+// A block's bytes, in 64 bits: the dims of a damaged header can be anything.
+constexpr std::uint64_t image_block_bytes(ImageBlockId block, const ImageDims& dims) {
+  switch (block) {
+    case ImageBlockId::geometry: return 4 * 3 * std::uint64_t{dims.segment_count};
+    case ImageBlockId::parameters:
+      return 4 * std::uint64_t{image_parameter_floats(dims.input_dims, dims.version_major, dims.extra_inputs)};
+    case ImageBlockId::inputs: return 4 * std::uint64_t{dims.training_points} * dims.input_dims;
+    case ImageBlockId::alpha: return 4 * std::uint64_t{dims.training_points} * kImageOutputs;
+    case ImageBlockId::variance: return 4 * image_variance_floats(dims.variance_rank, dims.input_dims);
+    case ImageBlockId::hysteresis: return 4 * std::uint64_t{dims.hysteresis_floats};
+    case ImageBlockId::compliance: return 4 * std::uint64_t{dims.compliance_floats};
+    case ImageBlockId::metadata: return kImageMetadataSize;
+    case ImageBlockId::none: break;
+  }
+  return 0;
+}
+
+struct ImageBlockFormat {
+  ImageBlockId id;
+  const char* name;
+  std::uint16_t version_major;  // the version that introduced the block
+  std::uint16_t version_minor;
+  bool only_when_counted;       // present only when its count (the dims) is non-zero
+  std::uint32_t ImageLayout::*offset;
+};
+
+// Each block starts at the next multiple of kImageBlockAlignment after the
+// one before it; the CRC-32 trailer follows the last.
+inline constexpr ImageBlockFormat kImageBlocks[] = {
+    {ImageBlockId::geometry, "geometry", 1, 0, false, &ImageLayout::geometry_offset},
+    {ImageBlockId::parameters, "parameters", 1, 0, false, &ImageLayout::parameters_offset},
+    {ImageBlockId::inputs, "inputs", 1, 0, false, &ImageLayout::inputs_offset},
+    {ImageBlockId::alpha, "alpha", 1, 0, false, &ImageLayout::alpha_offset},
+    {ImageBlockId::variance, "variance", 2, kImageVersionMinor, true, &ImageLayout::variance_offset},
+    {ImageBlockId::hysteresis, "hysteresis", 2, kImageVersionMinorHysteresis, true, &ImageLayout::hysteresis_offset},
+    {ImageBlockId::compliance, "compliance", 2, kImageVersionMinorCompliance, true, &ImageLayout::compliance_offset},
+    {ImageBlockId::metadata, "metadata", 1, 0, false, &ImageLayout::metadata_offset},
+};
+
+constexpr const ImageBlockFormat& image_block(ImageBlockId block) {
+  return kImageBlocks[static_cast<std::size_t>(block)];
+}
+
+// Calls visit(index) for each block, index a std::integral_constant, in
+// the order the blocks follow the header. Unrolled at compile time, each
+// block a constant: a firmware build keeps neither the table nor its names.
+template <typename Visit, std::size_t... I>
+constexpr void for_each_image_block(Visit&& visit, std::index_sequence<I...>) {
+  (visit(std::integral_constant<std::size_t, I>{}), ...);
+}
+
+// Where the dims put every block. 32-bit offsets, as in the header.
+constexpr ImageLayout image_layout(const ImageDims& dims) {
+  ImageLayout layout{};
+  std::uint32_t at = kImageHeaderSize;
+  const auto place = [&](auto index) {
+    constexpr ImageBlockFormat block = kImageBlocks[decltype(index)::value];
+    const std::uint64_t bytes = image_block_bytes(block.id, dims);
+    if (block.only_when_counted && bytes == 0) return;
+    layout.*block.offset = at;
+    at = align_up(at + static_cast<std::uint32_t>(bytes), kImageBlockAlignment);
+  };
+  for_each_image_block(place, std::make_index_sequence<std::size(kImageBlocks)>{});
+  layout.total_size = at + kImageTrailerSize;
+  return layout;
+}
+
 constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t input_dims,
                                    std::uint32_t segment_count, std::uint16_t version_major = kImageVersionMajor,
                                    std::uint32_t variance_rank = 0, std::uint32_t extra_inputs = 0,
                                    std::uint32_t hysteresis_floats = 0, std::uint32_t compliance_floats = 0) {
-  ImageLayout layout{};
-  std::uint32_t at = kImageHeaderSize;
-  layout.geometry_offset = at;
-  at = align_up(at + 4 * 3 * segment_count, kImageBlockAlignment);
-  layout.parameters_offset = at;
-  at = align_up(at + 4 * image_parameter_floats(input_dims, version_major, extra_inputs), kImageBlockAlignment);
-  layout.inputs_offset = at;
-  at = align_up(at + 4 * training_points * input_dims, kImageBlockAlignment);
-  layout.alpha_offset = at;
-  at = align_up(at + 4 * training_points * kImageOutputs, kImageBlockAlignment);
-  if (variance_rank > 0) {
-    layout.variance_offset = at;
-    at = align_up(at + 4 * static_cast<std::uint32_t>(image_variance_floats(variance_rank, input_dims)),
-                  kImageBlockAlignment);
+  return image_layout(ImageDims{training_points, input_dims, segment_count, version_major, variance_rank,
+                                extra_inputs, hysteresis_floats, compliance_floats});
+}
+
+// A header field's type; the value is its size in bytes.
+enum class ImageFieldType : std::uint8_t { u8 = 1, u16 = 2, u32 = 4 };
+
+// What an image older than a field holds in the field's bytes.
+enum class ImageFieldRule : std::uint8_t {
+  none,             // every version this parser reads has the field
+  reserved_before,  // older versions reserve the bytes: each must be zero
+  zero_before,      // older minor versions of its major version name the field and require it to be zero;
+                    // older major versions reserve its bytes
+};
+
+struct ImageHeaderField {
+  const char* name;
+  std::uint8_t offset;
+  ImageFieldType type;
+  std::uint16_t version_major;  // the version that gave the field its meaning
+  std::uint16_t version_minor;
+  ImageFieldRule before = ImageFieldRule::none;  // what an older image holds there
+  ImageBlockId locates = ImageBlockId::none;     // the block whose offset the field holds
+
+  constexpr std::uint32_t size() const { return static_cast<std::uint32_t>(type); }
+};
+
+// The header's fields (all little-endian). A field is used from its version
+// on; before it, its rule says what the bytes hold.
+namespace image_field {
+inline constexpr ImageHeaderField magic{"magic", 0, ImageFieldType::u32, 1, 0};
+inline constexpr ImageHeaderField version_major{"version_major", 4, ImageFieldType::u16, 1, 0};
+inline constexpr ImageHeaderField version_minor{"version_minor", 6, ImageFieldType::u16, 1, 0};
+inline constexpr ImageHeaderField header_size{"header_size", 8, ImageFieldType::u32, 1, 0};
+// Including the CRC trailer.
+inline constexpr ImageHeaderField total_size{"total_size", 12, ImageFieldType::u32, 1, 0};
+// The points: N training inputs or M inducing inputs.
+inline constexpr ImageHeaderField training_points{"training_points", 16, ImageFieldType::u32, 1, 0};
+// D = 2 * segment_count + extra_inputs.
+inline constexpr ImageHeaderField input_dims{"input_dims", 20, ImageFieldType::u16, 1, 0};
+// Always kImageOutputs.
+inline constexpr ImageHeaderField output_dims{"output_dims", 22, ImageFieldType::u16, 1, 0};
+inline constexpr ImageHeaderField segment_count{"segment_count", 24, ImageFieldType::u16, 1, 0};
+// ImageScalar, ImageKernel and InputEncoding.
+inline constexpr ImageHeaderField scalar_type{"scalar_type", 26, ImageFieldType::u8, 1, 0};
+inline constexpr ImageHeaderField kernel_kind{"kernel_kind", 27, ImageFieldType::u8, 1, 0};
+inline constexpr ImageHeaderField input_encoding{"input_encoding", 28, ImageFieldType::u8, 1, 0};
+// ImageModelKind.
+inline constexpr ImageHeaderField model_kind{"model_kind", 29, ImageFieldType::u8, 2, 0,
+                                             ImageFieldRule::reserved_before};
+// Inputs after the joint encoding: 0, or 1 the payload.
+inline constexpr ImageHeaderField extra_inputs{"extra_inputs", 30, ImageFieldType::u8, 2, 0,
+                                               ImageFieldRule::reserved_before};
+// The compliance block's segments; zero without one.
+inline constexpr ImageHeaderField compliance_segments{"compliance_segments", 31, ImageFieldType::u8, 2,
+                                                      kImageVersionMinorCompliance,
+                                                      ImageFieldRule::reserved_before};
+inline constexpr ImageHeaderField geometry_offset{"geometry_offset", 32, ImageFieldType::u32, 1, 0,
+                                                  ImageFieldRule::none, ImageBlockId::geometry};
+inline constexpr ImageHeaderField parameters_offset{"parameters_offset", 36, ImageFieldType::u32, 1, 0,
+                                                    ImageFieldRule::none, ImageBlockId::parameters};
+inline constexpr ImageHeaderField inputs_offset{"inputs_offset", 40, ImageFieldType::u32, 1, 0,
+                                                ImageFieldRule::none, ImageBlockId::inputs};
+inline constexpr ImageHeaderField alpha_offset{"alpha_offset", 44, ImageFieldType::u32, 1, 0, ImageFieldRule::none,
+                                               ImageBlockId::alpha};
+inline constexpr ImageHeaderField metadata_offset{"metadata_offset", 48, ImageFieldType::u32, 1, 0,
+                                                  ImageFieldRule::none, ImageBlockId::metadata};
+// Always kImageMetadataSize.
+inline constexpr ImageHeaderField metadata_size{"metadata_size", 52, ImageFieldType::u32, 1, 0};
+// The variance block and R, its points; zero without one. v2.0 defines no
+// block: both zero.
+inline constexpr ImageHeaderField variance_offset{"variance_offset", 56, ImageFieldType::u32, 2, kImageVersionMinor,
+                                                  ImageFieldRule::zero_before, ImageBlockId::variance};
+inline constexpr ImageHeaderField variance_rank{"variance_rank", 60, ImageFieldType::u16, 2, kImageVersionMinor,
+                                                ImageFieldRule::zero_before};
+// The hysteresis block's cables and play operators per cable; zero without one.
+inline constexpr ImageHeaderField hysteresis_cables{"hysteresis_cables", 62, ImageFieldType::u8, 2,
+                                                    kImageVersionMinorHysteresis,
+                                                    ImageFieldRule::reserved_before};
+inline constexpr ImageHeaderField hysteresis_operators{"hysteresis_operators", 63, ImageFieldType::u8, 2,
+                                                       kImageVersionMinorHysteresis,
+                                                       ImageFieldRule::reserved_before};
+}  // namespace image_field
+
+// Every field in the order of its bytes.
+inline constexpr ImageHeaderField kImageHeaderFields[] = {
+    image_field::magic,           image_field::version_major,       image_field::version_minor,
+    image_field::header_size,     image_field::total_size,          image_field::training_points,
+    image_field::input_dims,      image_field::output_dims,         image_field::segment_count,
+    image_field::scalar_type,     image_field::kernel_kind,         image_field::input_encoding,
+    image_field::model_kind,      image_field::extra_inputs,        image_field::compliance_segments,
+    image_field::geometry_offset, image_field::parameters_offset,   image_field::inputs_offset,
+    image_field::alpha_offset,    image_field::metadata_offset,     image_field::metadata_size,
+    image_field::variance_offset, image_field::variance_rank,       image_field::hysteresis_cables,
+    image_field::hysteresis_operators,
+};
+
+// The header field that holds a block's offset; null for a block that lies
+// where the layout puts it (hysteresis, compliance).
+constexpr const ImageHeaderField* image_block_offset_field(ImageBlockId block) {
+  for (const ImageHeaderField& field : kImageHeaderFields) {
+    if (field.locates == block) return &field;
   }
-  if (hysteresis_floats > 0) {
-    layout.hysteresis_offset = at;
-    at = align_up(at + 4 * hysteresis_floats, kImageBlockAlignment);
+  return nullptr;
+}
+
+// The fields cover the header, each byte once, in order; each field is
+// aligned to its size.
+constexpr bool image_header_fields_tile() {
+  std::uint32_t at = 0;
+  for (const ImageHeaderField& field : kImageHeaderFields) {
+    if (field.offset != at || field.offset % field.size() != 0) return false;
+    at += field.size();
   }
-  if (compliance_floats > 0) {
-    layout.compliance_offset = at;
-    at = align_up(at + 4 * compliance_floats, kImageBlockAlignment);
-  }
-  layout.metadata_offset = at;
-  at = align_up(at + kImageMetadataSize, kImageBlockAlignment);
-  layout.total_size = at + kImageTrailerSize;
-  return layout;
+  return at == kImageHeaderSize;
+}
+static_assert(image_header_fields_tile(), "the header fields must cover the header byte for byte");
+
+// Calls visit(index) for each header field, index a std::integral_constant,
+// in the order of the header's bytes, until visit returns false. Unrolled at
+// compile time, each field a constant: a firmware build keeps neither the
+// table nor its names.
+template <typename Visit, std::size_t... I>
+constexpr bool for_each_image_header_field(Visit&& visit, std::index_sequence<I...>) {
+  return (visit(std::integral_constant<std::size_t, I>{}) && ...);
+}
+
+template <typename Visit>
+constexpr bool for_each_image_header_field(Visit&& visit) {
+  return for_each_image_header_field(visit, std::make_index_sequence<std::size(kImageHeaderFields)>{});
+}
+
+// Whether an image of this version uses the field (gives it its meaning).
+// Minor versions count within any major version from the field's on.
+constexpr bool image_field_in_use(const ImageHeaderField& field, std::uint16_t major, std::uint16_t minor) {
+  return major >= field.version_major && minor >= field.version_minor;
+}
+
+// Whether an image of this version names the field, used or not: a
+// zero_before field is named from the first minor version of its major.
+constexpr bool image_field_named(const ImageHeaderField& field, std::uint16_t major, std::uint16_t minor) {
+  return field.before == ImageFieldRule::zero_before ? major >= field.version_major
+                                                     : image_field_in_use(field, major, minor);
+}
+
+// The field's value, from a header of at least field.offset + field.size() bytes.
+inline std::uint32_t image_field_value(const std::uint8_t* header, const ImageHeaderField& field) {
+  std::uint32_t value = 0;  // little-endian: the low bytes come first
+  std::memcpy(&value, header + field.offset, field.size());
+  return value;
 }
 
 // --- reporting every check -----------------------------------------------------
@@ -576,28 +767,31 @@ class ImageScan {
     *this = ImageScan{};
     bytes_ = bytes;
     if (bytes == nullptr || size < kImageHeaderSize) return;
-    using namespace image_field;
-    const std::uint32_t total = detail::read_u32(bytes + total_size);
+    const std::uint32_t total = image_field_value(bytes, image_field::total_size);
     end_ = total >= kImageHeaderSize + kImageTrailerSize && total <= size ? total - kImageTrailerSize
                                                                           : static_cast<std::uint32_t>(size);
-    const std::uint16_t major = detail::read_u16(bytes + version_major);
-    const std::uint32_t n = detail::read_u32(bytes + training_points);
-    const std::uint32_t d = detail::read_u16(bytes + input_dims);
-    const std::uint32_t rank = major == 1 ? 0 : detail::read_u16(bytes + variance_rank);
-    const std::uint64_t floats[kBlocks] = {3u * std::uint64_t{detail::read_u16(bytes + segment_count)},
-                                           image_parameter_floats(d, major), std::uint64_t{n} * d,
-                                           std::uint64_t{n} * kImageOutputs,
-                                           rank > 0 ? image_variance_floats(rank, d) : 0};
-    const std::size_t offsets[kBlocks] = {geometry_offset, parameters_offset, inputs_offset, alpha_offset,
-                                          variance_offset};
-    for (int i = 0; i < kBlocks; ++i) {
-      const std::uint32_t at = detail::read_u32(bytes + offsets[i]);
-      // Blocks the scan cannot check (outside the bytes, misaligned) stay
-      // empty: parse_image() then checks them itself, or refuses the image.
-      if (floats[i] == 0 || at % alignof(float) != 0 || at > end_ || 4 * floats[i] > end_ - at) continue;
-      first_[i] = at;
-      floats_[i] = static_cast<std::uint32_t>(floats[i]);
-    }
+    const auto major = static_cast<std::uint16_t>(image_field_value(bytes, image_field::version_major));
+    const ImageDims dims{image_field_value(bytes, image_field::training_points),
+                         image_field_value(bytes, image_field::input_dims),
+                         image_field_value(bytes, image_field::segment_count), major,
+                         major == 1 ? 0 : image_field_value(bytes, image_field::variance_rank)};
+    // The float blocks the header locates: all but the metadata.
+    int i = 0;
+    for_each_image_header_field([&](auto index) {
+      constexpr ImageHeaderField field = kImageHeaderFields[decltype(index)::value];
+      if constexpr (field.locates != ImageBlockId::none && field.locates != ImageBlockId::metadata) {
+        const std::uint64_t floats = image_block_bytes(field.locates, dims) / 4;
+        const std::uint32_t at = image_field_value(bytes, field);
+        // Blocks the scan cannot check (outside the bytes, misaligned) stay
+        // empty: parse_image() then checks them itself, or refuses the image.
+        if (floats != 0 && at % alignof(float) == 0 && at <= end_ && 4 * floats <= end_ - at) {
+          first_[i] = at;
+          floats_[i] = static_cast<std::uint32_t>(floats);
+        }
+        ++i;
+      }
+      return true;
+    });
   }
 
   // Up to max_bytes more; true once every byte is scanned. A slice ends on a
@@ -647,6 +841,602 @@ class ImageScan {
 
 namespace detail {
 
+// What the header declares, as the checks have read it so far.
+struct DeclaredImage {
+  std::uint16_t major = kImageVersionMajor;
+  std::uint16_t layout_major = kImageVersionMajor;  // an unknown major version is laid out as the newest
+  std::uint16_t minor = 0;
+  bool v1 = false;
+  std::uint32_t total = 0;  // total_size
+  bool total_holds_trailer = false;
+  bool aligned = false;  // the buffer
+  ImageModelKind kind = ImageModelKind::exact_gp;
+  std::uint32_t points = 0;
+  std::uint32_t input_dims = 0;
+  std::uint32_t segments = 0;
+  std::uint32_t extra = 0;
+  std::uint32_t rank = 0;
+  std::uint32_t hysteresis_cables = 0;
+  std::uint32_t hysteresis_operators = 0;
+  std::uint32_t compliance_segments = 0;
+
+  ImageDims dims() const {
+    return ImageDims{points,
+                     input_dims,
+                     segments,
+                     major,
+                     rank,
+                     extra,
+                     image_hysteresis_floats(hysteresis_cables, hysteresis_operators),
+                     image_compliance_floats(compliance_segments)};
+  }
+  // The field's value, or zero where this version does not name it.
+  std::uint32_t value(const std::uint8_t* bytes, const ImageHeaderField& field) const {
+    return image_field_named(field, layout_major, minor) ? image_field_value(bytes, field) : 0;
+  }
+};
+
+// The blocks where a stopping run has verified them to lie, or where a
+// reporting run found them inside the buffer; null otherwise.
+struct ImageBlocks {
+  const float* geometry = nullptr;
+  const float* parameters = nullptr;
+  const float* inputs = nullptr;
+  const float* alpha = nullptr;
+  const std::uint8_t* metadata = nullptr;
+  const float* variance = nullptr;
+  const float* hysteresis = nullptr;
+  const float* compliance = nullptr;
+};
+
+// The parameter arrays, back to back; null where the block is not readable.
+struct ImageParameterArrays {
+  const float* input_mean = nullptr;
+  const float* input_scale = nullptr;
+  const float* length_scale = nullptr;
+  const float* output_mean = nullptr;
+  const float* output_scale = nullptr;
+  const float* signal_variance = nullptr;
+  const float* noise_variance = nullptr;
+  const float* input_min = nullptr;  // v2
+  const float* input_max = nullptr;
+  const float* extra_default = nullptr;  // with extra inputs
+};
+
+inline ImageParameterArrays parameter_arrays(const float* parameters, const DeclaredImage& h) {
+  ImageParameterArrays p;
+  if (parameters == nullptr) return p;
+  const std::uint32_t d = h.input_dims;
+  p.input_mean = parameters;
+  p.input_scale = parameters + d;
+  p.length_scale = parameters + 2 * d;
+  p.output_mean = parameters + 3 * d;
+  p.output_scale = p.output_mean + kImageOutputs;
+  p.signal_variance = p.output_mean + 2 * kImageOutputs;
+  p.noise_variance = p.output_mean + 3 * kImageOutputs;
+  p.input_min = h.v1 ? nullptr : p.output_mean + 4 * kImageOutputs;
+  p.input_max = h.v1 ? nullptr : p.input_min + d;
+  p.extra_default = h.extra > 0 ? p.output_mean + 4 * kImageOutputs + 2 * d : nullptr;
+  return p;
+}
+
+// size, magic and version: what a file too short for a header may still
+// show. False where the run must stop, and where there is no whole header.
+template <typename Run>
+bool check_identity(Run& run, const std::uint8_t* bytes, std::size_t size, DeclaredImage& h) {
+  using Expect = ImageExpectation;
+  const bool whole_header = bytes != nullptr && size >= kImageHeaderSize;
+  if (!run.expect(whole_header, ImageCheckId::size, ImageStatus::truncated, "file_size", -1,
+                  static_cast<double>(size), kImageHeaderSize, Expect::at_least)) {
+    return false;
+  }
+  const ImageHeaderField& magic = image_field::magic;
+  if (bytes != nullptr && size >= magic.offset + magic.size()) {
+    const std::uint32_t declared_magic = image_field_value(bytes, magic);
+    if (!run.expect(declared_magic == kImageMagic, ImageCheckId::magic, ImageStatus::bad_magic, magic.name, -1,
+                    declared_magic, kImageMagic, Expect::equal)) {
+      return false;
+    }
+  }
+  const ImageHeaderField& major = image_field::version_major;
+  if (bytes != nullptr && size >= major.offset + major.size()) {
+    h.major = static_cast<std::uint16_t>(image_field_value(bytes, major));
+    const bool readable = h.major >= kImageOldestVersionMajor && h.major <= kImageVersionMajor;
+    if (!run.expect(readable, ImageCheckId::version, ImageStatus::unsupported_version, major.name, -1, h.major,
+                    kImageVersionMajor, Expect::known)) {
+      return false;
+    }
+  }
+  h.v1 = h.major == 1;
+  h.layout_major = h.v1 ? h.major : kImageVersionMajor;
+  return whole_header;
+}
+
+// header_size and total_size against the buffer, and the buffer's alignment.
+template <typename Run>
+bool check_sizes(Run& run, const std::uint8_t* bytes, std::size_t size, DeclaredImage& h) {
+  using Expect = ImageExpectation;
+  const std::uint32_t declared_header = image_field_value(bytes, image_field::header_size);
+  if (!run.expect(declared_header == kImageHeaderSize, ImageCheckId::header, ImageStatus::bad_header, "header_size",
+                  -1, declared_header, kImageHeaderSize, Expect::equal)) {
+    return false;
+  }
+  h.total = image_field_value(bytes, image_field::total_size);
+  h.total_holds_trailer = h.total >= kImageHeaderSize + kImageTrailerSize;
+  if (!run.expect(h.total_holds_trailer, ImageCheckId::header, ImageStatus::bad_header, "total_size", -1, h.total,
+                  kImageHeaderSize + kImageTrailerSize, Expect::at_least)) {
+    return false;
+  }
+  if (h.total_holds_trailer && !run.expect(h.total <= size, ImageCheckId::size, ImageStatus::truncated, "total_size",
+                                           -1, h.total, static_cast<double>(size), Expect::at_most)) {
+    return false;
+  }
+  const std::uintptr_t address = reinterpret_cast<std::uintptr_t>(bytes);
+  h.aligned = address % alignof(float) == 0;
+  return run.expect(h.aligned, ImageCheckId::alignment, ImageStatus::misaligned, "buffer_address", -1,
+                    static_cast<double>(address), alignof(float), Expect::multiple_of);
+}
+
+template <typename Run>
+bool check_checksum(Run& run, const std::uint8_t* bytes, std::size_t size, const DeclaredImage& h,
+                    const ImageScan* scan) {
+  if (!h.total_holds_trailer || h.total > size) return true;
+  const std::uint32_t stored_crc = read_u32(bytes + h.total - kImageTrailerSize);
+  const std::uint32_t covered = h.total - kImageTrailerSize;
+  const bool scanned = scan != nullptr && scan->done() && scan->bytes() == bytes && scan->crc_bytes() == covered;
+  const std::uint32_t computed_crc = scanned ? scan->crc() : crc32(bytes, covered);
+  return run.expect(stored_crc == computed_crc, ImageCheckId::checksum, ImageStatus::checksum_mismatch, "crc32", -1,
+                    stored_crc, computed_crc, ImageExpectation::equal);
+}
+
+// One field's bytes in an image older than the field, by the field's rule:
+// reserved bytes are each zero, a named but unused field is zero.
+template <std::size_t I, typename Run>
+bool check_older_version_field(Run& run, const std::uint8_t* bytes, const DeclaredImage& h) {
+  constexpr ImageHeaderField field = kImageHeaderFields[I];
+  if constexpr (field.before == ImageFieldRule::none) {
+    return true;
+  } else {
+    if (image_field_in_use(field, h.layout_major, h.minor)) return true;
+    if (field.before == ImageFieldRule::zero_before && image_field_named(field, h.layout_major, h.minor)) {
+      const std::uint32_t value = image_field_value(bytes, field);
+      return run.expect(value == 0, ImageCheckId::header, ImageStatus::bad_header, field.name, -1, value, 0,
+                        ImageExpectation::equal);
+    }
+    for (std::uint32_t at = field.offset; at < field.offset + field.size(); ++at) {
+      if (!run.expect(bytes[at] == 0, ImageCheckId::header, ImageStatus::bad_header, "reserved",
+                      static_cast<std::int32_t>(at), bytes[at], 0, ImageExpectation::equal)) {
+        return false;
+      }
+    }
+    return true;
+  }
+}
+
+// Every field the image's version does not use holds what its rule says, in
+// the order of the header's bytes.
+template <typename Run>
+bool check_older_version_fields(Run& run, const std::uint8_t* bytes, const DeclaredImage& h) {
+  return for_each_image_header_field(
+      [&](auto index) { return check_older_version_field<decltype(index)::value>(run, bytes, h); });
+}
+
+template <typename Run>
+bool check_kind(Run& run, const std::uint8_t* bytes, DeclaredImage& h) {
+  using Expect = ImageExpectation;
+  const std::uint8_t scalar = bytes[image_field::scalar_type.offset];
+  const std::uint8_t kernel = bytes[image_field::kernel_kind.offset];
+  const std::uint8_t encoding = bytes[image_field::input_encoding.offset];
+  if (!run.expect(scalar == static_cast<std::uint8_t>(ImageScalar::float32), ImageCheckId::kind,
+                  ImageStatus::unsupported_kind, "scalar_type", -1, scalar,
+                  static_cast<std::uint8_t>(ImageScalar::float32), Expect::equal) ||
+      !run.expect(kernel == static_cast<std::uint8_t>(ImageKernel::squared_exponential_ard), ImageCheckId::kind,
+                  ImageStatus::unsupported_kind, "kernel_kind", -1, kernel,
+                  static_cast<std::uint8_t>(ImageKernel::squared_exponential_ard), Expect::equal) ||
+      !run.expect(is_known(static_cast<InputEncoding>(encoding)), ImageCheckId::kind, ImageStatus::unsupported_kind,
+                  "input_encoding", -1, encoding, static_cast<std::uint8_t>(InputEncoding::bend_vector),
+                  Expect::known)) {
+    return false;
+  }
+  const std::uint8_t declared_kind = bytes[image_field::model_kind.offset];
+  h.kind = h.v1 ? ImageModelKind::exact_gp : static_cast<ImageModelKind>(declared_kind);
+  h.extra = h.value(bytes, image_field::extra_inputs);
+  if (h.v1) return true;
+  // One extra input is defined, the tip payload; more would be inputs this
+  // parser cannot supply.
+  return run.expect(is_known(h.kind), ImageCheckId::kind, ImageStatus::unsupported_kind, "model_kind", -1,
+                    declared_kind, static_cast<std::uint8_t>(ImageModelKind::sparse_gp), Expect::known) &&
+         run.expect(h.extra <= kMaxExtraInputs, ImageCheckId::kind, ImageStatus::unsupported_kind, "extra_inputs", -1,
+                    h.extra, kMaxExtraInputs, Expect::at_most);
+}
+
+template <typename Run>
+bool check_dims(Run& run, const std::uint8_t* bytes, DeclaredImage& h) {
+  using Expect = ImageExpectation;
+  h.points = image_field_value(bytes, image_field::training_points);
+  h.input_dims = image_field_value(bytes, image_field::input_dims);
+  h.segments = image_field_value(bytes, image_field::segment_count);
+  const std::uint32_t outputs = image_field_value(bytes, image_field::output_dims);
+  return run.expect(h.points >= 1, ImageCheckId::header, ImageStatus::bad_header, "training_points", -1, h.points, 1,
+                    Expect::at_least) &&
+         run.expect(h.segments >= 1, ImageCheckId::header, ImageStatus::bad_header, "segment_count", -1, h.segments,
+                    1, Expect::at_least) &&
+         run.expect(h.input_dims == 2 * h.segments + h.extra, ImageCheckId::header, ImageStatus::bad_header,
+                    "input_dims", -1, h.input_dims, 2 * h.segments + h.extra, Expect::equal) &&
+         run.expect(outputs == kImageOutputs, ImageCheckId::header, ImageStatus::bad_header, "output_dims", -1,
+                    outputs, kImageOutputs, Expect::equal);
+}
+
+// v2.2: the hysteresis block's counts, both zero without one. The model
+// library's storage (HysteresisModel) bounds them, not the build.
+template <typename Run>
+bool check_hysteresis_counts(Run& run, const std::uint8_t* bytes, DeclaredImage& h) {
+  using Expect = ImageExpectation;
+  h.hysteresis_cables = h.value(bytes, image_field::hysteresis_cables);
+  h.hysteresis_operators = h.value(bytes, image_field::hysteresis_operators);
+  const std::uint32_t cables = h.hysteresis_cables;
+  const std::uint32_t operators = h.hysteresis_operators;
+  if (cables == 0 && operators == 0) return true;
+  return run.expect(cables == 4 * h.segments, ImageCheckId::header, ImageStatus::bad_header, "hysteresis_cables", -1,
+                    cables, 4 * h.segments, Expect::equal) &&
+         run.expect(operators >= 1, ImageCheckId::header, ImageStatus::bad_header, "hysteresis_operators", -1,
+                    operators, 1, Expect::at_least) &&
+         run.expect(cables <= static_cast<std::uint32_t>(kMaxCables), ImageCheckId::capacity,
+                    ImageStatus::over_capacity, "hysteresis_cables", -1, cables, kMaxCables, Expect::at_most) &&
+         run.expect(operators <= static_cast<std::uint32_t>(kMaxHysteresisOperators), ImageCheckId::capacity,
+                    ImageStatus::over_capacity, "hysteresis_operators", -1, operators, kMaxHysteresisOperators,
+                    Expect::at_most);
+}
+
+// v2.3: the compliance block's segment count, zero without one. The sag
+// needs the tip load, so only a model with the payload input has one.
+template <typename Run>
+bool check_compliance_counts(Run& run, const std::uint8_t* bytes, DeclaredImage& h) {
+  using Expect = ImageExpectation;
+  h.compliance_segments = h.value(bytes, image_field::compliance_segments);
+  if (h.compliance_segments == 0) return true;
+  return run.expect(h.compliance_segments == h.segments, ImageCheckId::header, ImageStatus::bad_header,
+                    "compliance_segments", -1, h.compliance_segments, h.segments, Expect::equal) &&
+         run.expect(h.extra == 1, ImageCheckId::header, ImageStatus::bad_header, "compliance_without_payload_input",
+                    -1, h.extra, 1, Expect::equal);
+}
+
+template <typename Run>
+bool check_capacity(Run& run, const DeclaredImage& h, const ImageCapacity& capacity) {
+  using Expect = ImageExpectation;
+  return run.expect(h.points <= capacity.max_training_points, ImageCheckId::capacity, ImageStatus::over_capacity,
+                    "training_points", -1, h.points, capacity.max_training_points, Expect::at_most) &&
+         run.expect(h.segments <= capacity.max_segments, ImageCheckId::capacity, ImageStatus::over_capacity,
+                    "segment_count", -1, h.segments, capacity.max_segments, Expect::at_most) &&
+         run.expect(h.rank <= capacity.max_variance_rank, ImageCheckId::capacity, ImageStatus::over_capacity,
+                    "variance_rank", -1, h.rank, capacity.max_variance_rank, Expect::at_most) &&
+         run.expect(h.extra <= capacity.max_extra_inputs, ImageCheckId::capacity, ImageStatus::over_capacity,
+                    "extra_inputs", -1, h.extra, capacity.max_extra_inputs, Expect::at_most);
+}
+
+// Each header field that locates a block holds a multiple of the block
+// alignment (the fields in the order of the header's bytes).
+template <typename Run>
+bool check_block_alignment(Run& run, const std::uint8_t* bytes, const DeclaredImage& h) {
+  return for_each_image_header_field([&](auto index) {
+    constexpr ImageHeaderField field = kImageHeaderFields[decltype(index)::value];
+    if constexpr (field.locates == ImageBlockId::none) {
+      return true;
+    } else {
+      const std::uint32_t offset = h.value(bytes, field);
+      return run.expect(offset % kImageBlockAlignment == 0, ImageCheckId::alignment, ImageStatus::misaligned,
+                        Run::name(field.name), -1, offset, kImageBlockAlignment, ImageExpectation::multiple_of);
+    }
+  });
+}
+
+// The bytes of the arrays the dims declare. Under a generous capacity the
+// 32-bit layout arithmetic could wrap into a size that matches; dims whose
+// arrays alone exceed the image cannot.
+inline std::uint64_t declared_array_bytes(const DeclaredImage& h) {
+  const ImageDims dims = h.dims();
+  return (std::uint64_t{h.points} * (h.input_dims + kImageOutputs) + image_variance_floats(h.rank, h.input_dims) +
+          dims.hysteresis_floats + dims.compliance_floats) *
+         4;
+}
+
+// total_size, metadata_size and every block offset are what the dims imply.
+template <typename Run>
+bool check_layout(Run& run, const std::uint8_t* bytes, const DeclaredImage& h) {
+  using Expect = ImageExpectation;
+  const std::uint64_t array_bytes = declared_array_bytes(h);
+  if (!run.expect(array_bytes <= h.total, ImageCheckId::layout, ImageStatus::size_mismatch, "total_size", -1, h.total,
+                  static_cast<double>(array_bytes), Expect::at_least)) {
+    return false;
+  }
+  if (array_bytes > h.total) return true;
+  const ImageLayout expected = image_layout(h.dims());
+  if (!run.expect(h.total == expected.total_size, ImageCheckId::layout, ImageStatus::size_mismatch, "total_size", -1,
+                  h.total, expected.total_size, Expect::equal)) {
+    return false;
+  }
+  const std::uint32_t declared_metadata_size = image_field_value(bytes, image_field::metadata_size);
+  if (!run.expect(declared_metadata_size == kImageMetadataSize, ImageCheckId::layout, ImageStatus::size_mismatch,
+                  "metadata_size", -1, declared_metadata_size, kImageMetadataSize, Expect::equal)) {
+    return false;
+  }
+  return for_each_image_header_field([&](auto index) {
+    constexpr ImageHeaderField field = kImageHeaderFields[decltype(index)::value];
+    if constexpr (field.locates == ImageBlockId::none) {
+      return true;
+    } else {
+      const std::uint32_t offset = h.value(bytes, field);
+      const std::uint32_t expected_offset = expected.*image_block(field.locates).offset;
+      return run.expect(offset == expected_offset, ImageCheckId::layout, ImageStatus::size_mismatch,
+                        Run::name(field.name), -1, offset, expected_offset, Expect::equal);
+    }
+  });
+}
+
+// From here on a stopping run has verified every block to lie where the
+// dims put it, inside the image. A reporting run reads a block where the
+// header puts it, if it lies inside the buffer. The hysteresis and
+// compliance blocks lie where the dims put them (no offset fields).
+template <typename Run>
+ImageBlocks locate_blocks(const std::uint8_t* bytes, std::size_t size, const DeclaredImage& h) {
+  const ImageDims dims = h.dims();
+  const auto block = [&]([[maybe_unused]] ImageBlockId id, std::uint32_t offset) -> const float* {
+    if constexpr (Run::kEveryCheck) {
+      const std::uint64_t block_bytes = image_block_bytes(id, dims);
+      if (!h.aligned || offset % alignof(float) != 0 || offset > size || block_bytes > size - offset) return nullptr;
+    }
+    return reinterpret_cast<const float*>(bytes + offset);
+  };
+  const auto declared = [&](const ImageHeaderField& field) { return block(field.locates, h.value(bytes, field)); };
+  ImageBlocks b;
+  b.geometry = declared(image_field::geometry_offset);
+  b.parameters = declared(image_field::parameters_offset);
+  b.inputs = declared(image_field::inputs_offset);
+  b.alpha = declared(image_field::alpha_offset);
+  b.metadata = reinterpret_cast<const std::uint8_t*>(declared(image_field::metadata_offset));
+  b.variance = h.rank > 0 ? declared(image_field::variance_offset) : nullptr;
+  const ImageLayout implied = image_layout(dims);
+  const bool fit = declared_array_bytes(h) <= h.total;
+  b.hysteresis = dims.hysteresis_floats > 0 && fit ? block(ImageBlockId::hysteresis, implied.hysteresis_offset)
+                                                   : nullptr;
+  b.compliance = dims.compliance_floats > 0 && fit ? block(ImageBlockId::compliance, implied.compliance_offset)
+                                                   : nullptr;
+  return b;
+}
+
+// No NaN or Inf in the payload; the verdict is the scan's where it covers
+// a block.
+template <typename Run>
+bool check_finite(Run& run, const ImageBlocks& b, const DeclaredImage& h, const ImageScan* scan) {
+  const std::uint32_t n = h.points;
+  const struct {
+    const char* name;
+    const float* values;
+    std::uint32_t count;
+  } payload[] = {{Run::name("geometry"), b.geometry, 3 * h.segments},
+                 {Run::name("parameters"), b.parameters, image_parameter_floats(h.input_dims, h.major, h.extra)},
+                 {Run::name("inputs"), b.inputs, n * h.input_dims},
+                 {Run::name("alpha"), b.alpha, n * kImageOutputs},
+                 {Run::name("variance"), b.variance,
+                  static_cast<std::uint32_t>(image_variance_floats(h.rank, h.input_dims))}};
+  for (const auto& values : payload) {
+    bool finite = true;
+    if (values.values != nullptr && scan != nullptr && scan->covers(values.values, values.count, finite)) {
+      if (!run.expect(finite, ImageCheckId::finite, ImageStatus::non_finite_payload, values.name, -1, 0.0, 0.0,
+                      ImageExpectation::finite, values.count)) {
+        return false;
+      }
+      continue;
+    }
+    if (values.values != nullptr &&
+        !expect_each(run, values.values, values.count, is_finite, ImageCheckId::finite,
+                     ImageStatus::non_finite_payload, values.name, ImageExpectation::finite)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+template <typename Run>
+bool check_positive(Run& run, const ImageBlocks& b, const ImageParameterArrays& p, const DeclaredImage& h) {
+  const std::uint32_t d = h.input_dims;
+  const struct {
+    const char* name;
+    const float* values;
+    std::uint32_t count;
+  } must_be_positive[] = {{Run::name("geometry"), b.geometry, 3 * h.segments},
+                          {Run::name("input_scale"), p.input_scale, d},
+                          {Run::name("length_scale"), p.length_scale, d},
+                          {Run::name("output_scale"), p.output_scale, kImageOutputs},
+                          {Run::name("signal_variance"), p.signal_variance, kImageOutputs},
+                          {Run::name("noise_variance"), p.noise_variance, kImageOutputs}};
+  for (const auto& values : must_be_positive) {
+    if (values.values != nullptr &&
+        !expect_each(run, values.values, values.count, is_positive, ImageCheckId::positive,
+                     ImageStatus::invalid_parameters, values.name, ImageExpectation::positive)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// v2: input_min <= input_max, and a payload's default is not negative (it is
+// a mass).
+template <typename Run>
+bool check_ranges(Run& run, const ImageParameterArrays& p, const DeclaredImage& h) {
+  if (p.input_min != nullptr) {
+    bool all_ordered = true;
+    for (std::uint32_t i = 0; i < h.input_dims; ++i) {
+      if (p.input_min[i] <= p.input_max[i]) continue;
+      all_ordered = false;
+      if (!run.expect(false, ImageCheckId::ranges, ImageStatus::invalid_parameters, "input_min",
+                      static_cast<std::int32_t>(i), p.input_min[i], p.input_max[i], ImageExpectation::at_most)) {
+        return false;
+      }
+    }
+    if (all_ordered) {
+      run.expect(true, ImageCheckId::ranges, ImageStatus::invalid_parameters, "input_min", -1, 0, 0,
+                 ImageExpectation::at_most, h.input_dims);
+    }
+  }
+  for (std::uint32_t i = 0; p.extra_default != nullptr && i < h.extra; ++i) {
+    if (!run.expect(p.extra_default[i] >= 0.0f, ImageCheckId::ranges, ImageStatus::invalid_parameters,
+                    "extra_input_default", static_cast<std::int32_t>(i), p.extra_default[i], 0,
+                    ImageExpectation::at_least)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// v2: the metadata's fitted_rows. A v1 image was fitted on exactly the rows
+// it carries.
+template <typename Run>
+bool check_fitted_rows(Run& run, const std::uint8_t* metadata, const DeclaredImage& h, std::uint32_t& fitted) {
+  using Expect = ImageExpectation;
+  fitted = h.points;
+  if (h.v1 || metadata == nullptr) return true;
+  fitted = read_u32(metadata + image_metadata_field::fitted_rows);
+  if (!run.expect(fitted >= 1, ImageCheckId::fitted_rows, ImageStatus::invalid_parameters, "fitted_rows", -1, fitted,
+                  1, Expect::at_least)) {
+    return false;
+  }
+  // An exact model's points are its rows; a sparse model's rows may be
+  // any number, its points summarise them.
+  return h.kind != ImageModelKind::exact_gp ||
+         run.expect(fitted == h.points, ImageCheckId::fitted_rows, ImageStatus::invalid_parameters, "fitted_rows", -1,
+                    fitted, h.points, Expect::equal);
+}
+
+// The variance block: positive calibration, a threshold that is a share
+// of the signal variance, a zero reserved word, positive factor diagonals
+// (they are divided by), and the one kernel it was computed with: its
+// factors hold signal / noise, so every output must share both.
+template <typename Run>
+bool check_variance_block(Run& run, const float* variance, const ImageParameterArrays& p, const DeclaredImage& h) {
+  using Expect = ImageExpectation;
+  using namespace image_variance_field;
+  if (variance == nullptr) {
+    // Nothing to judge; the report still names the check.
+    if (Run::kEveryCheck) {
+      run.expect(true, ImageCheckId::variance, ImageStatus::invalid_parameters, "variance_rank", -1, h.rank, 0,
+                 Expect::at_least);
+    }
+    return true;
+  }
+  if (!expect_each(run, variance, reserved, is_positive, ImageCheckId::positive, ImageStatus::invalid_parameters,
+                   Run::name("variance_calibration"), Expect::positive)) {
+    return false;
+  }
+  const float* inducing_factor = variance + points + h.rank * h.input_dims;
+  const float* posterior_factor = inducing_factor + packed_triangle_floats(h.rank);
+  for (std::uint32_t i = 0; i < h.rank; ++i) {
+    const std::uint32_t diagonal = packed_triangle_floats(i + 1) - 1;
+    if (!run.expect(is_positive(inducing_factor[diagonal]), ImageCheckId::variance, ImageStatus::invalid_parameters,
+                    "variance_inducing_factor", static_cast<std::int32_t>(diagonal), inducing_factor[diagonal], 0,
+                    Expect::positive) ||
+        !run.expect(is_positive(posterior_factor[diagonal]), ImageCheckId::variance, ImageStatus::invalid_parameters,
+                    "variance_posterior_factor", static_cast<std::int32_t>(diagonal), posterior_factor[diagonal], 0,
+                    Expect::positive)) {
+      return false;
+    }
+  }
+  if (!run.expect(variance[extrapolation_variance] <= 1.0f, ImageCheckId::variance, ImageStatus::invalid_parameters,
+                  "extrapolation_variance", -1, variance[extrapolation_variance], 1, Expect::at_most) ||
+      !run.expect(variance[reserved] == 0.0f, ImageCheckId::variance, ImageStatus::invalid_parameters,
+                  "variance_reserved", -1, variance[reserved], 0, Expect::equal)) {
+    return false;
+  }
+  for (int k = 1; p.signal_variance != nullptr && k < kImageOutputs; ++k) {
+    if (!run.expect(p.signal_variance[k] == p.signal_variance[0], ImageCheckId::variance,
+                    ImageStatus::invalid_parameters, "signal_variance", k, p.signal_variance[k], p.signal_variance[0],
+                    Expect::equal) ||
+        !run.expect(p.noise_variance[k] == p.noise_variance[0], ImageCheckId::variance,
+                    ImageStatus::invalid_parameters, "noise_variance", k, p.noise_variance[k], p.noise_variance[0],
+                    Expect::equal)) {
+      return false;
+    }
+  }
+  return true;
+}
+
+// The v2.2 and v2.3 blocks' values; without a block the report still
+// names the check.
+template <typename Run>
+bool check_optional_blocks(Run& run, const ImageBlocks& b, const DeclaredImage& h) {
+  if (b.hysteresis == nullptr && Run::kEveryCheck) {
+    run.expect(true, ImageCheckId::hysteresis, ImageStatus::invalid_parameters, "hysteresis_operators", -1,
+               h.hysteresis_operators, 0, ImageExpectation::at_least);
+  }
+  if (b.hysteresis != nullptr &&
+      !check_hysteresis_block(run, b.hysteresis, h.hysteresis_cables, h.hysteresis_operators)) {
+    return false;
+  }
+  if (b.compliance == nullptr && Run::kEveryCheck) {
+    run.expect(true, ImageCheckId::compliance, ImageStatus::invalid_parameters, "compliance_segments", -1,
+               h.compliance_segments, 0, ImageExpectation::at_least);
+  }
+  return b.compliance == nullptr || check_compliance_block(run, b.compliance, h.compliance_segments);
+}
+
+// The view of an image that passed every check.
+inline ImageView make_view(const std::uint8_t* bytes, const DeclaredImage& h, const ImageBlocks& b,
+                           const ImageParameterArrays& p, std::uint32_t fitted) {
+  ImageView v{};
+  v.version_major = h.major;
+  v.version_minor = h.minor;
+  v.total_size = h.total;
+  v.model_kind = h.kind;
+  v.training_points = h.points;
+  v.fitted_rows = fitted;
+  v.input_dims = static_cast<int>(h.input_dims);
+  v.segment_count = static_cast<int>(h.segments);
+  v.extra_inputs = static_cast<int>(h.extra);
+  v.encoding = static_cast<InputEncoding>(bytes[image_field::input_encoding.offset]);
+  v.geometry = b.geometry;
+  v.input_mean = p.input_mean;
+  v.input_scale = p.input_scale;
+  v.length_scale = p.length_scale;
+  v.output_mean = p.output_mean;
+  v.output_scale = p.output_scale;
+  v.signal_variance = p.signal_variance;
+  v.noise_variance = p.noise_variance;
+  v.input_min = p.input_min;
+  v.input_max = p.input_max;
+  v.extra_input_default = p.extra_default;
+  v.inputs = b.inputs;
+  v.alpha = b.alpha;
+  v.variance_rank = h.rank;
+  if (b.variance != nullptr) {
+    v.variance_calibration = b.variance;
+    v.variance_points = b.variance + image_variance_field::points;
+    v.variance_inducing_factor = v.variance_points + h.rank * h.input_dims;
+    v.variance_posterior_factor = v.variance_inducing_factor + packed_triangle_floats(h.rank);
+  }
+  if (b.hysteresis != nullptr) {
+    const std::uint32_t values = h.hysteresis_cables * h.hysteresis_operators;
+    v.hysteresis_cables = static_cast<int>(h.hysteresis_cables);
+    v.hysteresis_operators = static_cast<int>(h.hysteresis_operators);
+    v.hysteresis_widths = b.hysteresis + image_hysteresis_field::widths;
+    v.hysteresis_weights = v.hysteresis_widths + values;
+    v.hysteresis_homing_lags = v.hysteresis_weights + values;
+  }
+  if (b.compliance != nullptr) {
+    v.compliance_segments = static_cast<int>(h.compliance_segments);
+    v.compliance_weighted_gravity = b.compliance + image_compliance_field::weighted_gravity;
+    v.compliance_ratios = b.compliance + image_compliance_field::ratios;
+    v.compliance_softening = v.compliance_ratios + h.compliance_segments;
+    v.compliance_unloaded_mass = v.compliance_softening + 1;
+  }
+  const std::uint8_t* metadata = b.metadata;
+  v.dataset_hash = read_u64(metadata + image_metadata_field::dataset_hash);
+  v.created_unix_s = static_cast<std::int64_t>(read_u64(metadata + image_metadata_field::created_unix_s));
+  v.validation_samples = read_u32(metadata + image_metadata_field::validation_samples);
+  std::memcpy(&v.metrics, metadata + image_metadata_field::metrics, sizeof(ImageMetrics));
+  v.trainer = reinterpret_cast<const char*>(metadata + image_metadata_field::trainer);
+  return v;
+}
+
 // Checks run from what is needed to read the rest (size, magic, version,
 // header) to the integrity check and then to the meaning of the payload, so
 // every rejection reports the first thing that is wrong. A reporting run
@@ -655,452 +1445,30 @@ namespace detail {
 template <typename Run>
 ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& view, const ImageCapacity& capacity,
                         Run& run, const ImageScan* scan = nullptr) {
-  using namespace image_field;
-  using Check = ImageCheckId;
-  using Status = ImageStatus;
-  using Expect = ImageExpectation;
-
-  const bool whole_header = bytes != nullptr && size >= kImageHeaderSize;
-  if (!run.expect(whole_header, Check::size, Status::truncated, "file_size", -1, static_cast<double>(size),
-                  kImageHeaderSize, Expect::at_least)) {
+  DeclaredImage h;
+  if (!check_identity(run, bytes, size, h) || !check_sizes(run, bytes, size, h) ||
+      !check_checksum(run, bytes, size, h, scan)) {
     return run.status;
   }
-  // A file too short for a header may still show what it is.
-  if (bytes != nullptr && size >= magic + 4) {
-    const std::uint32_t declared_magic = read_u32(bytes + magic);
-    if (!run.expect(declared_magic == kImageMagic, Check::magic, Status::bad_magic, "magic", -1, declared_magic,
-                    kImageMagic, Expect::equal)) {
-      return run.status;
-    }
-  }
-  std::uint16_t major = kImageVersionMajor;
-  if (bytes != nullptr && size >= version_major + 2) {
-    major = read_u16(bytes + version_major);
-    const bool readable = major >= kImageOldestVersionMajor && major <= kImageVersionMajor;
-    if (!run.expect(readable, Check::version, Status::unsupported_version, "version_major", -1, major,
-                    kImageVersionMajor, Expect::known)) {
-      return run.status;
-    }
-  }
-  if (!whole_header) return run.status;
-  const bool v1 = major == 1;
-
-  const std::uint32_t declared_header = read_u32(bytes + header_size);
-  if (!run.expect(declared_header == kImageHeaderSize, Check::header, Status::bad_header, "header_size", -1,
-                  declared_header, kImageHeaderSize, Expect::equal)) {
+  h.minor = static_cast<std::uint16_t>(image_field_value(bytes, image_field::version_minor));
+  h.rank = h.value(bytes, image_field::variance_rank);
+  if (!check_older_version_fields(run, bytes, h) ||
+      !check_kind(run, bytes, h) || !check_dims(run, bytes, h) || !check_hysteresis_counts(run, bytes, h) ||
+      !check_compliance_counts(run, bytes, h) || !check_capacity(run, h, capacity) ||
+      !check_block_alignment(run, bytes, h) || !check_layout(run, bytes, h)) {
     return run.status;
   }
-  const std::uint32_t declared_total = read_u32(bytes + total_size);
-  const bool total_holds_trailer = declared_total >= kImageHeaderSize + kImageTrailerSize;
-  if (!run.expect(total_holds_trailer, Check::header, Status::bad_header, "total_size", -1, declared_total,
-                  kImageHeaderSize + kImageTrailerSize, Expect::at_least)) {
+  const ImageBlocks blocks = locate_blocks<Run>(bytes, size, h);
+  const ImageParameterArrays parameters = parameter_arrays(blocks.parameters, h);
+  std::uint32_t fitted = h.points;
+  if (!check_finite(run, blocks, h, scan) || !check_positive(run, blocks, parameters, h) ||
+      !check_ranges(run, parameters, h) || !check_fitted_rows(run, blocks.metadata, h, fitted) ||
+      !check_variance_block(run, blocks.variance, parameters, h) || !check_optional_blocks(run, blocks, h)) {
     return run.status;
   }
-  if (total_holds_trailer && !run.expect(declared_total <= size, Check::size, Status::truncated, "total_size", -1,
-                                         declared_total, static_cast<double>(size), Expect::at_most)) {
-    return run.status;
-  }
-  const std::uintptr_t address = reinterpret_cast<std::uintptr_t>(bytes);
-  const bool aligned = address % alignof(float) == 0;
-  if (!run.expect(aligned, Check::alignment, Status::misaligned, "buffer_address", -1, static_cast<double>(address),
-                  alignof(float), Expect::multiple_of)) {
-    return run.status;
-  }
-
-  if (total_holds_trailer && declared_total <= size) {
-    const std::uint32_t stored_crc = read_u32(bytes + declared_total - kImageTrailerSize);
-    const std::uint32_t covered = declared_total - kImageTrailerSize;
-    const bool scanned = scan != nullptr && scan->done() && scan->bytes() == bytes && scan->crc_bytes() == covered;
-    const std::uint32_t computed_crc = scanned ? scan->crc() : crc32(bytes, covered);
-    if (!run.expect(stored_crc == computed_crc, Check::checksum, Status::checksum_mismatch, "crc32", -1, stored_crc,
-                    computed_crc, Expect::equal)) {
-      return run.status;
-    }
-  }
-
-  // v2 gives bytes 29 and 30 a meaning, and bytes 56..61 a meaning that v2.0
-  // requires to be zero; reserved bytes are zero in both versions.
-  const std::uint16_t minor = read_u16(bytes + version_minor);
-  // v2.3 gives byte 31 the compliance block's segment count.
-  const bool compliance_fields = !v1 && minor >= kImageVersionMinorCompliance;
-  for (std::size_t at = v1 ? model_kind : (compliance_fields ? geometry_offset : reserved_a); at < geometry_offset;
-       ++at) {
-    if (!run.expect(bytes[at] == 0, Check::header, Status::bad_header, "reserved", static_cast<std::int32_t>(at),
-                    bytes[at], 0, Expect::equal)) {
-      return run.status;
-    }
-  }
-  // v2.0 reserves the variance fields and requires them to be zero; v2.1
-  // defines the block they locate.
-  const std::uint32_t declared_variance_offset = v1 ? 0 : read_u32(bytes + variance_offset);
-  const std::uint32_t rank = v1 ? 0 : read_u16(bytes + variance_rank);
-  if (!v1 && minor == 0) {
-    if (!run.expect(declared_variance_offset == 0, Check::header, Status::bad_header, "variance_offset", -1,
-                    declared_variance_offset, 0, Expect::equal) ||
-        !run.expect(rank == 0, Check::header, Status::bad_header, "variance_rank", -1, rank, 0, Expect::equal)) {
-      return run.status;
-    }
-  }
-  // v2.2 gives bytes 62 and 63 the hysteresis block's counts.
-  const bool hysteresis_fields = !v1 && minor >= kImageVersionMinorHysteresis;
-  for (std::size_t at = v1 ? variance_offset : (hysteresis_fields ? kImageHeaderSize : reserved_b);
-       at < kImageHeaderSize; ++at) {
-    if (!run.expect(bytes[at] == 0, Check::header, Status::bad_header, "reserved", static_cast<std::int32_t>(at),
-                    bytes[at], 0, Expect::equal)) {
-      return run.status;
-    }
-  }
-
-  if (!run.expect(bytes[scalar_type] == static_cast<std::uint8_t>(ImageScalar::float32), Check::kind,
-                  Status::unsupported_kind, "scalar_type", -1, bytes[scalar_type],
-                  static_cast<std::uint8_t>(ImageScalar::float32), Expect::equal) ||
-      !run.expect(bytes[kernel_kind] == static_cast<std::uint8_t>(ImageKernel::squared_exponential_ard), Check::kind,
-                  Status::unsupported_kind, "kernel_kind", -1, bytes[kernel_kind],
-                  static_cast<std::uint8_t>(ImageKernel::squared_exponential_ard), Expect::equal) ||
-      !run.expect(is_known(static_cast<InputEncoding>(bytes[input_encoding])), Check::kind, Status::unsupported_kind,
-                  "input_encoding", -1, bytes[input_encoding], static_cast<std::uint8_t>(InputEncoding::bend_vector),
-                  Expect::known)) {
-    return run.status;
-  }
-  const ImageModelKind kind = v1 ? ImageModelKind::exact_gp : static_cast<ImageModelKind>(bytes[model_kind]);
-  const std::uint32_t extra = v1 ? 0 : bytes[extra_inputs];
-  if (!v1) {
-    // One extra input is defined, the tip payload; more would be inputs this
-    // parser cannot supply.
-    if (!run.expect(is_known(kind), Check::kind, Status::unsupported_kind, "model_kind", -1, bytes[model_kind],
-                    static_cast<std::uint8_t>(ImageModelKind::sparse_gp), Expect::known) ||
-        !run.expect(extra <= kMaxExtraInputs, Check::kind, Status::unsupported_kind, "extra_inputs", -1, extra,
-                    kMaxExtraInputs, Expect::at_most)) {
-      return run.status;
-    }
-  }
-
-  const std::uint32_t n = read_u32(bytes + training_points);
-  const std::uint32_t d = read_u16(bytes + input_dims);
-  const std::uint32_t segments = read_u16(bytes + segment_count);
-  const std::uint32_t outputs = read_u16(bytes + output_dims);
-  if (!run.expect(n >= 1, Check::header, Status::bad_header, "training_points", -1, n, 1, Expect::at_least) ||
-      !run.expect(segments >= 1, Check::header, Status::bad_header, "segment_count", -1, segments, 1,
-                  Expect::at_least) ||
-      !run.expect(d == 2 * segments + extra, Check::header, Status::bad_header, "input_dims", -1, d,
-                  2 * segments + extra, Expect::equal) ||
-      !run.expect(outputs == kImageOutputs, Check::header, Status::bad_header, "output_dims", -1, outputs,
-                  kImageOutputs, Expect::equal)) {
-    return run.status;
-  }
-  // v2.2: the hysteresis block's counts, both zero without one. The model
-  // library's storage (HysteresisModel) bounds them, not the build.
-  const std::uint32_t hysteresis_cable_count = hysteresis_fields ? bytes[hysteresis_cables] : 0;
-  const std::uint32_t hysteresis_operator_count = hysteresis_fields ? bytes[hysteresis_operators] : 0;
-  if (hysteresis_cable_count != 0 || hysteresis_operator_count != 0) {
-    if (!run.expect(hysteresis_cable_count == 4 * segments, Check::header, Status::bad_header, "hysteresis_cables", -1,
-                    hysteresis_cable_count, 4 * segments, Expect::equal) ||
-        !run.expect(hysteresis_operator_count >= 1, Check::header, Status::bad_header, "hysteresis_operators", -1,
-                    hysteresis_operator_count, 1, Expect::at_least) ||
-        !run.expect(hysteresis_cable_count <= static_cast<std::uint32_t>(kMaxCables), Check::capacity,
-                    Status::over_capacity, "hysteresis_cables", -1, hysteresis_cable_count, kMaxCables,
-                    Expect::at_most) ||
-        !run.expect(hysteresis_operator_count <= static_cast<std::uint32_t>(kMaxHysteresisOperators),
-                    Check::capacity, Status::over_capacity, "hysteresis_operators", -1, hysteresis_operator_count,
-                    kMaxHysteresisOperators, Expect::at_most)) {
-      return run.status;
-    }
-  }
-  const std::uint32_t hysteresis_floats = image_hysteresis_floats(hysteresis_cable_count, hysteresis_operator_count);
-  // v2.3: the compliance block's segment count, zero without one. The sag
-  // needs the tip load, so only a model with the payload input has one.
-  const std::uint32_t compliance_segment_count = compliance_fields ? bytes[compliance_segments] : 0;
-  if (compliance_segment_count != 0) {
-    if (!run.expect(compliance_segment_count == segments, Check::header, Status::bad_header, "compliance_segments", -1,
-                    compliance_segment_count, segments, Expect::equal) ||
-        !run.expect(extra == 1, Check::header, Status::bad_header, "compliance_without_payload_input", -1, extra, 1,
-                    Expect::equal)) {
-      return run.status;
-    }
-  }
-  const std::uint32_t compliance_floats = image_compliance_floats(compliance_segment_count);
-  if (!run.expect(n <= capacity.max_training_points, Check::capacity, Status::over_capacity, "training_points", -1, n,
-                  capacity.max_training_points, Expect::at_most) ||
-      !run.expect(segments <= capacity.max_segments, Check::capacity, Status::over_capacity, "segment_count", -1,
-                  segments, capacity.max_segments, Expect::at_most) ||
-      !run.expect(rank <= capacity.max_variance_rank, Check::capacity, Status::over_capacity, "variance_rank", -1,
-                  rank, capacity.max_variance_rank, Expect::at_most) ||
-      !run.expect(extra <= capacity.max_extra_inputs, Check::capacity, Status::over_capacity, "extra_inputs", -1,
-                  extra, capacity.max_extra_inputs, Expect::at_most)) {
-    return run.status;
-  }
-
-  constexpr const char* offset_names[] = {"geometry_offset", "parameters_offset", "inputs_offset", "alpha_offset",
-                                          "metadata_offset", "variance_offset"};
-  const std::uint32_t offsets[] = {read_u32(bytes + geometry_offset), read_u32(bytes + parameters_offset),
-                                   read_u32(bytes + inputs_offset),   read_u32(bytes + alpha_offset),
-                                   read_u32(bytes + metadata_offset), declared_variance_offset};
-  for (int i = 0; i < 6; ++i) {
-    if (!run.expect(offsets[i] % kImageBlockAlignment == 0, Check::alignment, Status::misaligned, offset_names[i], -1,
-                    offsets[i], kImageBlockAlignment, Expect::multiple_of)) {
-      return run.status;
-    }
-  }
-  // Under a generous capacity the 32-bit layout arithmetic below could wrap
-  // into a size that matches; dims whose arrays alone exceed the image cannot.
-  const std::uint64_t array_bytes =
-      (std::uint64_t{n} * (d + kImageOutputs) + std::uint64_t{image_variance_floats(rank, d)} + hysteresis_floats +
-       compliance_floats) *
-      4;
-  if (!run.expect(array_bytes <= declared_total, Check::layout, Status::size_mismatch, "total_size", -1,
-                  declared_total, static_cast<double>(array_bytes), Expect::at_least)) {
-    return run.status;
-  }
-  if (array_bytes <= declared_total) {
-    const ImageLayout expected = image_layout(n, d, segments, major, rank, extra, hysteresis_floats, compliance_floats);
-    const std::uint32_t expected_offsets[] = {expected.geometry_offset, expected.parameters_offset,
-                                              expected.inputs_offset,   expected.alpha_offset,
-                                              expected.metadata_offset, expected.variance_offset};
-    if (!run.expect(declared_total == expected.total_size, Check::layout, Status::size_mismatch, "total_size", -1,
-                    declared_total, expected.total_size, Expect::equal)) {
-      return run.status;
-    }
-    const std::uint32_t declared_metadata_size = read_u32(bytes + metadata_size);
-    if (!run.expect(declared_metadata_size == kImageMetadataSize, Check::layout, Status::size_mismatch,
-                    "metadata_size", -1, declared_metadata_size, kImageMetadataSize, Expect::equal)) {
-      return run.status;
-    }
-    for (int i = 0; i < 6; ++i) {
-      if (!run.expect(offsets[i] == expected_offsets[i], Check::layout, Status::size_mismatch, offset_names[i], -1,
-                      offsets[i], expected_offsets[i], Expect::equal)) {
-        return run.status;
-      }
-    }
-  }
-
-  // From here on a stopping run has verified every block to lie where the
-  // dims put it, inside the image. A reporting run reads a block where the
-  // header puts it, if it lies inside the buffer.
-  const auto block = [&](std::uint32_t offset, std::uint64_t floats) -> const float* {
-    if constexpr (Run::kEveryCheck) {
-      if (!aligned || offset % alignof(float) != 0 || offset > size || 4 * floats > size - offset) return nullptr;
-    }
-    return reinterpret_cast<const float*>(bytes + offset);
-  };
-  const std::uint32_t parameter_floats = image_parameter_floats(d, major, extra);
-  const float* geometry = block(offsets[0], 3 * std::uint64_t{segments});
-  const float* parameters = block(offsets[1], parameter_floats);
-  const float* inputs = block(offsets[2], std::uint64_t{n} * d);
-  const float* alpha = block(offsets[3], std::uint64_t{n} * kImageOutputs);
-  const std::uint8_t* metadata =
-      reinterpret_cast<const std::uint8_t*>(block(offsets[4], kImageMetadataSize / sizeof(float)));
-  const std::uint64_t variance_floats = image_variance_floats(rank, d);
-  const float* variance = rank > 0 ? block(offsets[5], variance_floats) : nullptr;
-  // The hysteresis and compliance blocks lie where the dims put them (no
-  // offset fields).
-  const ImageLayout implied = image_layout(n, d, segments, major, rank, extra, hysteresis_floats, compliance_floats);
-  const bool blocks_fit = array_bytes <= declared_total;
-  const float* hysteresis =
-      hysteresis_floats > 0 && blocks_fit ? block(implied.hysteresis_offset, hysteresis_floats) : nullptr;
-  const float* compliance =
-      compliance_floats > 0 && blocks_fit ? block(implied.compliance_offset, compliance_floats) : nullptr;
-
-  const struct {
-    const char* name;
-    const float* values;
-    std::uint32_t count;
-  } payload[] = {{Run::name("geometry"), geometry, 3 * segments},
-                 {Run::name("parameters"), parameters, parameter_floats},
-                 {Run::name("inputs"), inputs, n * d},
-                 {Run::name("alpha"), alpha, n * kImageOutputs},
-                 {Run::name("variance"), variance, static_cast<std::uint32_t>(variance_floats)}};
-  for (const auto& values : payload) {
-    bool finite = true;
-    if (values.values != nullptr && scan != nullptr && scan->covers(values.values, values.count, finite)) {
-      if (!run.expect(finite, Check::finite, Status::non_finite_payload, values.name, -1, 0.0, 0.0, Expect::finite,
-                      values.count)) {
-        return run.status;
-      }
-      continue;
-    }
-    if (values.values != nullptr && !expect_each(run, values.values, values.count, is_finite, Check::finite,
-                                                 Status::non_finite_payload, values.name, Expect::finite)) {
-      return run.status;
-    }
-  }
-
-  // The parameter arrays, back to back; none where the block is not readable.
-  const auto parameter = [parameters](std::uint32_t first) {
-    return parameters != nullptr ? parameters + first : nullptr;
-  };
-  const float* input_scale = parameter(d);
-  const float* length_scale = parameter(2 * d);
-  const float* output_mean = parameter(3 * d);
-  const float* output_scale = parameter(3 * d + kImageOutputs);
-  const float* signal_variance = parameter(3 * d + 2 * kImageOutputs);
-  const float* noise_variance = parameter(3 * d + 3 * kImageOutputs);
-  const struct {
-    const char* name;
-    const float* values;
-    std::uint32_t count;
-  } must_be_positive[] = {{Run::name("geometry"), geometry, 3 * segments},
-                          {Run::name("input_scale"), input_scale, d},
-                          {Run::name("length_scale"), length_scale, d},
-                          {Run::name("output_scale"), output_scale, kImageOutputs},
-                          {Run::name("signal_variance"), signal_variance, kImageOutputs},
-                          {Run::name("noise_variance"), noise_variance, kImageOutputs}};
-  for (const auto& values : must_be_positive) {
-    if (values.values != nullptr && !expect_each(run, values.values, values.count, is_positive, Check::positive,
-                                                 Status::invalid_parameters, values.name, Expect::positive)) {
-      return run.status;
-    }
-  }
-
-  const float* input_min = v1 ? nullptr : parameter(3 * d + 4 * kImageOutputs);
-  const float* input_max = v1 ? nullptr : parameter(4 * d + 4 * kImageOutputs);
-  const float* extra_default = extra > 0 ? parameter(5 * d + 4 * kImageOutputs) : nullptr;
-  if (input_min != nullptr) {
-    bool all_ordered = true;
-    for (std::uint32_t i = 0; i < d; ++i) {
-      if (input_min[i] <= input_max[i]) continue;
-      all_ordered = false;
-      if (!run.expect(false, Check::ranges, Status::invalid_parameters, "input_min", static_cast<std::int32_t>(i),
-                      input_min[i], input_max[i], Expect::at_most)) {
-        return run.status;
-      }
-    }
-    if (all_ordered) {
-      run.expect(true, Check::ranges, Status::invalid_parameters, "input_min", -1, 0, 0, Expect::at_most, d);
-    }
-  }
-
-  // A payload is a mass: its default is not negative.
-  for (std::uint32_t i = 0; extra_default != nullptr && i < extra; ++i) {
-    if (!run.expect(extra_default[i] >= 0.0f, Check::ranges, Status::invalid_parameters, "extra_input_default",
-                    static_cast<std::int32_t>(i), extra_default[i], 0, Expect::at_least)) {
-      return run.status;
-    }
-  }
-
-  std::uint32_t fitted = n;  // a v1 image was fitted on exactly the rows it carries
-  if (!v1 && metadata != nullptr) {
-    fitted = read_u32(metadata + image_metadata_field::fitted_rows);
-    if (!run.expect(fitted >= 1, Check::fitted_rows, Status::invalid_parameters, "fitted_rows", -1, fitted, 1,
-                    Expect::at_least)) {
-      return run.status;
-    }
-    // An exact model's points are its rows; a sparse model's rows may be
-    // any number, its points summarise them.
-    if (kind == ImageModelKind::exact_gp &&
-        !run.expect(fitted == n, Check::fitted_rows, Status::invalid_parameters, "fitted_rows", -1, fitted, n,
-                    Expect::equal)) {
-      return run.status;
-    }
-  }
-  // The variance block: positive calibration, a threshold that is a share
-  // of the signal variance, a zero reserved word, positive factor diagonals
-  // (they are divided by), and the one kernel it was computed with: its
-  // factors hold signal / noise, so every output must share both.
-  const float* variance_points = variance != nullptr ? variance + image_variance_field::points : nullptr;
-  const float* inducing_factor = variance_points != nullptr ? variance_points + rank * d : nullptr;
-  const float* posterior_factor = inducing_factor != nullptr ? inducing_factor + packed_triangle_floats(rank) : nullptr;
-  if (variance == nullptr && Run::kEveryCheck) {
-    // Nothing to judge; the report still names the check.
-    run.expect(true, Check::variance, Status::invalid_parameters, "variance_rank", -1, rank, 0, Expect::at_least);
-  }
-  if (variance != nullptr) {
-    using namespace image_variance_field;
-    if (!expect_each(run, variance, reserved, is_positive, Check::positive, Status::invalid_parameters,
-                     Run::name("variance_calibration"), Expect::positive)) {
-      return run.status;
-    }
-    for (std::uint32_t i = 0; i < rank; ++i) {
-      const std::uint32_t diagonal = packed_triangle_floats(i + 1) - 1;
-      if (!run.expect(is_positive(inducing_factor[diagonal]), Check::variance, Status::invalid_parameters,
-                      "variance_inducing_factor", static_cast<std::int32_t>(diagonal), inducing_factor[diagonal], 0,
-                      Expect::positive) ||
-          !run.expect(is_positive(posterior_factor[diagonal]), Check::variance, Status::invalid_parameters,
-                      "variance_posterior_factor", static_cast<std::int32_t>(diagonal), posterior_factor[diagonal],
-                      0, Expect::positive)) {
-        return run.status;
-      }
-    }
-    if (!run.expect(variance[extrapolation_variance] <= 1.0f, Check::variance, Status::invalid_parameters,
-                    "extrapolation_variance", -1, variance[extrapolation_variance], 1, Expect::at_most) ||
-        !run.expect(variance[reserved] == 0.0f, Check::variance, Status::invalid_parameters, "variance_reserved", -1,
-                    variance[reserved], 0, Expect::equal)) {
-      return run.status;
-    }
-    if (signal_variance != nullptr) {
-      for (int k = 1; k < kImageOutputs; ++k) {
-        if (!run.expect(signal_variance[k] == signal_variance[0], Check::variance, Status::invalid_parameters,
-                        "signal_variance", k, signal_variance[k], signal_variance[0], Expect::equal) ||
-            !run.expect(noise_variance[k] == noise_variance[0], Check::variance, Status::invalid_parameters,
-                        "noise_variance", k, noise_variance[k], noise_variance[0], Expect::equal)) {
-          return run.status;
-        }
-      }
-    }
-  }
-  if (hysteresis == nullptr && Run::kEveryCheck) {
-    run.expect(true, Check::hysteresis, Status::invalid_parameters, "hysteresis_operators", -1,
-               hysteresis_operator_count, 0, Expect::at_least);
-  }
-  if (hysteresis != nullptr &&
-      !check_hysteresis_block(run, hysteresis, hysteresis_cable_count, hysteresis_operator_count)) {
-    return run.status;
-  }
-  if (compliance == nullptr && Run::kEveryCheck) {
-    run.expect(true, Check::compliance, Status::invalid_parameters, "compliance_segments", -1,
-               compliance_segment_count, 0, Expect::at_least);
-  }
-  if (compliance != nullptr && !check_compliance_block(run, compliance, compliance_segment_count)) {
-    return run.status;
-  }
-  if (run.status != Status::ok) return run.status;
-
-  ImageView v{};
-  v.version_major = major;
-  v.version_minor = read_u16(bytes + version_minor);
-  v.total_size = declared_total;
-  v.model_kind = kind;
-  v.training_points = n;
-  v.fitted_rows = fitted;
-  v.input_dims = static_cast<int>(d);
-  v.segment_count = static_cast<int>(segments);
-  v.extra_inputs = static_cast<int>(extra);
-  v.encoding = static_cast<InputEncoding>(bytes[input_encoding]);
-  v.geometry = geometry;
-  v.input_mean = parameters;
-  v.input_scale = input_scale;
-  v.length_scale = length_scale;
-  v.output_mean = output_mean;
-  v.output_scale = output_scale;
-  v.signal_variance = signal_variance;
-  v.noise_variance = noise_variance;
-  v.input_min = input_min;
-  v.input_max = input_max;
-  v.extra_input_default = extra_default;
-  v.inputs = inputs;
-  v.alpha = alpha;
-  v.variance_rank = rank;
-  v.variance_calibration = variance;
-  v.variance_points = variance_points;
-  v.variance_inducing_factor = inducing_factor;
-  v.variance_posterior_factor = posterior_factor;
-  v.hysteresis_cables = hysteresis != nullptr ? static_cast<int>(hysteresis_cable_count) : 0;
-  v.hysteresis_operators = hysteresis != nullptr ? static_cast<int>(hysteresis_operator_count) : 0;
-  const std::uint32_t hysteresis_values = hysteresis_cable_count * hysteresis_operator_count;
-  v.hysteresis_widths = hysteresis;
-  v.hysteresis_weights = hysteresis != nullptr ? hysteresis + hysteresis_values : nullptr;
-  v.hysteresis_homing_lags = hysteresis != nullptr ? hysteresis + 2 * hysteresis_values : nullptr;
-  v.compliance_segments = compliance != nullptr ? static_cast<int>(compliance_segment_count) : 0;
-  v.compliance_weighted_gravity = compliance;
-  v.compliance_ratios = compliance != nullptr ? compliance + image_compliance_field::ratios : nullptr;
-  v.compliance_softening = compliance != nullptr ? v.compliance_ratios + compliance_segment_count : nullptr;
-  v.compliance_unloaded_mass = compliance != nullptr ? v.compliance_softening + 1 : nullptr;
-  v.dataset_hash = read_u64(metadata + image_metadata_field::dataset_hash);
-  v.created_unix_s = static_cast<std::int64_t>(read_u64(metadata + image_metadata_field::created_unix_s));
-  v.validation_samples = read_u32(metadata + image_metadata_field::validation_samples);
-  std::memcpy(&v.metrics, metadata + image_metadata_field::metrics, sizeof(ImageMetrics));
-  v.trainer = reinterpret_cast<const char*>(metadata + image_metadata_field::trainer);
-  view = v;
-  return Status::ok;
+  if (run.status != ImageStatus::ok) return run.status;
+  view = make_view(bytes, h, blocks, parameters, fitted);
+  return ImageStatus::ok;
 }
 }  // namespace detail
 
