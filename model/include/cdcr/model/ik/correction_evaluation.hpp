@@ -2,6 +2,7 @@
 // The corrections an IK solve evaluates: sliced ones (GpCorrection) as they
 // come, any other evaluated whole, as one unit (ik_solver.hpp).
 
+#include <cstdint>
 #include <type_traits>
 #include <utility>
 
@@ -99,5 +100,60 @@ struct WholeEvaluation {
 };
 
 }  // namespace detail
+
+namespace ik {
+
+// The correction evaluation in progress and its point: a sliced correction
+// evaluated as it comes, any other whole (detail::WholeEvaluation); none
+// bound: the nominal model.
+template <typename S, int Max, typename Correction>
+class CorrectionEvaluation {
+  static constexpr bool kSliced = is_sliced_correction<Correction>::value;
+  using Evaluator = std::conditional_t<kSliced, Correction, detail::WholeEvaluation<S, Max, Correction>>;
+
+ public:
+  using Joints = JointVector<S, Max>;
+  static constexpr bool kOffersGradient = kSliced || detail::WholeEvaluation<S, Max, Correction>::kHasGradient;
+
+  void bind(const Correction* correction) {
+    if (correction == nullptr) {
+      evaluator_ = nullptr;
+    } else if constexpr (kSliced) {
+      evaluator_ = correction;
+    } else {
+      whole_.correction = correction;
+      evaluator_ = &whole_;
+    }
+  }
+  bool bound() const { return evaluator_ != nullptr; }
+
+  Status begin(const Joints& bend, bool with_gradient) {
+    point_ = bend;
+    return evaluator_->begin_evaluation(point_, evaluation_, with_gradient);
+  }
+  // Goes on within max_units; returns the units spent. A whole evaluation
+  // counts one unit, and reports its failure in `status`.
+  std::uint32_t advance(std::uint32_t max_units, Status& status) {
+    if constexpr (kSliced) {
+      return evaluator_->continue_evaluation(evaluation_, max_units);
+    } else {
+      (void)max_units;
+      status = whole_.finish(evaluation_);
+      return 1;
+    }
+  }
+  bool finished() const { return evaluator_->evaluation_finished(evaluation_); }
+  bool has_gradient() const { return evaluator_->evaluation_has_gradient(evaluation_); }
+  void result(Twist<S>& eps, Jacobian<S, Max>& gradient) const { evaluator_->evaluation_result(evaluation_, eps, gradient); }
+  const Joints& point() const { return point_; }
+
+ private:
+  const Evaluator* evaluator_ = nullptr;
+  detail::WholeEvaluation<S, Max, Correction> whole_{};
+  typename Evaluator::Evaluation evaluation_{};
+  Joints point_;
+};
+
+}  // namespace ik
 
 }  // namespace cdcr::model
