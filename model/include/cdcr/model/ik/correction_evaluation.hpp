@@ -144,7 +144,9 @@ class CorrectionEvaluation {
   }
   bool finished() const { return evaluator_->evaluation_finished(evaluation_); }
   bool has_gradient() const { return evaluator_->evaluation_has_gradient(evaluation_); }
-  void result(Twist<S>& eps, Jacobian<S, Max>& gradient) const { evaluator_->evaluation_result(evaluation_, eps, gradient); }
+  void result(Twist<S>& eps, Jacobian<S, Max>& gradient) const {
+    evaluator_->evaluation_result(evaluation_, eps, gradient);
+  }
   const Joints& point() const { return point_; }
 
  private:
