@@ -11,7 +11,7 @@
 // this model's correction): the last outer iterations let the residual
 // wander at 2-3 um (2.1 -> 2.5 -> 3.5 um), and a stall rule that ends the
 // solve after two stalled iterations stops it a few um short. A third
-// iteration is allowed within 3 tolerances (ik_solver.hpp, outer_step).
+// iteration is allowed within 3 tolerances (ik/restarts.hpp, Restarts::stalled).
 //
 // Which targets end a few um short depends on the last bits of the float
 // arithmetic, so the counts differ from CPU to CPU: the image the build
