@@ -18,8 +18,8 @@
 // refuses the frame), check() (what the decoder must reject beyond
 // check_frame's identifier, length, reserved-bit and range checks) and get()
 // (write the field from a checked word). The encoder and decoder unroll over
-// the signals and inline every step, so a board runs the same instructions
-// a decoder written out per message would.
+// the fields and inline every step, as a codec written out per message
+// would: a board pays nothing for the table walk.
 
 #include <array>
 #include <cstddef>
@@ -58,8 +58,8 @@ struct MemberOf<Type Frame::*> {
 // Every raw value the signal can carry fits a field of type Field.
 template <typename Field>
 constexpr bool holds_raw_range(const SignalSpec& signal) {
-  using Value = std::conditional_t<std::is_enum_v<Field>, std::underlying_type<Field>, std::common_type<Field>>;
-  using Limits = std::numeric_limits<typename Value::type>;
+  using Integer = std::conditional_t<std::is_enum_v<Field>, std::underlying_type<Field>, std::common_type<Field>>;
+  using Limits = std::numeric_limits<typename Integer::type>;
   return signal.raw_minimum >= std::int64_t{Limits::min()} && signal.raw_maximum <= std::int64_t{Limits::max()};
 }
 
