@@ -3,8 +3,8 @@
 // DLC, sender and receiver, each signal's bits, scaling, range and unit, the
 // value tables of the enums, the acceptance filter of each frame group, and
 // the comments of the DBC file. This is the protocol's only description:
-// frames.hpp encodes and decodes the messages from it, and the build writes
-// the DBC file for candump/cantools users from it
+// frame_codec.hpp encodes and decodes the messages from it, and the build
+// writes the DBC file for candump/cantools users from it
 // (firmware/protocol/write_dbc.cpp, into <build>/firmware/protocol/cdcr.dbc).
 // host_tests/firmware/protocol_golden_frames_test.cpp holds a frame of every
 // message written out by hand, so a wrong start bit or scale here fails.
