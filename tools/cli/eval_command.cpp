@@ -99,7 +99,9 @@ struct EvalInputs {
 };
 
 EvalInputs load_eval_inputs(const EvalCommandOptions& o) {
-  EvalInputs in{load_image(o.model_path), load_dataset(o.data_path, true)};
+  EvalInputs in;
+  in.image = load_image(o.model_path);
+  in.data = load_dataset(o.data_path, true);
   const dataset::Dataset& data = in.data;
   if (const model::Status s = model::geometry_from_image(in.image.view, in.geometry); s != model::Status::ok) {
     throw InputError(fmt::format("{}: geometry: {}", o.model_path, model::to_string(s)));
