@@ -1204,21 +1204,25 @@ ImageBlocks locate_blocks(const std::uint8_t* bytes, std::size_t size, const Dec
   return b;
 }
 
+// A named run of the payload's floats (name nullptr in the firmware's run,
+// which reports no names), for the checks that walk several.
+struct NamedFloats {
+  const char* name;
+  const float* values;
+  std::uint32_t count;
+};
+
 // No NaN or Inf in the payload; the verdict is the scan's where it covers
 // a block.
 template <typename Run>
 bool check_finite(Run& run, const ImageBlocks& b, const DeclaredImage& h, const ImageScan* scan) {
   const std::uint32_t n = h.points;
-  const struct {
-    const char* name;
-    const float* values;
-    std::uint32_t count;
-  } payload[] = {{Run::name("geometry"), b.geometry, 3 * h.segments},
-                 {Run::name("parameters"), b.parameters, image_parameter_floats(h.input_dims, h.major, h.extra)},
-                 {Run::name("inputs"), b.inputs, n * h.input_dims},
-                 {Run::name("alpha"), b.alpha, n * kImageOutputs},
-                 {Run::name("variance"), b.variance,
-                  static_cast<std::uint32_t>(image_variance_floats(h.rank, h.input_dims))}};
+  const NamedFloats payload[] = {
+      {Run::name("geometry"), b.geometry, 3 * h.segments},
+      {Run::name("parameters"), b.parameters, image_parameter_floats(h.input_dims, h.major, h.extra)},
+      {Run::name("inputs"), b.inputs, n * h.input_dims},
+      {Run::name("alpha"), b.alpha, n * kImageOutputs},
+      {Run::name("variance"), b.variance, static_cast<std::uint32_t>(image_variance_floats(h.rank, h.input_dims))}};
   for (const auto& values : payload) {
     bool finite = true;
     if (values.values != nullptr && scan != nullptr && scan->covers(values.values, values.count, finite)) {
@@ -1240,16 +1244,13 @@ bool check_finite(Run& run, const ImageBlocks& b, const DeclaredImage& h, const 
 template <typename Run>
 bool check_positive(Run& run, const ImageBlocks& b, const ImageParameterArrays& p, const DeclaredImage& h) {
   const std::uint32_t d = h.input_dims;
-  const struct {
-    const char* name;
-    const float* values;
-    std::uint32_t count;
-  } must_be_positive[] = {{Run::name("geometry"), b.geometry, 3 * h.segments},
-                          {Run::name("input_scale"), p.input_scale, d},
-                          {Run::name("length_scale"), p.length_scale, d},
-                          {Run::name("output_scale"), p.output_scale, kImageOutputs},
-                          {Run::name("signal_variance"), p.signal_variance, kImageOutputs},
-                          {Run::name("noise_variance"), p.noise_variance, kImageOutputs}};
+  const NamedFloats must_be_positive[] = {
+      {Run::name("geometry"), b.geometry, 3 * h.segments},
+      {Run::name("input_scale"), p.input_scale, d},
+      {Run::name("length_scale"), p.length_scale, d},
+      {Run::name("output_scale"), p.output_scale, kImageOutputs},
+      {Run::name("signal_variance"), p.signal_variance, kImageOutputs},
+      {Run::name("noise_variance"), p.noise_variance, kImageOutputs}};
   for (const auto& values : must_be_positive) {
     if (values.values != nullptr &&
         !expect_each(run, values.values, values.count, is_positive, ImageCheckId::positive,
