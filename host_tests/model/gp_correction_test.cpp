@@ -22,11 +22,7 @@ namespace {
 using BoundModel = test_support::SyntheticImage;
 
 BoundModel make_model(int segments, InputEncoding encoding, int training_points) {
-  test_support::SyntheticModelOptions options;
-  options.segments = segments;
-  options.encoding = encoding;
-  options.training_points = training_points;
-  return test_support::synthetic_image(options);
+  return test_support::synthetic_image(test_support::SyntheticModelOptions{training_points, segments, encoding});
 }
 
 // 2 to 4 segments take the fixed-size loops, 5 the general one; each in both
@@ -99,15 +95,12 @@ TEST_P(GpCorrectionSizes, FloatMeanAndGradientFollowDouble) {
   GpCorrection<float, double> correction;
   ASSERT_EQ(reference.bind(b.view), Status::ok);
   ASSERT_EQ(correction.bind(b.view), Status::ok);
-  const Eigen::MatrixXd expected_mean = [&] {
-    std::mt19937 rng(5);
-    Eigen::MatrixXd bends(30, 2 * segments);
-    for (int q = 0; q < 30; ++q) bends.row(q) = random_bend(segments, rng).transpose();
-    return training::predict_error_twists(b.trained, bends);
-  }();
   std::mt19937 rng(5);
-  for (int q = 0; q < 30; ++q) {
-    const JointVector<double> bend = random_bend(segments, rng);
+  Eigen::MatrixXd bends(30, 2 * segments);
+  for (int q = 0; q < bends.rows(); ++q) bends.row(q) = random_bend(segments, rng).transpose();
+  const Eigen::MatrixXd expected_mean = training::predict_error_twists(b.trained, bends);
+  for (int q = 0; q < bends.rows(); ++q) {
+    const JointVector<double> bend = bends.row(q).transpose();
     Twist<double> eps;
     Jacobian<double> gradient;
     ASSERT_EQ(reference(bend, eps, gradient), Status::ok);

@@ -138,17 +138,17 @@ struct ChoiceSetup {
                                                    with_mass.unloaded_mass = true;
                                                    return with_mass;
                                                  }()};
+
+  ComplianceChoice choose(const dataset::Dataset& recording) const {
+    return choose_compliance(make_training_set(recording, design, model::InputEncoding::bend_vector), design, options,
+                             structures);
+  }
 };
 
 TEST(ComplianceIdentification, TheChoiceTakesTheSagWhereThereIsOneAndNoneWhereThereIsNot) {
   const ChoiceSetup setup;
-  const auto& design = setup.design;
-  const auto& options = setup.options;
-  const auto& structures = setup.structures;
-
-  sim::SimulatedRobot sagging(design, gravity_only());
-  const TrainingSet loaded = make_training_set(recorded(sagging, 80, true), design, model::InputEncoding::bend_vector);
-  const ComplianceChoice with_sag = choose_compliance(loaded, design, options, structures);
+  sim::SimulatedRobot sagging(setup.design, gravity_only());
+  const ComplianceChoice with_sag = setup.choose(recorded(sagging, 80, true));
   ASSERT_TRUE(with_sag.attempted);
   EXPECT_FALSE(with_sag.model.empty());
   EXPECT_TRUE(with_sag.structure.unloaded_mass);
@@ -159,10 +159,8 @@ TEST(ComplianceIdentification, TheChoiceTakesTheSagWhereThereIsOneAndNoneWhereTh
   sim::SimulatorConfig still = gravity_only();
   still.gravity.enabled = false;
   still.mocap_noise.enabled = true;
-  sim::SimulatedRobot rigid(design, still);
-  const TrainingSet unloaded =
-      make_training_set(recorded(rigid, 80, true, true), design, model::InputEncoding::bend_vector);
-  const ComplianceChoice without_sag = choose_compliance(unloaded, design, options, structures);
+  sim::SimulatedRobot rigid(setup.design, still);
+  const ComplianceChoice without_sag = setup.choose(recorded(rigid, 80, true, true));
   ASSERT_TRUE(without_sag.attempted);
   EXPECT_TRUE(without_sag.model.empty());
 }
@@ -172,15 +170,10 @@ TEST(ComplianceIdentification, TheChoiceTakesTheSagWhereThereIsOneAndNoneWhereTh
 // has. That candidate is reported, but the choice falls on a plausible one.
 TEST(ComplianceIdentification, AnImplausibleCandidateIsNeverChosenHoweverWellItFits) {
   const ChoiceSetup setup;
-  const auto& design = setup.design;
-  const auto& options = setup.options;
-  const auto& structures = setup.structures;
-
-  sim::SimulatedRobot sagging(design, gravity_only());
+  sim::SimulatedRobot sagging(setup.design, gravity_only());
   dataset::Dataset data = recorded(sagging, 80, true);
   data.payload_kg.array() += 0.5;
-  const TrainingSet set = make_training_set(data, design, model::InputEncoding::bend_vector);
-  const ComplianceChoice choice = choose_compliance(set, design, options, structures);
+  const ComplianceChoice choice = setup.choose(data);
   ASSERT_TRUE(choice.attempted);
   ASSERT_EQ(choice.candidates.size(), 3u);
   const ComplianceCandidate& negative_mass = choice.candidates[2];
