@@ -10,6 +10,7 @@
 // the outcome of every check it can evaluate, which is how `cdcr inspect`
 // shows all that is wrong with an image rather than only the first thing.
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -643,6 +644,23 @@ bool expect_each(Run& run, const float* values, std::uint32_t count, Good good, 
   return true;
 }
 
+// A named run of the payload's floats (name nullptr in the firmware's run,
+// which reports no names), for the checks that walk several.
+struct NamedFloats {
+  const char* name;
+  const float* values;
+  std::uint32_t count;
+};
+
+// A named run's values against `good`; nothing to check where the image
+// has no such run.
+template <typename Run, typename Good>
+bool expect_each(Run& run, const NamedFloats& named, Good good, ImageCheckId check, ImageStatus failure,
+                 ImageExpectation expectation) {
+  return named.values == nullptr ||
+         expect_each(run, named.values, named.count, good, check, failure, named.name, expectation);
+}
+
 inline bool is_finite(float value) { return std::isfinite(value); }
 inline bool is_positive(float value) { return value > 0.0f; }
 
@@ -1204,14 +1222,6 @@ ImageBlocks locate_blocks(const std::uint8_t* bytes, std::size_t size, const Dec
   return b;
 }
 
-// A named run of the payload's floats (name nullptr in the firmware's run,
-// which reports no names), for the checks that walk several.
-struct NamedFloats {
-  const char* name;
-  const float* values;
-  std::uint32_t count;
-};
-
 // No NaN or Inf in the payload; the verdict is the scan's where it covers
 // a block.
 template <typename Run>
@@ -1232,9 +1242,8 @@ bool check_finite(Run& run, const ImageBlocks& b, const DeclaredImage& h, const 
       }
       continue;
     }
-    if (values.values != nullptr &&
-        !expect_each(run, values.values, values.count, is_finite, ImageCheckId::finite,
-                     ImageStatus::non_finite_payload, values.name, ImageExpectation::finite)) {
+    if (!expect_each(run, values, is_finite, ImageCheckId::finite, ImageStatus::non_finite_payload,
+                     ImageExpectation::finite)) {
       return false;
     }
   }
@@ -1251,14 +1260,10 @@ bool check_positive(Run& run, const ImageBlocks& b, const ImageParameterArrays& 
       {Run::name("output_scale"), p.output_scale, kImageOutputs},
       {Run::name("signal_variance"), p.signal_variance, kImageOutputs},
       {Run::name("noise_variance"), p.noise_variance, kImageOutputs}};
-  for (const auto& values : must_be_positive) {
-    if (values.values != nullptr &&
-        !expect_each(run, values.values, values.count, is_positive, ImageCheckId::positive,
-                     ImageStatus::invalid_parameters, values.name, ImageExpectation::positive)) {
-      return false;
-    }
-  }
-  return true;
+  return std::all_of(std::begin(must_be_positive), std::end(must_be_positive), [&run](const NamedFloats& values) {
+    return expect_each(run, values, is_positive, ImageCheckId::positive, ImageStatus::invalid_parameters,
+                       ImageExpectation::positive);
+  });
 }
 
 // v2: input_min <= input_max, and a payload's default is not negative (it is

@@ -65,7 +65,6 @@
 #include "cdcr/model/ik/linearisation.hpp"
 #include "cdcr/model/ik/lm_solve.hpp"
 #include "cdcr/model/ik/options.hpp"
-#include "cdcr/model/ik/preference.hpp"
 #include "cdcr/model/ik/problem.hpp"
 #include "cdcr/model/ik/restarts.hpp"
 #include "cdcr/model/ik/solve_flow.hpp"

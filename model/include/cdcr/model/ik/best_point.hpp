@@ -34,10 +34,9 @@ struct BestPoint {
   void keep(const Joints& point, const Twist<S>& eps, const Pose<S>& tip, S point_cost, S point_position_error,
             S point_orientation_error) {
     cost = point_cost;
-    bend = point;
     position_error = point_position_error;
     orientation_error = point_orientation_error;
-    warm_bend = point;
+    bend = warm_bend = point;
     warm_eps = eps;
     warm_tip = tip;
   }
