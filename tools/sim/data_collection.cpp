@@ -5,7 +5,6 @@
 
 #include <cdcr/model/chain.hpp>
 #include <cdcr/model/hysteresis.hpp>
-#include <cdcr/model/pose_error_summary.hpp>
 
 #include "sim/random_stream.hpp"
 
@@ -127,9 +126,7 @@ CollectionSummary summarize(const std::vector<CollectedSample>& samples) {
   if (summary.sequence) {
     std::vector<model::Pose<double>> frictionless;
     for (const CollectedSample& s : samples) frictionless.push_back(s.frictionless_pose);
-    const model::PoseErrorSummary e = model::summarize_pose_errors(frictionless.data(), truth.data(), truth.size());
-    summary.hysteresis = HysteresisEffect{e.mean_position_mm, e.max_position_mm, e.mean_orientation_deg,
-                                          e.max_orientation_deg};
+    summary.hysteresis = model::summarize_pose_errors(frictionless.data(), truth.data(), truth.size());
   }
   return summary;
 }

@@ -12,6 +12,7 @@
 
 #include <vector>
 
+#include <cdcr/model/pose_error_summary.hpp>
 #include <cdcr/model/se3.hpp>
 #include <cdcr/model/types.hpp>
 
@@ -39,21 +40,14 @@ struct MeanPoseError {
   double orientation_deg = 0.0;
 };
 
-// How far the hysteresis moves the tip: the true pose against the true pose
-// of the same commanded cables without it.
-struct HysteresisEffect {
-  double mean_position_mm = 0.0;
-  double max_position_mm = 0.0;
-  double mean_orientation_deg = 0.0;
-  double max_orientation_deg = 0.0;
-};
-
 struct CollectionSummary {
   int samples = 0;
   MeanPoseError initial;      // nominal pose vs. measured pose (Table 2)
   MeanPoseError noise_floor;  // true pose vs. measured pose: what no model can remove
   bool sequence = false;      // a motion sequence (hysteresis on): `hysteresis` is set
-  HysteresisEffect hysteresis;
+  // How far the hysteresis moves the tip: the true pose against the true
+  // pose of the same commanded cables without it.
+  model::PoseErrorSummary hysteresis;
 };
 
 // The homing move of model::homing_waypoints for the robot's nominal

@@ -26,16 +26,22 @@ void openblas_set_num_threads(int threads);
 
 namespace cdcr::training::lapack {
 
-// Lower Cholesky factor of the lower triangle of a, in place (the strict
-// upper triangle is left alone). info > 0: the leading minor of that order
-// is not positive definite.
-inline int cholesky_lower(Eigen::Ref<Eigen::MatrixXd> a) {
+namespace detail {
+// dpotrf_ and dpotri_: the lower triangle of a square matrix, in place.
+using InPlaceLowerRoutine = void(const char*, const int*, double*, const int*, int*, std::size_t);
+inline int in_place_lower(InPlaceLowerRoutine routine, Eigen::Ref<Eigen::MatrixXd> a) {
   const int n = static_cast<int>(a.rows());
   const int lda = static_cast<int>(a.outerStride());
   int info = 0;
-  dpotrf_("L", &n, a.data(), &lda, &info, 1);
+  routine("L", &n, a.data(), &lda, &info, 1);
   return info;
 }
+}  // namespace detail
+
+// Lower Cholesky factor of the lower triangle of a, in place (the strict
+// upper triangle is left alone). info > 0: the leading minor of that order
+// is not positive definite.
+inline int cholesky_lower(Eigen::Ref<Eigen::MatrixXd> a) { return detail::in_place_lower(dpotrf_, a); }
 
 // b <- (L L^T)^-1 b for the lower factor l.
 inline int cholesky_solve_lower(const Eigen::Ref<const Eigen::MatrixXd>& l, Eigen::Ref<Eigen::MatrixXd> b) {
@@ -49,13 +55,7 @@ inline int cholesky_solve_lower(const Eigen::Ref<const Eigen::MatrixXd>& l, Eige
 }
 
 // The lower factor l of K, in place, to the lower triangle of K^-1.
-inline int inverse_from_cholesky_lower(Eigen::Ref<Eigen::MatrixXd> l) {
-  const int n = static_cast<int>(l.rows());
-  const int lda = static_cast<int>(l.outerStride());
-  int info = 0;
-  dpotri_("L", &n, l.data(), &lda, &info, 1);
-  return info;
-}
+inline int inverse_from_cholesky_lower(Eigen::Ref<Eigen::MatrixXd> l) { return detail::in_place_lower(dpotri_, l); }
 
 // c <- a b (general dense product).
 inline void multiply(const Eigen::Ref<const Eigen::MatrixXd>& a, const Eigen::Ref<const Eigen::MatrixXd>& b,
