@@ -1,7 +1,8 @@
 # Shared part of the arm-none-eabi toolchain files. The including file sets
-# CDCR_CORTEXM_CPU (the -mcpu value), CDCR_CORTEXM_FPU (the -mfpu value) and
-# CDCR_CORTEXM_BOARD (the QEMU machine the startup code targets) first; it also
-# sets CDCR_MODEL_ARCH, the GP loops' architecture code that model/ selects.
+# CDCR_ARM_CPU (the -mcpu value), CDCR_ARM_FPU (the -mfpu value) and
+# CDCR_BOARD (the QEMU machine, and with it the board, the start-up code
+# targets) first; it also sets CDCR_MODEL_ARCH, the GP loops' architecture
+# code that model/ selects.
 set(CMAKE_SYSTEM_NAME Generic)
 set(CMAKE_SYSTEM_PROCESSOR arm)
 
@@ -17,9 +18,9 @@ set(CMAKE_NM arm-none-eabi-nm CACHE FILEPATH "")
 # script, which the project itself provides.
 set(CMAKE_TRY_COMPILE_TARGET_TYPE STATIC_LIBRARY)
 
-set(CDCR_CORTEXM_BOARD ${CDCR_CORTEXM_BOARD} CACHE STRING "QEMU machine the Cortex-M startup code targets")
+set(CDCR_BOARD ${CDCR_BOARD} CACHE STRING "QEMU machine (board) the start-up code targets: mps2-an500, mps2-an386, xlnx-zcu102")
 
-set(_cdcr_arch_flags "-mcpu=${CDCR_CORTEXM_CPU} -mthumb -mfpu=${CDCR_CORTEXM_FPU} -mfloat-abi=hard")
+set(_cdcr_arch_flags "-mcpu=${CDCR_ARM_CPU} -mthumb -mfpu=${CDCR_ARM_FPU} -mfloat-abi=hard")
 # No exceptions, RTTI or atexit registration on the target; -fno-math-errno
 # lets sqrtf compile to one instruction instead of a libm call.
 set(_cdcr_common_flags "${_cdcr_arch_flags} -fno-math-errno -ffunction-sections -fdata-sections")

@@ -4,11 +4,9 @@
 # newlib as the Cortex-M boards. C and C++ compile to Thumb-2 (the common
 # file's -mthumb), which the R5 runs as well as ARM code; the exception
 # vectors and the start-up are ARM-state assembly (hal/zynqmp/src/vectors.S).
-# The common file's variable names say CORTEXM because it served the
-# M-profile boards first; they carry the R5F's values unchanged.
-set(CDCR_CORTEXM_CPU cortex-r5)
-set(CDCR_CORTEXM_FPU vfpv3-d16)
-set(CDCR_CORTEXM_BOARD xlnx-zcu102)
+set(CDCR_ARM_CPU cortex-r5)
+set(CDCR_ARM_FPU vfpv3-d16)
+set(CDCR_BOARD xlnx-zcu102)
 # The GP loops' architecture code: the portable loops until the R5F's own
 # are measured (the fpv4 and fpv5 codes are tuned on M-profile pipelines).
 set(CDCR_MODEL_ARCH portable CACHE STRING "Architecture code of the GP loops: portable, fpv4 or fpv5")

@@ -1,6 +1,6 @@
 # The installed package: `cmake --install <build> --prefix <prefix>` puts
 #   include/cdcr/...                       the C header cdcr/cdcr.h and the C++ headers
-#   lib/libcdcr_runtime.a, libcdcr_firmware.a, libcdcr_callbacks.a
+#   lib/libcdcr_c_api.a, libcdcr_firmware.a, libcdcr_callbacks.a
 #   lib/cdcr/...                           (cross builds) the MPS2 board's startup objects
 #   lib/cmake/cdcr/cdcrConfig.cmake, ...   the package find_package(cdcr) reads
 #   share/cdcr/toolchains/*                the toolchain files a cross consumer configures with

@@ -4,7 +4,7 @@
 #   1. install cdcr under WORK_DIR/prefix from the build BUILD_DIR as it is:
 #      the host build, or with TOOLCHAIN a cross build of the tree made with
 #      that toolchain file (the QEMU tests' own, which has built the
-#      libraries that install: cdcr_runtime, cdcr_cortexm, cdcr_mps2);
+#      libraries that install: cdcr_c_api, cdcr_cortexm, cdcr_mps2);
 #   2. export the model image as C with `cdcr export --format c` (MODEL_IMAGE,
 #      or one trained here on a small simulated data set);
 #   3. configure firmware/examples/c_main_loop out of tree against the prefix
