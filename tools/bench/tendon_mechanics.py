@@ -15,13 +15,17 @@ segment m) and is fixed to the end disk of segment i.
     length is the commanded (effective) length less pretension / k, so the
     straight command holds every cable at its pretension; a cable with
     negative stretch is slack and carries nothing.
-  - Capstan friction on the disks: the tension reaching the anchor, T_a,
-    sticks at its last value while T_d e^(-mu phi) <= T_a <= T_d e^(mu phi),
-    and slides to the nearer bound otherwise: T_a = T_d e^(-mu phi) after a
-    pull, T_d e^(mu phi) after a release. phi is the angle the cable wraps,
-    phi_0 (the entry guide) plus the bends of every segment it runs
-    through. The history's size grows with the tension and the bend; mu = 0
-    is no friction.
+  - Capstan friction along the disks: the cable wraps phi_0 at its entry
+    guide and theta_m / n_m at each of the n_m disks of every segment m it
+    runs through. At each wrap w the tension beyond it, T_out, sticks at its
+    last value while T_in e^(-mu w) <= T_out <= T_in e^(mu w) and slides to
+    the nearer bound otherwise, from the drive (T_in = T_d) to the anchor
+    (T_a, the last). A long pull leaves T_a = T_d e^(-mu phi), a long
+    release T_d e^(mu phi), phi = phi_0 + the bends passed; T_a moves only
+    once T_d leaves [T_a e^(-mu phi), T_a e^(mu phi)]; a short reversal
+    turns only the disks near the drive, so the state remembers more than
+    the direction of the last move. The history's size grows with the
+    tension and the bend; mu = 0 is no friction.
   - Equilibrium, per segment: the backbone's bending stiffness against the
     moment of every tension crossing it on its anchor radius, and its axial
     stiffness against their sum,
@@ -73,6 +77,9 @@ class Tendons:
         self.wrap0 = float(wrap0_rad)
         self.spans = spans
         self.u = np.stack([np.cos(self.anchor_rad), np.sin(self.anchor_rad)], axis=-1)
+        # The wraps along a cable: the entry, then the disks of each segment in turn.
+        self.disks = [1 if spans is None else int(spans)] * self.segments
+        self.stages = 1 + sum(self.disks)
 
     def straight_paths(self):
         """Each cable's path when every segment is straight and uncompressed: sum of L_m up to its segment."""
@@ -100,23 +107,39 @@ class Tendons:
             dpath_ddelta[m] = -s
         return paths, dpath_db, dpath_ddelta, bends
 
-    def tensions(self, x, rest_mm, anchor_before=None):
-        """Drive and anchor tensions (segments x cables) in state x; anchor_before None means no friction
-        history (the anchor tension is the drive's: mu must then be 0 or the call is the first)."""
+    def wraps(self, bends):
+        """The angle each cable wraps at each stage (segments x cables x stages): phi_0, then theta_m / n_m per
+        disk of every segment m up to the cable's own, zero beyond it."""
+        out = np.zeros((self.segments, self.cables, self.stages))
+        out[:, :, 0] = self.wrap0
+        first = 1
+        for m in range(self.segments):
+            out[m:, :, first:first + self.disks[m]] = bends[m] / self.disks[m]
+            first += self.disks[m]
+        return out
+
+    def tensions(self, x, rest_mm, before=None):
+        """Drive tensions (segments x cables) and the tension beyond every stage (segments x cables x stages;
+        the last is the anchor's) in state x. before: the stages' tensions of the friction's last state (None:
+        no history, the drive's tension everywhere)."""
         paths, _, _, bends = self._geometry(x)
         stretch = np.cumsum(paths, axis=0) - rest_mm
         drive = self.k * np.maximum(0.0, stretch)
-        if anchor_before is None:
-            return drive, drive.copy()
-        wrap = self.wrap0 + np.cumsum(bends)[:, None]
-        ratio = np.exp(self.mu * wrap)
-        return drive, np.clip(anchor_before, drive / ratio, drive * ratio)
+        stages = np.repeat(drive[:, :, None], self.stages, axis=2)
+        if before is None:
+            return drive, stages
+        ratio = np.exp(self.mu[:, :, None] * self.wraps(bends))
+        inside = drive
+        for st in range(self.stages):
+            inside = np.clip(before[:, :, st], inside / ratio[:, :, st], inside * ratio[:, :, st])
+            stages[:, :, st] = inside
+        return drive, stages
 
-    def residual(self, x, rest_mm, anchor_before=None):
+    def residual(self, x, rest_mm, before=None):
         """The force balance per segment: bending (N mm, 2) and axial (N)."""
         x = x.reshape(self.segments, 3)
         _, dpath_db, dpath_ddelta, _ = self._geometry(x)
-        _, anchor = self.tensions(x, rest_mm, anchor_before)
+        anchor = self.tensions(x, rest_mm, before)[1][:, :, -1]
         # The tension crossing segment m at angle j: every cable of segment m or beyond.
         crossing = np.cumsum(anchor[::-1], axis=0)[::-1]
         out = np.empty((self.segments, 3))
@@ -132,12 +155,13 @@ class Tendons:
         return float(0.5 * np.sum(self.bending * bends ** 2) + 0.5 * np.sum(self.axial * x[:, 2] ** 2)
                      + 0.5 * np.sum(self.k * stretch ** 2))
 
-    def solve(self, rest_mm, start=None, anchor_before=None):
-        """The equilibrium for the rest lengths: state (segments x 3: bend vector, compression) and the anchor
-        tensions there. start is the guess (straight by default); anchor_before the friction's state."""
+    def solve(self, rest_mm, start=None, before=None):
+        """The equilibrium for the rest lengths: the state (segments x 3: bend vector, compression) and the
+        tensions beyond every stage there (segments x cables x stages, the anchor's last: the friction's next
+        state). start is the guess (straight by default); before the friction's state (None: none)."""
         rest_mm = np.asarray(rest_mm, dtype=float)
         x = np.zeros(3 * self.segments) if start is None else np.array(start, dtype=float).ravel()
-        f = self.residual(x, rest_mm, anchor_before)
+        f = self.residual(x, rest_mm, before)
         norm = np.linalg.norm(f)
         for _ in range(NEWTON_ITERATIONS):
             if norm < NEWTON_TOLERANCE:
@@ -146,7 +170,7 @@ class Tendons:
             for c in range(x.size):
                 step = np.zeros_like(x)
                 step[c] = JACOBIAN_STEP
-                jacobian[:, c] = (self.residual(x + step, rest_mm, anchor_before) - f) / JACOBIAN_STEP
+                jacobian[:, c] = (self.residual(x + step, rest_mm, before) - f) / JACOBIAN_STEP
             try:
                 dx = -np.linalg.solve(jacobian, f)
             except np.linalg.LinAlgError:
@@ -154,7 +178,7 @@ class Tendons:
             scale = 1.0
             while True:
                 trial = x + scale * dx
-                f_trial = self.residual(trial, rest_mm, anchor_before)
+                f_trial = self.residual(trial, rest_mm, before)
                 if np.linalg.norm(f_trial) < norm or scale < 1e-6:
                     break
                 scale *= 0.5
@@ -163,4 +187,4 @@ class Tendons:
             if norm > 1e-6:
                 raise RuntimeError("tendon equilibrium does not converge (residual {:.3g})".format(norm))
         x = x.reshape(self.segments, 3)
-        return x, self.tensions(x, rest_mm, anchor_before)[1]
+        return x, self.tensions(x, rest_mm, before)[1]

@@ -345,7 +345,8 @@ class TendonStatics(unittest.TestCase):
                 for pair in ((0, 2), (1, 3)):
                     rest = np.full((1, 4), L + 50.0)
                     rest[0, list(pair)] = L - e
-                    state, tension = tendons(spans).solve(rest)
+                    state, stages = tendons(spans).solve(rest)
+                    tension = stages[:, :, -1]
                     np.testing.assert_allclose(state[0, :2], 0.0, atol=1e-9)
                     self.assertAlmostEqual(state[0, 2], 2.0 * K * e / (KA + 2.0 * K), delta=1e-9)
                     np.testing.assert_allclose(tension[0, list(pair)], K * (e - state[0, 2]), rtol=1e-9)
@@ -358,7 +359,8 @@ class TendonStatics(unittest.TestCase):
             for e in (1.0, 6.0, 13.0):
                 rest = np.full((1, 4), L + 50.0)
                 rest[0, j] = L - e
-                state, tension = tendons().solve(rest)
+                state, stages = tendons().solve(rest)
+                tension = stages[:, :, -1]
                 t = K * e / (1.0 + K / KA + K * R * R / KB)
                 theta = math.hypot(*state[0, :2])
                 self.assertAlmostEqual(theta, t * R / KB, delta=1e-9)
@@ -411,7 +413,8 @@ class TendonStatics(unittest.TestCase):
         slack = np.full((1, 4), L + 50.0)
         pulled = slack.copy()
         pulled[0, 0] = L - 10.0
-        state, anchor = t.solve(pulled, anchor_before=np.zeros((1, 4)))
+        state, stages = t.solve(pulled, before=np.zeros((1, 4, t.stages)))
+        anchor = stages[:, :, -1]
         theta = math.hypot(*state[0, :2])
 
         def drive(state, rest):
@@ -425,11 +428,11 @@ class TendonStatics(unittest.TestCase):
         threshold = L - state[0, 2] - R * theta - anchor[0, 0] * math.exp(-mu * (wrap0 + theta)) / K
         inside = pulled.copy()
         inside[0, 0] = threshold - 1e-4
-        stuck, stuck_anchor = t.solve(inside, state, anchor)
+        stuck, _ = t.solve(inside, state, stages)
         np.testing.assert_allclose(stuck, state, atol=1e-9)
         beyond = pulled.copy()
         beyond[0, 0] = threshold + 0.5
-        released, released_anchor = t.solve(beyond, state, anchor)
+        released, _ = t.solve(beyond, state, stages)
         theta2 = math.hypot(*released[0, :2])
         self.assertLess(theta2, theta - 1e-3)
         # After the release the anchor keeps e^(+mu phi) of the drive.
@@ -439,6 +442,26 @@ class TendonStatics(unittest.TestCase):
         free, _ = tendons().solve(beyond)
         self.assertGreater(theta2, math.hypot(*free[0, :2]))
         self.assertLess(math.hypot(*free[0, :2]), theta)
+
+    def test_a_short_release_turns_the_entry_before_the_anchor(self):
+        mu, wrap0 = 0.15, 0.3
+        t = tendons(mu=mu, wrap0=wrap0, spans=8)
+        pulled = np.full((1, 4), L + 50.0)
+        pulled[0, 0] = L - 10.0
+        state, stages = t.solve(pulled, before=np.zeros((1, 4, t.stages)))
+        drive = stages[0, 0, 0] * math.exp(mu * wrap0)
+        cable_path = pulled[0, 0] + drive / K
+        # The entry's band: its tension turns once the drive falls below it times e^(-mu phi_0).
+        for factor, turned in ((1.0 + 1e-6, False), (1.0 - 1e-3, True)):
+            released = pulled.copy()
+            released[0, 0] = cable_path - stages[0, 0, 0] * math.exp(-mu * wrap0) * factor / K
+            after, after_stages = t.solve(released, state, stages)
+            np.testing.assert_allclose(after, state, atol=1e-9)
+            self.assertEqual(after_stages[0, 0, -1], stages[0, 0, -1])
+            self.assertEqual(after_stages[0, 0, 0] < stages[0, 0, 0] - 1e-9, turned)
+            if turned:
+                self.assertAlmostEqual(after_stages[0, 0, 0], (cable_path - released[0, 0]) * K * math.exp(mu * wrap0),
+                                       delta=1e-9)
 
     def test_friction_history_grows_with_tension_and_bend(self):
         # The same command reached by a pull and by a release: the bends differ, more for a harder pull.
@@ -451,9 +474,9 @@ class TendonStatics(unittest.TestCase):
             before_pull[0, 0] += 2.0
             before_release = target.copy()
             before_release[0, 0] -= 2.0
-            s1, a1 = t.solve(before_pull, anchor_before=np.zeros((1, 4)))
+            s1, a1 = t.solve(before_pull, before=np.zeros((1, 4, t.stages)))
             s1, _ = t.solve(target, s1, a1)
-            s2, a2 = t.solve(before_release, anchor_before=np.zeros((1, 4)))
+            s2, a2 = t.solve(before_release, before=np.zeros((1, 4, t.stages)))
             s2, _ = t.solve(target, s2, a2)
             gaps.append(math.hypot(*s2[0, :2]) - math.hypot(*s1[0, :2]))
         self.assertGreater(gaps[0], 0.0)
