@@ -352,6 +352,27 @@ class TendonStatics(unittest.TestCase):
                     np.testing.assert_allclose(tension[0, list(pair)], K * (e - state[0, 2]), rtol=1e-9)
                     self.assertEqual(np.count_nonzero(tension), 2)
 
+    def test_the_straight_command_holds_every_cable_at_its_pretension_less_the_backbones_give(self):
+        # Four equal stretches T0 / k - delta: K_a delta = 4 (T0 - k delta), T = T0 K_a / (K_a + 4 k).
+        for spans in (None, 8):
+            t = tendons(spans)
+            state, stages = t.solve(t.rest_lengths(t.straight_paths()))
+            np.testing.assert_allclose(state[0, :2], 0.0, atol=1e-12)
+            self.assertAlmostEqual(state[0, 2], 4.0 * T0 / (KA + 4.0 * K), delta=1e-12)
+            np.testing.assert_allclose(stages[0, :, -1], T0 * KA / (KA + 4.0 * K), rtol=1e-9)
+
+    def test_span_factor_is_sin_x_over_x_and_its_derivative_through_its_series(self):
+        for spans in (1, 8):
+            for q in (0.0, 1e-4, 2.0 * spans * 0.99e-4, 2.0 * spans * 1.01e-4, 0.01, 0.7, 2.0):
+                s, ds = tendon_mechanics.span_factor(q, spans)
+                x = q / (2.0 * spans)
+                self.assertAlmostEqual(s, math.sin(x) / x if x > 0.0 else 1.0, delta=1e-13)
+                h = 1e-6
+                numeric = (tendon_mechanics.span_factor(q + h, spans)[0] - tendon_mechanics.span_factor(abs(q - h), spans)[0]) \
+                    / (2 * h) if q > 0.0 else 0.0
+                self.assertAlmostEqual(ds, numeric, delta=1e-9 + 1e-6 * abs(numeric))
+        self.assertEqual(tendon_mechanics.span_factor(0.5, None), (1.0, 0.0))
+
     def test_one_pulled_cable_with_three_slack_reaches_the_closed_form_curvature(self):
         # The continuous arc: path = L - delta - r theta; K_b theta = T r, K_a delta = T,
         # T = k (L - rest - delta - r theta): T = k e / (1 + k / K_a + k r^2 / K_b).
@@ -464,8 +485,9 @@ class TendonStatics(unittest.TestCase):
                                        delta=1e-9)
 
     def test_friction_history_grows_with_tension_and_bend(self):
-        # The same command reached by a pull and by a release: the bends differ, more for a harder pull.
-        t = tendons(mu=0.15, wrap0=0.3)
+        # The same command reached by a pull and by a release: the bends differ, more for a harder pull. No
+        # wrap at the entry: the band is the bend's alone.
+        t = tendons(mu=0.15, wrap0=0.0)
         gaps = []
         for e in (3.0, 6.0, 12.0):
             target = np.full((1, 4), L + 50.0)
