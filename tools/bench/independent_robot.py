@@ -411,7 +411,7 @@ PRETENSION_N = (0.8, 1.2)
 # Bending stiffness as K_b r^2 / L: the cables' lever against the backbone.
 BENDING_N_MM_PER_RAD_AT_LAB = (25.0, 35.0)
 AXIAL_N_PER_MM_AT_LAB = (2.5, 3.5)
-CAPSTAN_MU = (0.1, 0.2)
+CAPSTAN_MU = (0.15, 0.3)
 CAPSTAN_ENTRY_WRAP_RAD = 0.3
 SPACER_PITCH_MM = 8.0
 # The friction state follows every move in steps of at most this much cable travel.
@@ -419,7 +419,7 @@ TENSION_STEP_MM = 2.0
 # Bouc-Wen play on the drives of the real-like robot: the lab robot's servo
 # horns and cable ends, smaller than the four-segment robot's 0.3 to 0.9 mm.
 REAL_LIKE_LAG_MM = (0.1, 0.3)
-REAL_LIKE_REPEATABILITY_RAD = 0.006
+REAL_LIKE_REPEATABILITY_RAD = 0.007
 REAL_LIKE_COMPRESSION_NOISE_MM = 0.1
 TRACKER_POSITION_NOISE_MM = 0.15
 TRACKER_ORIENTATION_NOISE_DEG = 0.1
