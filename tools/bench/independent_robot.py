@@ -61,6 +61,60 @@ kilogram sags the straight robot's tip by 60 to 77 mm. The rows are then
 independent samples without cable friction, written as cables, payload_kg,
 pose (no t_s: the project takes no time column with a payload). Zero
 payload is the robot without one, bit for bit.
+
+The real-like robot (any of --preset, --mechanics, --segments, --length,
+--radius, --cables, --collection, --capstan-mu selects it; without them
+every file and figure above is unchanged, byte for byte): what makes a real
+robot's recordings hard.
+
+  - Geometry: --segments S (default 4), --length L and --radius r (default
+    110 and 60 mm), --cables 3 or 4 (default 4) at anchor angles
+    psi_j = -(j - 1) 360 deg / c (cable 1 towards alpha = 0; four cables are
+    eq. (2)'s); the CSV then has l<s>_1..l<s>_<c>. --preset lab-1seg is the
+    lab's robot: 1 segment, L = 64 mm, r = 8 mm, 4 cables, tension
+    mechanics. Errors as above, scaled to the size: segment length sigma
+    L / 110, anchor radius sigma 1 %, anchor angle sigma 2 deg, twist sigma
+    1 deg, mount and marker offsets; no sag.
+  - --mechanics lengths (default): the bend is the constant-curvature map of
+    the effective lengths. --mechanics tension: the bend and the backbone's
+    compression are the static equilibrium of tendon_mechanics.py (elastic
+    cables with pretension that go slack under negative stretch, a backbone
+    with bending and axial stiffness, cables straight between spacer disks
+    every 8 mm), solved numerically for every row. Per seed, at the lab's
+    size: cable stiffness k 1.6 to 2.4 N/mm per cable, pretension 0.8 to
+    1.2 N, bending stiffness 25 to 35 N mm/rad, axial 2.5 to 3.5 N/mm
+    (scaled with r^2 / L and 1 / L for other sizes, so k r^2 against the
+    bending stiffness stays the lab's); distal cables get the nominal path
+    through the segments before them added to their command.
+  - Friction with tension mechanics: capstan friction along the entry guide
+    (0.3 rad of wrap) and every spacer disk (its share of the bend), mu 0.15
+    to 0.3 per cable (--capstan-mu sets one for all; 0 turns it off): the
+    tension reaching the anchor lags the drive's by exp(-+mu phi) according
+    to the direction of each cable's last move, a history that grows with
+    tension and bend; followed along every move in steps of 2 mm of cable
+    travel. Beside it the Bouc-Wen play above on every drive, largest lags
+    0.1 to 0.3 mm (0.3 to 0.9 mm with lengths mechanics).
+    --no-hysteresis turns both off.
+  - Noise with tension mechanics: a repeatability of 0.007 rad per bend
+    component and 0.1 mm of compression, a tracker's 0.15 mm and 0.1 deg
+    per axis (with lengths mechanics 0.001 rad, 0.1 mm and 0.05 deg).
+  - --collection consistent (default): random configurations (alpha
+    uniform, theta uniform up to 0.2 rad x 60 / r, the four-segment robot's
+    12 mm of cable travel, at most 1.2 rad) visited in sequence, timed as
+    above. babbling: every cable's
+    displacement from its straight length uniform in +-D (--babble-mm,
+    default 13), independently, a row every 3.5 s, as the lab's motor
+    babbling. repeatability: straight and each pull of --repeat-pulls
+    (default 6,12 mm) in --repeat-directions directions (default 8; cable j
+    displaced by -p cos(beta - psi_j), the cable towards beta pulled, its
+    antagonist released), 17 commands, each reached --repeat-rounds times
+    (default 2) from every other one along a random walk that starts and
+    ends straight: 544 rows, a row every 3.5 s; --rows is then ignored.
+  - The figures add the share of rows bent beyond pi/2 by the
+    constant-curvature map of the commands, the spread of the pair sums
+    l1 + l3 and l2 + l4 (four cables), and for repeatability runs the
+    spread of the same command reached from the same previous one
+    (|p_a - p_b| / sqrt(2) over pairs of such visits).
 Only numpy; deterministic from the seed.
 """
 
@@ -513,9 +567,8 @@ class RealLikeRobot:
         self.orientation_noise_deg = scale * (TRACKER_ORIENTATION_NOISE_DEG if tension else 0.05)
         count = segments * cables
         self.friction_parameters = bouc_wen_parameters(rng, count, REAL_LIKE_LAG_MM if tension else (0.3, 0.9))
-        self.workspace_theta_max_rad = min(1.0, WORKSPACE_THETA_MAX_RAD * 110.0 / length_mm * radius_mm / 60.0) \
-            if (segments, length_mm, radius_mm) != (SEGMENTS, NOMINAL_LENGTH_MM, NOMINAL_RADIUS_MM) \
-            else WORKSPACE_THETA_MAX_RAD
+        # The same cable travel as the four-segment robot's workspace (12 mm), at most 1.2 rad.
+        self.workspace_theta_max_rad = min(1.2, WORKSPACE_THETA_MAX_RAD * NOMINAL_RADIUS_MM / radius_mm)
         self.tendons = self.frictionless = None
         if tension:
             t_rng = np.random.default_rng([seed, 3001])
