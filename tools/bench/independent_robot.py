@@ -96,7 +96,8 @@ robot's recordings hard.
     0.1 to 0.3 mm (0.3 to 0.9 mm with lengths mechanics).
     --no-hysteresis turns both off.
   - Noise with tension mechanics: a repeatability of 0.007 rad per bend
-    component and 0.1 mm of compression, a tracker's 0.15 mm and 0.1 deg
+    component at the lab's 64 mm (times 64 mm / (S L) for longer robots:
+    0.001 rad at 4 x 110 mm) and 0.1 mm of compression, a tracker's 0.15 mm and 0.1 deg
     per axis (with lengths mechanics 0.001 rad, 0.1 mm and 0.05 deg).
   - --collection consistent (default): random configurations (alpha
     uniform, theta uniform up to 0.2 rad x 60 / r, the four-segment robot's
@@ -561,7 +562,9 @@ class RealLikeRobot:
         self.base = transform(small_rotation(rng, scale * math.radians(0.7)), scale * size * rng.normal(0.0, 1.5, 3))
         self.marker = transform(small_rotation(rng, scale * math.radians(1.0)), scale * size * rng.normal(0.0, 1.0, 3))
         tension = mechanics == "tension"
-        self.repeatability_rad = scale * (REAL_LIKE_REPEATABILITY_RAD if tension else 0.001)
+        # The lab robot's repeatability at its 64 mm, in proportion for longer robots (0.001 rad at 4 x 110 mm).
+        self.repeatability_rad = scale * (REAL_LIKE_REPEATABILITY_RAD * 64.0 / (segments * length_mm) if tension
+                                          else 0.001)
         self.compression_noise_mm = scale * REAL_LIKE_COMPRESSION_NOISE_MM if tension else 0.0
         self.position_noise_mm = scale * (TRACKER_POSITION_NOISE_MM if tension else 0.1)
         self.orientation_noise_deg = scale * (TRACKER_ORIENTATION_NOISE_DEG if tension else 0.05)
