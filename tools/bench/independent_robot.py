@@ -471,6 +471,7 @@ CAPSTAN_ENTRY_WRAP_RAD = 0.3
 SPACER_PITCH_MM = 8.0
 # The friction state follows every move in steps of at most this much cable travel.
 TENSION_STEP_MM = 2.0
+TENSION_HALVINGS = 6
 # Bouc-Wen play on the drives of the real-like robot: the lab robot's servo
 # horns and cable ends, smaller than the four-segment robot's 0.3 to 0.9 mm.
 REAL_LIKE_LAG_MM = (0.1, 0.3)
@@ -684,12 +685,27 @@ class RealLikeMotion:
             return effective, self.state
         steps = max(1, int(math.ceil(np.abs(end_mm - start_mm).max() / TENSION_STEP_MM)))
         previous = start_mm
+        rest = r.rest_lengths(self.play.move(start_mm, start_mm) if self.play is not None else start_mm)
         for s in range(1, steps + 1):
             point = start_mm + (end_mm - start_mm) * s / steps
             effective = self.play.move(previous, point) if self.play is not None else point.copy()
             previous = point
-            self.state, self.anchor = r.tendons.solve(r.rest_lengths(effective), self.state, self.anchor)
+            following = r.rest_lengths(effective)
+            self._settle(rest, following)
+            rest = following
         return effective, self.state
+
+    def _settle(self, rest_from, rest_to, depth=0):
+        """The equilibrium at rest_to from the one at rest_from; where Newton's method stalls on a change of
+        stick and slip, the step in halves (at most TENSION_HALVINGS times)."""
+        try:
+            self.state, self.anchor = self.robot.tendons.solve(rest_to, self.state, self.anchor)
+        except RuntimeError:
+            if depth >= TENSION_HALVINGS:
+                raise
+            middle = 0.5 * (rest_from + rest_to)
+            self._settle(rest_from, middle, depth + 1)
+            self._settle(middle, rest_to, depth + 1)
 
     def without_friction(self, commanded_mm):
         """The state the same command reaches without play or capstan friction."""

@@ -34,7 +34,11 @@ segment m) and is fixed to the end disk of segment i.
     which for the continuous arc is K_b theta = r sum T_a cos(alpha - psi_j)
     and K_a delta = sum T_a; without friction it is the stationary point of
     the energy K_b theta^2 / 2 + K_a delta^2 / 2 + sum k max(0, stretch)^2 / 2.
-    Solved by damped Newton steps with a finite-difference Jacobian.
+    Solved by damped Newton steps with a finite-difference Jacobian; where
+    they stall on a disk between sticking and sliding, by the chord method
+    from the guess again (one Jacobian, damped steps). With friction the equilibria of one
+    command form a set (the band); the solver returns one of them, near the
+    last state.
 
 Only numpy.
 """
@@ -46,6 +50,9 @@ import numpy as np
 NEWTON_TOLERANCE = 1e-10
 NEWTON_ITERATIONS = 200
 JACOBIAN_STEP = 1e-7
+CHORD_STEP = 1e-4
+CHORD_DAMPING = 0.7
+CHORD_ITERATIONS = 20000
 
 
 def span_factor(q, spans):
@@ -155,12 +162,31 @@ class Tendons:
         return float(0.5 * np.sum(self.bending * bends ** 2) + 0.5 * np.sum(self.axial * x[:, 2] ** 2)
                      + 0.5 * np.sum(self.k * stretch ** 2))
 
+    def _chord(self, x, rest_mm, before):
+        """Where Newton's method stalls on a corner of the friction (a disk between sticking and sliding), the
+        chord method: damped steps with one Jacobian, by central differences across the corner."""
+        f = self.residual(x, rest_mm, before)
+        jacobian = np.empty((x.size, x.size))
+        for c in range(x.size):
+            step = np.zeros_like(x)
+            step[c] = CHORD_STEP
+            jacobian[:, c] = (self.residual(x + step, rest_mm, before) - self.residual(x - step, rest_mm, before)) \
+                / (2.0 * CHORD_STEP)
+        inverse = np.linalg.pinv(jacobian)
+        for _ in range(CHORD_ITERATIONS):
+            if np.linalg.norm(f) < NEWTON_TOLERANCE:
+                break
+            x = x - CHORD_DAMPING * inverse @ f
+            f = self.residual(x, rest_mm, before)
+        return x, np.linalg.norm(f)
+
     def solve(self, rest_mm, start=None, before=None):
         """The equilibrium for the rest lengths: the state (segments x 3: bend vector, compression) and the
         tensions beyond every stage there (segments x cables x stages, the anchor's last: the friction's next
         state). start is the guess (straight by default); before the friction's state (None: none)."""
         rest_mm = np.asarray(rest_mm, dtype=float)
         x = np.zeros(3 * self.segments) if start is None else np.array(start, dtype=float).ravel()
+        guess = x.copy()
         f = self.residual(x, rest_mm, before)
         norm = np.linalg.norm(f)
         for _ in range(NEWTON_ITERATIONS):
@@ -184,6 +210,8 @@ class Tendons:
                 scale *= 0.5
             x, f, norm = trial, f_trial, np.linalg.norm(f_trial)
         else:
+            if norm > 1e-6:
+                x, norm = self._chord(guess, rest_mm, before)
             if norm > 1e-6:
                 raise RuntimeError("tendon equilibrium does not converge (residual {:.3g})".format(norm))
         x = x.reshape(self.segments, 3)
