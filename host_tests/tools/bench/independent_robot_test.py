@@ -506,6 +506,31 @@ class TendonStatics(unittest.TestCase):
         self.assertGreater(gaps[2], gaps[1])
 
 
+# A row of seed 2's babbling run (lab-1seg) on which Newton's steps stalled between stick and slip: the rest
+# lengths, the state before and the disks' tensions before.
+STALL_REST = [[54.39307850604763, 59.714987229809026, 54.08917785067079, 69.8635976771253]]
+STALL_START = [[-0.09834939056351193, -0.001644704489169184, 5.26481863302967]]
+STALL_BEFORE = [[[7.162039704162335, 7.136035442870189, 7.110125599039169, 7.08430982985404, 7.058587793744274,
+                  7.0329591503795355, 7.007423560665174, 6.9819806867377405, 6.956630191960516], [0.0] * 9,
+                 [7.158106494296149, 7.1812180226533, 7.204404171686105, 7.227665182323901, 7.2510012962739205,
+                  7.274412756023802, 7.297899804844105, 7.321462686790847, 7.345101646708029], [0.0] * 9]]
+
+
+class StickSlipCorner(unittest.TestCase):
+    def test_an_equilibrium_on_the_corner_of_a_stick_band_is_found(self):
+        tendons = robot.RealLikeRobot(2, 1, 4, 64.0, 8.0, "tension").tendons
+        rest, before = np.array(STALL_REST), np.array(STALL_BEFORE)
+        state, stages = tendons.solve(rest, np.array(STALL_START), before)
+        # The balance holds, and the disks' tensions are the ones it was computed with.
+        np.testing.assert_allclose(tendons.residual(state.ravel(), rest, before), 0.0, atol=1e-9)
+        np.testing.assert_array_equal(stages, tendons.tensions(state, rest, before)[1])
+        # Every disk within its band of the one before it (the drive's for the first).
+        drive, _ = tendons.tensions(state, rest)
+        inside = np.concatenate([drive[:, :, None], stages[:, :, :-1]], axis=2)
+        ratio = np.exp(tendons.mu[:, :, None] * tendons.wraps(np.hypot(state[:, 0], state[:, 1])))
+        self.assertTrue(np.all(stages >= inside / ratio - 1e-12) and np.all(stages <= inside * ratio + 1e-12))
+
+
 class CableCounts(unittest.TestCase):
     def test_four_cables_are_eq_2_and_its_inverse(self):
         rng = np.random.default_rng(9)
