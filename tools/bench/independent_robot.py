@@ -1075,11 +1075,14 @@ def main_real_like(args):
             s["hysteresis_tip_movement_mm"]["mean"], s["hysteresis_tip_movement_mm"]["max"]))
         print("    nominal model error  {:.3f} mm / {:.4f} deg".format(
             s["nominal_error"]["position_mm"], s["nominal_error"]["orientation_deg"]))
-        print("    beyond pi/2 (constant-curvature map of the commands) {:.1f} %".format(100.0 * s["beyond_quarter_turn"]))
+        print("    beyond pi/2 (constant-curvature map of the commands) {:.1f} %".format(
+            100.0 * s["beyond_quarter_turn"]))
         if s["pair_sum_spread_mm"] is not None:
-            print("    pair sums' spread    {} mm".format(", ".join("{:.1f}".format(v) for v in s["pair_sum_spread_mm"])))
+            print("    pair sums' spread    {} mm".format(
+                ", ".join("{:.1f}".format(v) for v in s["pair_sum_spread_mm"])))
         if "same_transition_repeatability_mm" in s:
-            print("    same command from the same previous one: {:.3f} mm".format(s["same_transition_repeatability_mm"]))
+            print("    same command from the same previous one: {:.3f} mm".format(
+                s["same_transition_repeatability_mm"]))
     return 0
 
 

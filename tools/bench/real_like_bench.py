@@ -89,7 +89,8 @@ def babbling(path, train_rows):
     differences = np.stack([cables[:, 2] - cables[:, 0], cables[:, 1] - cables[:, 3]], axis=1)
     out = {"rows": n, "train_rows_used": int(len(pick)), "test_rows": n - cut,
            "beyond_quarter_turn": float(np.mean(thetas > 0.5 * math.pi)),
-           "pair_sum_spread_mm": [float(np.ptp(cables[:, 0] + cables[:, 2])), float(np.ptp(cables[:, 1] + cables[:, 3]))],
+           "pair_sum_spread_mm": [float(np.ptp(cables[:, 0] + cables[:, 2])),
+                                  float(np.ptp(cables[:, 1] + cables[:, 3]))],
            "nominal_mm": mean_distance(nominal, position[cut:])}
     for name, inputs in (("gp_all_cables_mm", cables), ("gp_differences_mm", differences)):
         predicted, kernel = fit_gp(inputs[pick], position[pick], inputs[cut:])
