@@ -61,6 +61,61 @@ kilogram sags the straight robot's tip by 60 to 77 mm. The rows are then
 independent samples without cable friction, written as cables, payload_kg,
 pose (no t_s: the project takes no time column with a payload). Zero
 payload is the robot without one, bit for bit.
+
+The real-like robot (any of --preset, --mechanics, --segments, --length,
+--radius, --cables, --collection, --capstan-mu selects it; without them
+every file and figure above is unchanged, byte for byte): what makes a real
+robot's recordings hard.
+
+  - Geometry: --segments S (default 4), --length L and --radius r (default
+    110 and 60 mm), --cables 3 or 4 (default 4) at anchor angles
+    psi_j = -(j - 1) 360 deg / c (cable 1 towards alpha = 0; four cables are
+    eq. (2)'s); the CSV then has l<s>_1..l<s>_<c>. --preset lab-1seg is the
+    lab's robot: 1 segment, L = 64 mm, r = 8 mm, 4 cables, tension
+    mechanics. Errors as above, scaled to the size: segment length sigma
+    L / 110, anchor radius sigma 1 %, anchor angle sigma 2 deg, twist sigma
+    1 deg, mount and marker offsets; no sag.
+  - --mechanics lengths (default): the bend is the constant-curvature map of
+    the effective lengths. --mechanics tension: the bend and the backbone's
+    compression are the static equilibrium of tendon_mechanics.py (elastic
+    cables with pretension that go slack under negative stretch, a backbone
+    with bending and axial stiffness, cables straight between spacer disks
+    every 8 mm), solved numerically for every row. Per seed, at the lab's
+    size: cable stiffness k 1.6 to 2.4 N/mm per cable, pretension 0.8 to
+    1.2 N, bending stiffness 25 to 35 N mm/rad, axial 2.5 to 3.5 N/mm
+    (scaled with r^2 / L and 1 / L for other sizes, so k r^2 against the
+    bending stiffness stays the lab's); distal cables get the nominal path
+    through the segments before them added to their command.
+  - Friction with tension mechanics: capstan friction along the entry guide
+    (0.3 rad of wrap) and every spacer disk (its share of the bend), mu 0.15
+    to 0.3 per cable (--capstan-mu sets one for all; 0 turns it off): the
+    tension reaching the anchor lags the drive's by exp(-+mu phi) according
+    to the direction of each cable's last move, a history that grows with
+    tension and bend; followed along every move in steps of 2 mm of cable
+    travel. Beside it the Bouc-Wen play above on every drive, largest lags
+    0.1 to 0.3 mm (0.3 to 0.9 mm with lengths mechanics).
+    --no-hysteresis turns both off.
+  - Noise with tension mechanics: a repeatability of 0.007 rad per bend
+    component at the lab's 64 mm (times 64 mm / (S L) for longer robots:
+    0.001 rad at 4 x 110 mm) and 0.1 mm of compression, a tracker's 0.15 mm and 0.1 deg
+    per axis (with lengths mechanics 0.001 rad, 0.1 mm and 0.05 deg).
+  - --collection consistent (default): random configurations (alpha
+    uniform, theta uniform up to 0.2 rad x 60 / r, the four-segment robot's
+    12 mm of cable travel, at most 1.2 rad) visited in sequence, timed as
+    above. babbling: every cable's
+    displacement from its straight length uniform in +-D (--babble-mm,
+    default 13), independently, a row every 3.5 s, as the lab's motor
+    babbling. repeatability: straight and each pull of --repeat-pulls
+    (default 6,12 mm) in --repeat-directions directions (default 8; cable j
+    displaced by -p cos(beta - psi_j), the cable towards beta pulled, its
+    antagonist released), 17 commands, each reached --repeat-rounds times
+    (default 2) from every other one along a random walk that starts and
+    ends straight: 544 rows, a row every 3.5 s; --rows is then ignored.
+  - The figures add the share of rows bent beyond pi/2 by the
+    constant-curvature map of the commands, the spread of the pair sums
+    l1 + l3 and l2 + l4 (four cables), and for repeatability runs the
+    spread of the same command reached from the same previous one
+    (|p_a - p_b| / sqrt(2) over pairs of such visits).
 Only numpy; deterministic from the seed.
 """
 
@@ -71,6 +126,8 @@ import os
 import sys
 
 import numpy as np
+
+import tendon_mechanics
 
 SEGMENTS = 4
 NOMINAL_LENGTH_MM = 110.0
@@ -238,17 +295,7 @@ class Robot:
         self.gravity = gravity / np.linalg.norm(gravity)
         self.sag_rad = scale * rng.uniform(0.004, 0.006, SEGMENTS)
         self.repeatability_rad = 0.001 * scale
-        cables = 4 * SEGMENTS
-        max_lag = rng.uniform(0.3, 0.9, cables)
-        n = rng.uniform(1.0, 2.0, cables)
-        # Right after a full reversal dz/dx = 2 A beta / (beta + gamma): the
-        # effective length's slope there, 1 - 2 A beta / (beta + gamma), must
-        # stay positive (the cable end never moves against the drive).
-        reversal_slope = rng.uniform(0.05, 0.4, cables)
-        beta_share = rng.uniform(0.5, 0.85, cables)
-        a = (1.0 - reversal_slope) / (2.0 * beta_share)
-        beta_plus_gamma = a / max_lag ** n
-        self.friction_parameters = (a, beta_share * beta_plus_gamma, (1.0 - beta_share) * beta_plus_gamma, n)
+        self.friction_parameters = bouc_wen_parameters(rng, 4 * SEGMENTS)
         # The segments' bending stiffness under a payload, from a stream of its
         # own so the robot without payload stays the one it always was.
         stiffness_rng = np.random.default_rng([seed, 1001])
@@ -404,6 +451,424 @@ def write_csv(path, data, seed, session, robot, cables="cables", payload=False):
             values += ["{:.6f}".format(v) for v in pose[:3, 3]] + ["{:.8f}".format(v) for v in quaternion(pose[:3, :3])]
             f.write(",".join(values) + "\n")
 
+# --- the real-like robot: tendon statics, capstan friction, collections ------
+
+# Named geometries: the lab's one-segment robot (four servo-driven cables at
+# 90 deg on an 8 mm anchor radius, a 64 mm backbone, a tracker at the tip).
+PRESETS = {
+    "lab-1seg": {"segments": 1, "length": 64.0, "radius": 8.0, "cables": 4, "mechanics": "tension"},
+}
+REAL_LIKE_DEFAULTS = {"segments": SEGMENTS, "length": NOMINAL_LENGTH_MM, "radius": NOMINAL_RADIUS_MM, "cables": 4,
+                      "mechanics": "lengths"}
+# The tendon statics (tension mechanics), per seed within these ranges.
+CABLE_STIFFNESS_N_PER_MM = (1.6, 2.4)
+PRETENSION_N = (0.8, 1.2)
+# Bending stiffness as K_b r^2 / L: the cables' lever against the backbone.
+BENDING_N_MM_PER_RAD_AT_LAB = (25.0, 35.0)
+AXIAL_N_PER_MM_AT_LAB = (2.5, 3.5)
+CAPSTAN_MU = (0.15, 0.3)
+CAPSTAN_ENTRY_WRAP_RAD = 0.3
+SPACER_PITCH_MM = 8.0
+# The friction state follows every move in steps of at most this much cable travel.
+TENSION_STEP_MM = 2.0
+TENSION_HALVINGS = 6
+# Bouc-Wen play on the drives of the real-like robot: the lab robot's servo
+# horns and cable ends, smaller than the four-segment robot's 0.3 to 0.9 mm.
+REAL_LIKE_LAG_MM = (0.1, 0.3)
+REAL_LIKE_REPEATABILITY_RAD = 0.007
+REAL_LIKE_COMPRESSION_NOISE_MM = 0.1
+TRACKER_POSITION_NOISE_MM = 0.15
+TRACKER_ORIENTATION_NOISE_DEG = 0.1
+# Collections.
+BABBLE_MM = 13.0
+STEP_S = 3.5
+REPEAT_PULLS_MM = (6.0, 12.0)
+REPEAT_DIRECTIONS = 8
+REPEAT_ROUNDS = 2
+
+
+def anchor_angles(cables):
+    """Cable j (0-based) of a segment at -j 2 pi / c: for four cables the handedness of eq. (2), where cable 1
+    lies towards alpha = 0 and cable 4 towards alpha = 90 deg."""
+    return np.array([-2.0 * math.pi * j / cables for j in range(cables)])
+
+
+def cable_lengths_general(alpha, theta, length_mm, radius_mm, cables=4):
+    """Eq. (2) for c cables at anchor_angles(c): 2 (L/theta) sin(theta/2) - 2 r cos(alpha - psi_j) sin(theta/2)."""
+    half = 0.5 * theta
+    backbone = length_mm * (math.sin(half) / half if half > 1e-8 else 1.0 - half * half / 6.0)
+    return backbone - 2.0 * radius_mm * np.cos(alpha - anchor_angles(cables)) * math.sin(half)
+
+
+def joints_from_cables_general(cables_mm, radius_mm):
+    """The inverse of cable_lengths_general for c >= 3 cables: the first harmonic of the lengths over the
+    anchor angles, (a, b) = (2/c) sum l_j (cos psi_j, sin psi_j) = -2 r sin(theta/2) (cos alpha, sin alpha).
+    For four cables, alpha = atan2(l2 - l4, l3 - l1) and theta = 2 asin(hypot(l3 - l1, l4 - l2) / (4 r))."""
+    cables_mm = np.asarray(cables_mm, dtype=float)
+    psi = anchor_angles(len(cables_mm))
+    a = 2.0 / len(cables_mm) * np.dot(cables_mm, np.cos(psi))
+    b = 2.0 / len(cables_mm) * np.dot(cables_mm, np.sin(psi))
+    alpha = math.atan2(-b, -a)
+    theta = 2.0 * math.asin(min(1.0, math.hypot(a, b) / (2.0 * radius_mm)))
+    return alpha, theta
+
+
+def nominal_pose_general(cables_mm, segments, cables, length_mm, radius_mm):
+    """Eq. (13) for any cable count: the product of the segments' constant-curvature transforms."""
+    pose = np.eye(4)
+    for i in range(segments):
+        alpha, theta = joints_from_cables_general(cables_mm[cables * i:cables * (i + 1)], radius_mm)
+        pose = pose @ segment_transform(alpha, theta, length_mm)
+    return pose
+
+
+def bouc_wen_parameters(rng, count, lag_range_mm=(0.3, 0.9)):
+    """Bouc-Wen A, beta, gamma, n per cable with the largest lag uniform in lag_range_mm (the draws and their
+    order as the four-segment robot's)."""
+    max_lag = rng.uniform(lag_range_mm[0], lag_range_mm[1], count)
+    n = rng.uniform(1.0, 2.0, count)
+    # Right after a full reversal dz/dx = 2 A beta / (beta + gamma): the
+    # effective length's slope there, 1 - 2 A beta / (beta + gamma), must
+    # stay positive (the cable end never moves against the drive).
+    reversal_slope = rng.uniform(0.05, 0.4, count)
+    beta_share = rng.uniform(0.5, 0.85, count)
+    a = (1.0 - reversal_slope) / (2.0 * beta_share)
+    beta_plus_gamma = a / max_lag ** n
+    return a, beta_share * beta_plus_gamma, (1.0 - beta_share) * beta_plus_gamma, n
+
+
+class RealLikeRobot:
+    """A robot of any segment count, cable count and size, drawn once from the seed. mechanics 'lengths': the
+    bend is the constant-curvature map of the effective lengths (as the four-segment robot, without its sag);
+    'tension': the bend is the statics of tendon_mechanics.Tendons, with capstan friction of mu per cable
+    (capstan_mu None: drawn in CAPSTAN_MU; 0: none). ideal=True turns every error off; hysteresis=False the
+    Bouc-Wen play and the capstan friction."""
+
+    def __init__(self, seed, segments, cables, length_mm, radius_mm, mechanics="lengths", capstan_mu=None,
+                 hysteresis=True, ideal=False):
+        if cables < 3:
+            raise ValueError("a segment needs at least 3 cables (got {})".format(cables))
+        rng = np.random.default_rng([seed, 3000])
+        self.segments, self.cables, self.mechanics = segments, cables, mechanics
+        self.nominal_length_mm, self.nominal_radius_mm = length_mm, radius_mm
+        self.ideal = ideal
+        self.hysteresis = hysteresis and not ideal
+        scale = 0.0 if ideal else 1.0
+        # Manufacturing errors in proportion to the size (the four-segment robot's at L = 110, r = 60).
+        self.length_mm = length_mm + scale * rng.normal(0.0, length_mm / 110.0, segments)
+        self.radius_mm = radius_mm + scale * rng.normal(0.0, 0.01 * radius_mm, segments)
+        self.anchor_offset_rad = scale * rng.normal(0.0, math.radians(2.0), segments)
+        self.twist_rad = scale * rng.normal(0.0, math.radians(1.0), segments)
+        size = length_mm * segments / (4.0 * 110.0)
+        self.base = transform(small_rotation(rng, scale * math.radians(0.7)), scale * size * rng.normal(0.0, 1.5, 3))
+        self.marker = transform(small_rotation(rng, scale * math.radians(1.0)), scale * size * rng.normal(0.0, 1.0, 3))
+        tension = mechanics == "tension"
+        # The lab robot's repeatability at its 64 mm, in proportion for longer robots (0.001 rad at 4 x 110 mm).
+        self.repeatability_rad = scale * (REAL_LIKE_REPEATABILITY_RAD * 64.0 / (segments * length_mm) if tension
+                                          else 0.001)
+        self.compression_noise_mm = scale * REAL_LIKE_COMPRESSION_NOISE_MM if tension else 0.0
+        self.position_noise_mm = scale * (TRACKER_POSITION_NOISE_MM if tension else 0.1)
+        self.orientation_noise_deg = scale * (TRACKER_ORIENTATION_NOISE_DEG if tension else 0.05)
+        count = segments * cables
+        self.friction_parameters = bouc_wen_parameters(rng, count, REAL_LIKE_LAG_MM if tension else (0.3, 0.9))
+        # The same cable travel as the four-segment robot's workspace (12 mm), at most 1.2 rad.
+        self.workspace_theta_max_rad = min(1.2, WORKSPACE_THETA_MAX_RAD * NOMINAL_RADIUS_MM / radius_mm)
+        self.tendons = self.frictionless = None
+        if tension:
+            t_rng = np.random.default_rng([seed, 3001])
+            # Stiffness scaled from the lab's robot so the cables' lever k r^2 against K_b stays its own.
+            lever = (radius_mm / 8.0) ** 2 * (64.0 / length_mm)
+            bending = t_rng.uniform(*BENDING_N_MM_PER_RAD_AT_LAB, segments) * lever
+            axial = t_rng.uniform(*AXIAL_N_PER_MM_AT_LAB, segments) * 64.0 / length_mm
+            k = t_rng.uniform(*CABLE_STIFFNESS_N_PER_MM, (segments, cables))
+            pretension = t_rng.uniform(*PRETENSION_N, (segments, cables))
+            if capstan_mu is None:
+                mu = t_rng.uniform(*CAPSTAN_MU, (segments, cables))
+            else:
+                mu = np.full((segments, cables), float(capstan_mu))
+            if not self.hysteresis:
+                mu = np.zeros_like(mu)
+            angles = anchor_angles(cables)[None, :] + self.anchor_offset_rad[:, None]
+            spans = max(1, int(round(length_mm / SPACER_PITCH_MM)))
+            common = dict(length_mm=self.length_mm, radius_mm=self.radius_mm, anchor_rad=angles,
+                          bending_n_mm_per_rad=bending, axial_n_per_mm=axial, cable_n_per_mm=k,
+                          pretension_n=pretension, wrap0_rad=CAPSTAN_ENTRY_WRAP_RAD, spans=spans)
+            self.tendons = tendon_mechanics.Tendons(mu=mu, **common)
+            self.frictionless = tendon_mechanics.Tendons(mu=0.0, **common)
+            self.mu = mu
+
+    def new_friction(self, rng):
+        """The play's state at power-up: anywhere within each cable's range."""
+        friction = BoucWen(*self.friction_parameters)
+        friction.z = rng.uniform(-1.0, 1.0, friction.a.shape) * friction.max_lag_mm()
+        return friction
+
+    def straight_command(self):
+        return np.full(self.segments * self.cables, self.nominal_length_mm)
+
+    def random_configuration(self, rng):
+        alphas = rng.uniform(-math.pi, math.pi, self.segments)
+        thetas = rng.uniform(0.0, self.workspace_theta_max_rad, self.segments)
+        return np.concatenate([cable_lengths_general(a, t, self.nominal_length_mm, self.nominal_radius_mm, self.cables)
+                               for a, t in zip(alphas, thetas)])
+
+    def homing_waypoints(self):
+        approach = np.concatenate([cable_lengths_general(HOMING_ALPHA_RAD, HOMING_BEND_RAD, self.nominal_length_mm,
+                                                         self.nominal_radius_mm, self.cables)
+                                   for _ in range(self.segments)])
+        return approach, self.straight_command()
+
+    def nominal_pose(self, cables_mm):
+        return nominal_pose_general(cables_mm, self.segments, self.cables, self.nominal_length_mm,
+                                    self.nominal_radius_mm)
+
+    def rest_lengths(self, effective_mm, tendons=None):
+        """The cables' rest lengths for effective drive lengths: cable j of segment i is commanded its length
+        in segment i; the drive adds the nominal path through the segments before (the decoupling a controller
+        does), less the pretension's stretch."""
+        tendons = tendons or self.tendons
+        per_segment = np.asarray(effective_mm, dtype=float).reshape(self.segments, self.cables)
+        total = per_segment.copy()
+        for i in range(1, self.segments):
+            for m in range(i):
+                alpha, theta = joints_from_cables_general(per_segment[m], self.nominal_radius_mm)
+                total[i] += cable_lengths_general(alpha, theta, self.nominal_length_mm, self.nominal_radius_mm,
+                                                  self.cables)
+        return tendons.rest_lengths(total)
+
+    def state_for(self, effective_mm):
+        """Lengths mechanics: (segments x 3) bend vectors from the constant-curvature map, no compression."""
+        state = np.zeros((self.segments, 3))
+        for i in range(self.segments):
+            alpha, theta = joints_from_cables_general(effective_mm[self.cables * i:self.cables * (i + 1)],
+                                                      self.radius_mm[i])
+            state[i, :2] = theta * np.array([math.cos(alpha + self.anchor_offset_rad[i]),
+                                             math.sin(alpha + self.anchor_offset_rad[i])])
+        return state
+
+    def pose(self, state, noise):
+        """The tip's pose in the tracker's base frame for a state (bend vectors, compressions) and its noise."""
+        pose = self.base.copy()
+        for i in range(self.segments):
+            bend = state[i, :2] + noise[i, :2]
+            pose = pose @ segment_transform(math.atan2(bend[1], bend[0]), float(np.hypot(*bend)),
+                                            self.length_mm[i] - state[i, 2] - noise[i, 2])
+            pose = pose @ transform(rotation(np.array([0.0, 0.0, 1.0]), self.twist_rad[i]), np.zeros(3))
+        return pose @ self.marker
+
+    def noise(self, rng):
+        out = np.empty((self.segments, 3))
+        out[:, :2] = rng.normal(0.0, self.repeatability_rad, (self.segments, 2))
+        out[:, 2] = rng.normal(0.0, self.compression_noise_mm, self.segments) if self.compression_noise_mm \
+            else 0.0
+        return out
+
+
+class RealLikeMotion:
+    """The robot's state along a sequence of commands: the drives' Bouc-Wen play and, with tension mechanics,
+    the capstan friction's anchor tensions, followed in steps of at most TENSION_STEP_MM."""
+
+    def __init__(self, robot, rng):
+        self.robot = robot
+        self.play = robot.new_friction(rng) if robot.hysteresis else None
+        self.state = np.zeros((robot.segments, 3))
+        self.anchor = None
+        self.free_state = np.zeros((robot.segments, 3))
+
+    def move(self, start_mm, end_mm):
+        """Moves along the straight line start -> end; returns the effective lengths and the state at the end."""
+        r = self.robot
+        start_mm, end_mm = np.asarray(start_mm, dtype=float), np.asarray(end_mm, dtype=float)
+        if r.tendons is None:
+            effective = self.play.move(start_mm, end_mm) if self.play is not None else end_mm.copy()
+            self.state = r.state_for(effective)
+            return effective, self.state
+        steps = max(1, int(math.ceil(np.abs(end_mm - start_mm).max() / TENSION_STEP_MM)))
+        previous = start_mm
+        rest = r.rest_lengths(self.play.move(start_mm, start_mm) if self.play is not None else start_mm)
+        for s in range(1, steps + 1):
+            point = start_mm + (end_mm - start_mm) * s / steps
+            effective = self.play.move(previous, point) if self.play is not None else point.copy()
+            previous = point
+            following = r.rest_lengths(effective)
+            self._settle(rest, following)
+            rest = following
+        return effective, self.state
+
+    def _settle(self, rest_from, rest_to, depth=0):
+        """The equilibrium at rest_to from the one at rest_from; where Newton's method stalls on a change of
+        stick and slip, the step in halves (at most TENSION_HALVINGS times)."""
+        try:
+            self.state, self.anchor = self.robot.tendons.solve(rest_to, self.state, self.anchor)
+        except RuntimeError:
+            if depth >= TENSION_HALVINGS:
+                raise
+            middle = 0.5 * (rest_from + rest_to)
+            self._settle(rest_from, middle, depth + 1)
+            self._settle(middle, rest_to, depth + 1)
+
+    def without_friction(self, commanded_mm):
+        """The state the same command reaches without play or capstan friction."""
+        r = self.robot
+        if r.tendons is None:
+            return r.state_for(np.asarray(commanded_mm, dtype=float))
+        self.free_state, _ = r.frictionless.solve(r.rest_lengths(commanded_mm, r.frictionless), self.free_state)
+        return self.free_state
+
+
+def babbling_commands(robot, rng, rows, babble_mm=BABBLE_MM):
+    """Each cable's displacement from its straight length uniform in [-D, D], independently, row by row."""
+    return [robot.straight_command() + rng.uniform(-babble_mm, babble_mm, robot.segments * robot.cables)
+            for _ in range(rows)]
+
+
+def repeatability_commands(robot, pulls_mm=REPEAT_PULLS_MM, directions=REPEAT_DIRECTIONS):
+    """Straight, then each pull in each direction beta: cable j displaced by -p cos(beta - psi_j) in every
+    segment (the cable towards beta pulled by p, its antagonist released by as much)."""
+    psi = anchor_angles(robot.cables)
+    out = [robot.straight_command()]
+    for p in pulls_mm:
+        for d in range(directions):
+            beta = 2.0 * math.pi * d / directions
+            out.append(robot.straight_command() + np.tile(-p * np.cos(beta - psi), robot.segments))
+    return out
+
+
+def repeatability_order(count, rounds, rng):
+    """A walk over `count` commands from command 0 back to it in which every ordered pair of different commands
+    is a step exactly `rounds` times: each command is reached rounds (count - 1) times, from each other command
+    `rounds` times. An Eulerian circuit of that multigraph (Hierholzer's algorithm), the edges taken in a
+    random order."""
+    remaining = []
+    for node in range(count):
+        edges = [other for other in range(count) if other != node for _ in range(rounds)]
+        rng.shuffle(edges)
+        remaining.append(edges)
+    stack, circuit = [0], []
+    while stack:
+        node = stack[-1]
+        if remaining[node]:
+            stack.append(remaining[node].pop())
+        else:
+            circuit.append(stack.pop())
+    circuit.reverse()
+    return circuit
+
+
+def record_real_like(robot, seed, session, rows, collection="consistent", babble_mm=BABBLE_MM,
+                     pulls_mm=REPEAT_PULLS_MM, directions=REPEAT_DIRECTIONS, rounds=REPEAT_ROUNDS):
+    """One session of the real-like robot: power-up, homing, then the collection's commands in order.
+    consistent: `rows` random constant-curvature configurations; babbling: `rows` independent uniform cable
+    displacements; repeatability: the commands of repeatability_commands, visited by repeatability_order
+    (rows is ignored). Also records, per row, the command before it and its index in the command set."""
+    rng = np.random.default_rng([seed, session, 3100])
+    motion = RealLikeMotion(robot, rng)
+    commanded = robot.random_configuration(rng)
+    approach, home = robot.homing_waypoints()
+    for waypoint in (approach, home):
+        motion.move(commanded, waypoint)
+        motion.without_friction(waypoint)
+        commanded = waypoint
+    command_rng = np.random.default_rng([seed, session, 3200])
+    labels = None
+    if collection == "consistent":
+        targets = [robot.random_configuration(command_rng) for _ in range(rows)]
+    elif collection == "babbling":
+        targets = babbling_commands(robot, command_rng, rows, babble_mm)
+    elif collection == "repeatability":
+        commands = repeatability_commands(robot, pulls_mm, directions)
+        order = repeatability_order(len(commands), rounds, command_rng)
+        labels = order[1:]
+        targets = [commands[i] for i in labels]
+        previous = order[:-1]
+    else:
+        raise ValueError("unknown collection '{}'".format(collection))
+    out = {"t_s": [], "cables": [], "effective": [], "measured": [], "true": [], "repeatable": [],
+           "without_hysteresis": [], "command": labels or [], "previous": previous if labels else []}
+    t = 0.0
+    for target in targets:
+        effective, state = motion.move(commanded, target)
+        if collection == "consistent":
+            t += np.abs(target - commanded).max() / CABLE_SPEED_MM_PER_S + DWELL_S * rng.uniform(0.8, 1.2)
+        else:
+            t += STEP_S
+        commanded = target
+        noise = robot.noise(rng)
+        true = robot.pose(state, noise)
+        measured = true.copy()
+        measured[:3, 3] += rng.normal(0.0, robot.position_noise_mm, 3)
+        measured[:3, :3] = measured[:3, :3] @ small_rotation(rng, math.radians(robot.orientation_noise_deg))
+        out["t_s"].append(round(t, 3))
+        out["cables"].append(commanded.copy())
+        out["effective"].append(effective.copy())
+        out["measured"].append(measured)
+        out["true"].append(true)
+        out["repeatable"].append(robot.pose(state, np.zeros_like(noise)))
+        out["without_hysteresis"].append(robot.pose(motion.without_friction(commanded), noise))
+    return out
+
+
+def beyond_quarter_turn(cables, robot):
+    """The share of rows whose constant-curvature bend (the nominal map of the commands) of any segment
+    exceeds pi / 2."""
+    c = robot.cables
+    beyond = [any(joints_from_cables_general(row[c * i:c * (i + 1)], robot.nominal_radius_mm)[1] > 0.5 * math.pi
+                  for i in range(robot.segments)) for row in cables]
+    return float(np.mean(beyond))
+
+
+def pair_sum_spread(cables, robot):
+    """Four cables per segment: the range (max - min) of l1 + l3 and of l2 + l4 over the rows, per segment."""
+    if robot.cables != 4:
+        return None
+    table = np.asarray(cables)
+    out = []
+    for i in range(robot.segments):
+        for a, b in ((0, 2), (1, 3)):
+            sums = table[:, 4 * i + a] + table[:, 4 * i + b]
+            out.append(float(np.ptp(sums)))
+    return out
+
+
+def same_transition_repeatability(data):
+    """Repeatability rows: the tip's spread when the same command is reached from the same previous one, as
+    the mean over those pairs of visits of |p_a - p_b| / sqrt(2) (the expected distance of one visit from the
+    repeatable pose, for independent noise)."""
+    groups = {}
+    for command, previous, pose in zip(data["command"], data["previous"], data["measured"]):
+        groups.setdefault((previous, command), []).append(pose[:3, 3])
+    distances = []
+    for positions in groups.values():
+        for a in range(len(positions)):
+            for b in range(a + 1, len(positions)):
+                distances.append(np.linalg.norm(positions[a] - positions[b]) / math.sqrt(2.0))
+    return float(np.mean(distances)) if distances else float("nan")
+
+
+def write_real_like_csv(path, data, seed, session, robot, collection, cables="cables"):
+    """The dataset CSV of the real-like robot: t_s, l<s>_1..l<s>_<c>, pose."""
+    names = ["t_s"] + ["l{}_{}".format(i + 1, j + 1) for i in range(robot.segments) for j in range(robot.cables)]
+    names += ["x", "y", "z", "qw", "qx", "qy", "qz"]
+    with open(path, "w") as f:
+        f.write("# independent robot (tools/bench/independent_robot.py): seed {}, session {}\n".format(seed, session))
+        f.write("# nominal geometry: {} segments, L = {} mm, r = {} mm, {} cables per segment\n".format(
+            robot.segments, robot.nominal_length_mm, robot.nominal_radius_mm, robot.cables))
+        f.write("# mechanics: {}; collection: {}\n".format(robot.mechanics, collection))
+        f.write("# rows are a motion sequence after the homing move; t_s in seconds\n")
+        friction = "off"
+        if robot.hysteresis:
+            friction = "Bouc-Wen per cable" + (" and capstan" if robot.tendons is not None and np.any(robot.mu > 0)
+                                               else "")
+        f.write("# hysteresis: {}\n".format(friction))
+        if cables == "effective":
+            f.write("# cable columns: the effective lengths (commanded less the friction's lag), for reference\n")
+        f.write(",".join(names) + "\n")
+        for t, lengths, pose in zip(data["t_s"], data[cables], data["measured"]):
+            values = ["{:.3f}".format(t)] + ["{:.6f}".format(c) for c in lengths]
+            values += ["{:.6f}".format(v) for v in pose[:3, 3]] + ["{:.8f}".format(v) for v in quaternion(pose[:3, :3])]
+            f.write(",".join(values) + "\n")
+
+
 
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
@@ -419,7 +884,39 @@ def main(argv=None):
     parser.add_argument("--payload-range", metavar="LO,HI",
                         help="every row carries a tip payload uniform in [LO, HI] kg, written as payload_kg; the "
                              "rows are then independent samples without t_s and without cable friction")
+    real = parser.add_argument_group("the real-like robot (any of these options selects it)")
+    real.add_argument("--preset", choices=sorted(PRESETS),
+                      help="named geometry and mechanics: lab-1seg is 1 segment, L = 64 mm, r = 8 mm, 4 cables, "
+                           "tension mechanics (options given beside it win)")
+    real.add_argument("--mechanics", choices=("lengths", "tension"),
+                      help="lengths: the bend is the constant-curvature map of the effective cable lengths (the "
+                           "default); tension: the statics of elastic tendons against the backbone's bending and "
+                           "axial stiffness, with capstan friction")
+    real.add_argument("--segments", type=int, help="segments (default 4)")
+    real.add_argument("--length", type=float, help="nominal backbone length per segment in mm (default 110)")
+    real.add_argument("--radius", type=float, help="nominal anchor radius in mm (default 60)")
+    real.add_argument("--cables", type=int, choices=(3, 4),
+                      help="cables per segment, at 120 or 90 deg (default 4); columns l<s>_1..l<s>_<c>")
+    real.add_argument("--collection", choices=("consistent", "babbling", "repeatability"),
+                      help="consistent: random constant-curvature configurations (the default); babbling: every "
+                           "cable displaced independently and uniformly within +-D mm; repeatability: a set of "
+                           "commands each reached from every other, --repeat-rounds times")
+    real.add_argument("--babble-mm", type=float, default=BABBLE_MM,
+                      help="babbling: the largest displacement D (default {:g} mm)".format(BABBLE_MM))
+    real.add_argument("--repeat-pulls", default=",".join("{:g}".format(p) for p in REPEAT_PULLS_MM),
+                      help="repeatability: antagonistic pulls in mm (default 6,12), each in every direction")
+    real.add_argument("--repeat-directions", type=int, default=REPEAT_DIRECTIONS,
+                      help="repeatability: directions per pull (default 8): with straight, 17 commands")
+    real.add_argument("--repeat-rounds", type=int, default=REPEAT_ROUNDS,
+                      help="repeatability: how often each command is reached from each other one (default 2: "
+                           "32 visits of each of 17 commands, 544 rows; --rows is then ignored)")
+    real.add_argument("--capstan-mu", type=float,
+                      help="tension mechanics: the capstan friction coefficient of every cable (default: drawn "
+                           "per cable in {:g} to {:g}; 0 turns it off)".format(*CAPSTAN_MU))
     args = parser.parse_args(argv)
+    if any(getattr(args, name) is not None for name in ("preset", "mechanics", "segments", "length", "radius",
+                                                      "cables", "collection", "capstan_mu")):
+        return main_real_like(args)
     payload_range = None
     if args.payload_range is not None:
         try:
@@ -496,6 +993,96 @@ def main(argv=None):
             if "payload_tip_movement_mm" in s:
                 print("    payload moves tip    {:.3f} mm mean, {:.3f} mm max".format(
                     s["payload_tip_movement_mm"]["mean"], s["payload_tip_movement_mm"]["max"]))
+    return 0
+
+
+def main_real_like(args):
+    """The real-like robot's sessions, files and figures (the four-segment robot's options where they apply)."""
+    def fail(message):
+        sys.exit("independent_robot.py: error: " + message)
+
+    settings = dict(REAL_LIKE_DEFAULTS)
+    if args.preset:
+        settings.update(PRESETS[args.preset])
+    for name in settings:
+        if getattr(args, name) is not None:
+            settings[name] = getattr(args, name)
+    collection = args.collection or "consistent"
+    if args.payload_range is not None:
+        fail("--payload-range is the four-segment robot's only")
+    if settings["segments"] < 1 or settings["length"] <= 0.0 or settings["radius"] <= 0.0:
+        fail("--segments, --length and --radius must be positive")
+    if args.capstan_mu is not None and (settings["mechanics"] != "tension" or not args.capstan_mu >= 0.0):
+        fail("--capstan-mu takes a coefficient >= 0 and needs --mechanics tension")
+    if not args.babble_mm > 0.0:
+        fail("--babble-mm must be positive")
+    try:
+        pulls = [float(v) for v in args.repeat_pulls.split(",")]
+    except ValueError:
+        pulls = []
+    if not pulls or args.repeat_directions < 1 or args.repeat_rounds < 1:
+        fail("--repeat-pulls takes mm values like 6,12; --repeat-directions and --repeat-rounds positive counts")
+    try:
+        rows = [int(v) for v in args.rows.split(",")]
+    except ValueError:
+        rows = []
+    if len(rows) != 2 or min(rows) < 1:
+        fail("--rows takes two positive counts, e.g. 700,200, not '{}'".format(args.rows))
+    os.makedirs(args.out_dir, exist_ok=True)
+    robot = RealLikeRobot(args.seed, settings["segments"], settings["cables"], settings["length"],
+                          settings["radius"], settings["mechanics"], args.capstan_mu, hysteresis=not args.no_hysteresis)
+    report = {"seed": args.seed, "hysteresis": robot.hysteresis, "collection": collection,
+              "geometry": settings, "sessions": []}
+    if robot.tendons is not None:
+        report["capstan_mu"] = {"min": float(robot.mu.min()), "max": float(robot.mu.max())}
+    for session, count in enumerate(rows):
+        data = record_real_like(robot, args.seed, session, count, collection, args.babble_mm, pulls,
+                                args.repeat_directions, args.repeat_rounds)
+        path = os.path.join(args.out_dir, "session{}.csv".format(session))
+        write_real_like_csv(path, data, args.seed, session, robot, collection)
+        if args.effective:
+            write_real_like_csv(os.path.join(args.out_dir, "session{}.effective.csv".format(session)), data,
+                                args.seed, session, robot, collection, cables="effective")
+        nominal = [robot.nominal_pose(c) for c in data["cables"]]
+        floor = mean_errors(data["repeatable"], data["measured"])
+        tracker = mean_errors(data["true"], data["measured"])
+        effect = mean_errors(data["true"], data["without_hysteresis"])
+        initial = mean_errors(nominal, data["measured"])
+        entry = {"session": session, "rows": len(data["cables"]), "file": path,
+                 "noise_floor": {"position_mm": floor[0], "orientation_deg": floor[1]},
+                 "motion_capture": {"position_mm": tracker[0], "orientation_deg": tracker[1]},
+                 "hysteresis_tip_movement_mm": {"mean": effect[0], "max": effect[2], "orientation_deg": effect[1]},
+                 "nominal_error": {"position_mm": initial[0], "orientation_deg": initial[1]},
+                 "beyond_quarter_turn": beyond_quarter_turn(data["cables"], robot),
+                 "pair_sum_spread_mm": pair_sum_spread(data["cables"], robot)}
+        if collection == "repeatability":
+            entry["same_transition_repeatability_mm"] = same_transition_repeatability(data)
+        report["sessions"].append(entry)
+    if args.report:
+        with open(args.report, "w") as f:
+            json.dump(report, f)
+    if args.json:
+        print(json.dumps(report))
+        return 0
+    print("independent robot, seed {}: {} segment(s), L = {:g} mm, r = {:g} mm, {} cables, {} mechanics, {}".format(
+        args.seed, settings["segments"], settings["length"], settings["radius"], settings["cables"],
+        settings["mechanics"], collection))
+    for s in report["sessions"]:
+        print("  session {} ({} rows) -> {}".format(s["session"], s["rows"], s["file"]))
+        print("    noise floor          {:.3f} mm / {:.4f} deg".format(
+            s["noise_floor"]["position_mm"], s["noise_floor"]["orientation_deg"]))
+        print("    hysteresis moves tip {:.3f} mm mean, {:.3f} mm max".format(
+            s["hysteresis_tip_movement_mm"]["mean"], s["hysteresis_tip_movement_mm"]["max"]))
+        print("    nominal model error  {:.3f} mm / {:.4f} deg".format(
+            s["nominal_error"]["position_mm"], s["nominal_error"]["orientation_deg"]))
+        print("    beyond pi/2 (constant-curvature map of the commands) {:.1f} %".format(
+            100.0 * s["beyond_quarter_turn"]))
+        if s["pair_sum_spread_mm"] is not None:
+            print("    pair sums' spread    {} mm".format(
+                ", ".join("{:.1f}".format(v) for v in s["pair_sum_spread_mm"])))
+        if "same_transition_repeatability_mm" in s:
+            print("    same command from the same previous one: {:.3f} mm".format(
+                s["same_transition_repeatability_mm"]))
     return 0
 
 

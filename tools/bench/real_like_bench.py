@@ -1,0 +1,160 @@
+#!/usr/bin/env python3
+"""What makes the real robot's recordings hard, measured on the independent robot's real-like files.
+
+    real_like_bench.py babbling FILE.csv [--report ROBOT.json] [--train-rows 1500] [--json]
+    real_like_bench.py repeatability FILE.csv [--report ROBOT.json] [--json]
+
+babbling: the rows in order, the first 80 % to train and the last 20 % to
+test (as the lab's), then
+  - the share of rows whose constant-curvature bend exceeds pi/2, and the
+    spread (max - min) of the pair sums l1 + l3 and l2 + l4;
+  - the nominal model's mean position error on the test rows;
+  - scikit-learn's GP (constant x ARD squared exponential + white noise,
+    normalised outputs, 2 restarts) from the cables to the tip position,
+    given all cables, and given only the two differences l3 - l1, l2 - l4;
+    at most --train-rows training rows, evenly spaced;
+  - the noise floor of the robot's report (--report: independent_robot.py's
+    JSON, the first session's), when given.
+repeatability: the same split, and
+  - the same command from the same previous one: the mean over pairs of
+    such visits of |p_a - p_b| / sqrt(2), from the file alone (commands told
+    apart by their cable values);
+  - a joints-only GP (the cables) against one also given the sign of each
+    cable's last move (-1, 0, +1).
+One segment of four cables (l1_1..l1_4) only. Needs numpy and scikit-learn.
+"""
+
+import argparse
+import json
+import math
+import os
+import sys
+
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import independent_robot as robot  # noqa: E402
+
+TRAIN_SHARE = 0.8
+
+
+def read(path):
+    """The header's geometry and the table: cables (n x 4) and positions (n x 3)."""
+    length_mm = radius_mm = None
+    with open(path) as f:
+        lines = f.read().splitlines()
+    for line in lines:
+        if line.startswith("# nominal geometry:"):
+            parts = line.replace(",", " ").split()
+            length_mm = float(parts[parts.index("L") + 2])
+            radius_mm = float(parts[parts.index("r") + 2])
+    rows = [line for line in lines if not line.startswith("#")]
+    header = rows[0].split(",")
+    table = np.array([r.split(",") for r in rows[1:]], dtype=float)
+    cables = [header.index("l1_{}".format(j)) for j in range(1, 5)]
+    if "l2_1" in header or "l1_5" in header:
+        sys.exit("real_like_bench.py: error: one segment of four cables only")
+    position = [header.index(name) for name in ("x", "y", "z")]
+    return length_mm, radius_mm, table[:, cables], table[:, position]
+
+
+def fit_gp(x_train, y_train, x_test, seed=0):
+    """scikit-learn's GP, ARD squared exponential + white noise, on standardised inputs; the test predictions."""
+    from sklearn.gaussian_process import GaussianProcessRegressor
+    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+    mean, scale = x_train.mean(axis=0), x_train.std(axis=0)
+    scale[scale == 0.0] = 1.0
+    kernel = ConstantKernel(1.0, (1e-3, 1e3)) * RBF(np.ones(x_train.shape[1]), (1e-2, 1e3)) \
+        + WhiteKernel(1e-2, (1e-6, 1.0))
+    gp = GaussianProcessRegressor(kernel, normalize_y=True, n_restarts_optimizer=2, random_state=seed)
+    gp.fit((x_train - mean) / scale, y_train)
+    return gp.predict((x_test - mean) / scale), gp.kernel_
+
+
+def mean_distance(a, b):
+    return float(np.mean(np.linalg.norm(a - b, axis=1)))
+
+
+def split(n):
+    return int(round(TRAIN_SHARE * n))
+
+
+def babbling(path, train_rows):
+    length_mm, radius_mm, cables, position = read(path)
+    n = len(cables)
+    cut = split(n)
+    pick = np.unique(np.linspace(0, cut - 1, min(cut, train_rows)).round().astype(int))
+    nominal = np.array([robot.nominal_pose_general(c, 1, 4, length_mm, radius_mm)[:3, 3] for c in cables[cut:]])
+    thetas = np.array([robot.joints_from_cables_general(c, radius_mm)[1] for c in cables])
+    differences = np.stack([cables[:, 2] - cables[:, 0], cables[:, 1] - cables[:, 3]], axis=1)
+    out = {"rows": n, "train_rows_used": int(len(pick)), "test_rows": n - cut,
+           "beyond_quarter_turn": float(np.mean(thetas > 0.5 * math.pi)),
+           "pair_sum_spread_mm": [float(np.ptp(cables[:, 0] + cables[:, 2])),
+                                  float(np.ptp(cables[:, 1] + cables[:, 3]))],
+           "nominal_mm": mean_distance(nominal, position[cut:])}
+    for name, inputs in (("gp_all_cables_mm", cables), ("gp_differences_mm", differences)):
+        predicted, kernel = fit_gp(inputs[pick], position[pick], inputs[cut:])
+        out[name] = mean_distance(predicted, position[cut:])
+        out[name.replace("_mm", "_kernel")] = str(kernel)
+    return out
+
+
+def command_ids(cables):
+    """Rows with the same cable values (to 1e-4 mm) get the same id."""
+    ids, out = {}, []
+    for row in cables:
+        out.append(ids.setdefault(tuple(np.round(row, 4)), len(ids)))
+    return np.array(out)
+
+
+def repeatability(path):
+    length_mm, _, cables, position = read(path)
+    n = len(cables)
+    cut = split(n)
+    ids = command_ids(cables)
+    groups = {}
+    for i in range(1, n):
+        groups.setdefault((ids[i - 1], ids[i]), []).append(position[i])
+    distances = [np.linalg.norm(p[a] - p[b]) / math.sqrt(2.0) for p in groups.values()
+                 for a in range(len(p)) for b in range(a + 1, len(p))]
+    # The sign of each cable's last move; the first row is reached from home, the straight lengths L.
+    before = np.vstack([np.full((1, cables.shape[1]), length_mm), cables[:-1]])
+    moves = cables - before
+    signs = np.zeros_like(cables)
+    last = np.zeros(cables.shape[1])
+    for i in range(n):
+        moved = np.abs(moves[i]) > 1e-6
+        last[moved] = np.sign(moves[i][moved])
+        signs[i] = last
+    out = {"rows": n, "commands": int(ids.max() + 1), "test_rows": n - cut,
+           "same_transition_mm": float(np.mean(distances)),
+           "transitions_repeated": int(sum(1 for p in groups.values() if len(p) > 1))}
+    for name, inputs in (("gp_joints_only_mm", cables), ("gp_sign_of_last_move_mm", np.hstack([cables, signs]))):
+        predicted, kernel = fit_gp(inputs[:cut], position[:cut], inputs[cut:])
+        out[name] = mean_distance(predicted, position[cut:])
+        out[name.replace("_mm", "_kernel")] = str(kernel)
+    return out
+
+
+def main(argv=None):
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("collection", choices=("babbling", "repeatability"))
+    parser.add_argument("file", help="a session CSV of independent_robot.py")
+    parser.add_argument("--report", help="independent_robot.py's --report JSON: adds the first session's floor")
+    parser.add_argument("--train-rows", type=int, default=1500, help="babbling: training rows used (default 1500)")
+    parser.add_argument("--json", action="store_true", help="print the figures as one JSON object")
+    args = parser.parse_args(argv)
+    out = babbling(args.file, args.train_rows) if args.collection == "babbling" else repeatability(args.file)
+    if args.report:
+        with open(args.report) as f:
+            out["noise_floor_mm"] = json.load(f)["sessions"][0]["noise_floor"]["position_mm"]
+    if args.json:
+        print(json.dumps(out))
+    else:
+        for key, value in out.items():
+            print("{:28s} {}".format(key, value))
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
