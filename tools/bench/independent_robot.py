@@ -461,14 +461,16 @@ PRESETS = {
 REAL_LIKE_DEFAULTS = {"segments": SEGMENTS, "length": NOMINAL_LENGTH_MM, "radius": NOMINAL_RADIUS_MM, "cables": 4,
                       "mechanics": "lengths"}
 # The tendon statics (tension mechanics), per seed within these ranges.
-CABLE_STIFFNESS_N_PER_MM = (1.6, 2.4)
-PRETENSION_N = (0.8, 1.2)
-# Bending stiffness as K_b r^2 / L: the cables' lever against the backbone.
-BENDING_N_MM_PER_RAD_AT_LAB = (25.0, 35.0)
-AXIAL_N_PER_MM_AT_LAB = (2.5, 3.5)
-CAPSTAN_MU = (0.15, 0.3)
-CAPSTAN_ENTRY_WRAP_RAD = 0.3
-SPACER_PITCH_MM = 8.0
+TENDON = {
+    "cable_stiffness_n_per_mm": (1.6, 2.4),
+    "pretension_n": (0.8, 1.2),
+    # Bending stiffness as K_b r^2 / L: the cables' lever against the backbone.
+    "bending_n_mm_per_rad_at_lab": (25.0, 35.0),
+    "axial_n_per_mm_at_lab": (2.5, 3.5),
+    "capstan_mu": (0.15, 0.3),
+    "capstan_entry_wrap_rad": 0.3,
+    "spacer_pitch_mm": 8.0,
+}
 # The friction state follows every move in steps of at most this much cable travel.
 TENSION_STEP_MM = 2.0
 TENSION_HALVINGS = 6
@@ -541,7 +543,7 @@ class RealLikeRobot:
     """A robot of any segment count, cable count and size, drawn once from the seed. mechanics 'lengths': the
     bend is the constant-curvature map of the effective lengths (as the four-segment robot, without its sag);
     'tension': the bend is the statics of tendon_mechanics.Tendons, with capstan friction of mu per cable
-    (capstan_mu None: drawn in CAPSTAN_MU; 0: none). ideal=True turns every error off; hysteresis=False the
+    (capstan_mu None: drawn in TENDON["capstan_mu"]; 0: none). ideal=True turns every error off; hysteresis=False the
     Bouc-Wen play and the capstan friction."""
 
     def __init__(self, seed, segments, cables, length_mm, radius_mm, mechanics="lengths", capstan_mu=None,
@@ -578,21 +580,21 @@ class RealLikeRobot:
             t_rng = np.random.default_rng([seed, 3001])
             # Stiffness scaled from the lab's robot so the cables' lever k r^2 against K_b stays its own.
             lever = (radius_mm / 8.0) ** 2 * (64.0 / length_mm)
-            bending = t_rng.uniform(*BENDING_N_MM_PER_RAD_AT_LAB, segments) * lever
-            axial = t_rng.uniform(*AXIAL_N_PER_MM_AT_LAB, segments) * 64.0 / length_mm
-            k = t_rng.uniform(*CABLE_STIFFNESS_N_PER_MM, (segments, cables))
-            pretension = t_rng.uniform(*PRETENSION_N, (segments, cables))
+            bending = t_rng.uniform(*TENDON["bending_n_mm_per_rad_at_lab"], segments) * lever
+            axial = t_rng.uniform(*TENDON["axial_n_per_mm_at_lab"], segments) * 64.0 / length_mm
+            k = t_rng.uniform(*TENDON["cable_stiffness_n_per_mm"], (segments, cables))
+            pretension = t_rng.uniform(*TENDON["pretension_n"], (segments, cables))
             if capstan_mu is None:
-                mu = t_rng.uniform(*CAPSTAN_MU, (segments, cables))
+                mu = t_rng.uniform(*TENDON["capstan_mu"], (segments, cables))
             else:
                 mu = np.full((segments, cables), float(capstan_mu))
             if not self.hysteresis:
                 mu = np.zeros_like(mu)
             angles = anchor_angles(cables)[None, :] + self.anchor_offset_rad[:, None]
-            spans = max(1, int(round(length_mm / SPACER_PITCH_MM)))
+            spans = max(1, int(round(length_mm / TENDON["spacer_pitch_mm"])))
             common = dict(length_mm=self.length_mm, radius_mm=self.radius_mm, anchor_rad=angles,
                           bending_n_mm_per_rad=bending, axial_n_per_mm=axial, cable_n_per_mm=k,
-                          pretension_n=pretension, wrap0_rad=CAPSTAN_ENTRY_WRAP_RAD, spans=spans)
+                          pretension_n=pretension, wrap0_rad=TENDON["capstan_entry_wrap_rad"], spans=spans)
             self.tendons = tendon_mechanics.Tendons(mu=mu, **common)
             self.frictionless = tendon_mechanics.Tendons(mu=0.0, **common)
             self.mu = mu
@@ -870,6 +872,19 @@ def write_real_like_csv(path, data, seed, session, robot, collection, cables="ca
 
 
 
+def print_session_figures(s):
+    """A session's file and the figures both robots report for it."""
+    print("  session {} ({} rows) -> {}".format(s["session"], s["rows"], s["file"]))
+    print("    noise floor          {:.3f} mm / {:.4f} deg".format(
+        s["noise_floor"]["position_mm"], s["noise_floor"]["orientation_deg"]))
+    print("    motion capture alone {:.3f} mm / {:.4f} deg".format(
+        s["motion_capture"]["position_mm"], s["motion_capture"]["orientation_deg"]))
+    print("    hysteresis moves tip {:.3f} mm mean, {:.3f} mm max".format(
+        s["hysteresis_tip_movement_mm"]["mean"], s["hysteresis_tip_movement_mm"]["max"]))
+    print("    nominal model error  {:.3f} mm / {:.4f} deg".format(
+        s["nominal_error"]["position_mm"], s["nominal_error"]["orientation_deg"]))
+
+
 def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--seed", type=int, default=7, help="names the robot and its sessions (default 7)")
@@ -912,7 +927,7 @@ def main(argv=None):
                            "32 visits of each of 17 commands, 544 rows; --rows is then ignored)")
     real.add_argument("--capstan-mu", type=float,
                       help="tension mechanics: the capstan friction coefficient of every cable (default: drawn "
-                           "per cable in {:g} to {:g}; 0 turns it off)".format(*CAPSTAN_MU))
+                           "per cable in {:g} to {:g}; 0 turns it off)".format(*TENDON["capstan_mu"]))
     args = parser.parse_args(argv)
     if any(getattr(args, name) is not None for name in ("preset", "mechanics", "segments", "length", "radius",
                                                       "cables", "collection", "capstan_mu")):
@@ -981,15 +996,7 @@ def main(argv=None):
             print("  tip payload {:g} to {:g} kg per row; the first kg sags the straight tip {:.1f} mm".format(
                 payload_range[0], payload_range[1], report["straight_tip_sag_mm_first_kg"]))
         for s in report["sessions"]:
-            print("  session {} ({} rows) -> {}".format(s["session"], s["rows"], s["file"]))
-            print("    noise floor          {:.3f} mm / {:.4f} deg".format(
-                s["noise_floor"]["position_mm"], s["noise_floor"]["orientation_deg"]))
-            print("    motion capture alone {:.3f} mm / {:.4f} deg".format(
-                s["motion_capture"]["position_mm"], s["motion_capture"]["orientation_deg"]))
-            print("    hysteresis moves tip {:.3f} mm mean, {:.3f} mm max".format(
-                s["hysteresis_tip_movement_mm"]["mean"], s["hysteresis_tip_movement_mm"]["max"]))
-            print("    nominal model error  {:.3f} mm / {:.4f} deg".format(
-                s["nominal_error"]["position_mm"], s["nominal_error"]["orientation_deg"]))
+            print_session_figures(s)
             if "payload_tip_movement_mm" in s:
                 print("    payload moves tip    {:.3f} mm mean, {:.3f} mm max".format(
                     s["payload_tip_movement_mm"]["mean"], s["payload_tip_movement_mm"]["max"]))
@@ -1068,13 +1075,7 @@ def main_real_like(args):
         args.seed, settings["segments"], settings["length"], settings["radius"], settings["cables"],
         settings["mechanics"], collection))
     for s in report["sessions"]:
-        print("  session {} ({} rows) -> {}".format(s["session"], s["rows"], s["file"]))
-        print("    noise floor          {:.3f} mm / {:.4f} deg".format(
-            s["noise_floor"]["position_mm"], s["noise_floor"]["orientation_deg"]))
-        print("    hysteresis moves tip {:.3f} mm mean, {:.3f} mm max".format(
-            s["hysteresis_tip_movement_mm"]["mean"], s["hysteresis_tip_movement_mm"]["max"]))
-        print("    nominal model error  {:.3f} mm / {:.4f} deg".format(
-            s["nominal_error"]["position_mm"], s["nominal_error"]["orientation_deg"]))
+        print_session_figures(s)
         print("    beyond pi/2 (constant-curvature map of the commands) {:.1f} %".format(
             100.0 * s["beyond_quarter_turn"]))
         if s["pair_sum_spread_mm"] is not None:
