@@ -36,6 +36,7 @@
 #include <cdcr/firmware/runtime.hpp>
 
 #include "board.hpp"
+#include "cycle_tally.hpp"
 #include "golden_check.hpp"
 #include "instruction_count.hpp"
 #include "program_expectation.hpp"
@@ -46,15 +47,11 @@ namespace {
 namespace console = cdcr::cortexm;
 using namespace cdcr::qemu_programs;  // the workload, and its model, firmware and protocol
 
-constexpr std::uint32_t kBudgetInstructions = cdcr::boards::mps2::kCycleBudgetInstructions;
-
 cdcr::boards::mps2::Board board;
 firmware::Runtime runtime(board.hal(), cdcr::boards::mps2::golden_geometry());
 firmware::Correction correction;
 
 cdcr::boards::mps2::InstructionCounter counter{board.timer};
-
-std::uint32_t counted_cycle() { return cdcr::qemu_programs::counted_cycle(counter, board, runtime); }
 
 // The same workload on every run and both boards (workload.hpp).
 cdcr::qemu_programs::Random random_numbers{0x2545F491u};
@@ -115,57 +112,59 @@ struct Latencies {
   }
 };
 
-Latencies paper_pose{"paper_pose"};
-Latencies paper_position{"paper_position"};
-Latencies full_range_pose{full_range_name};
-Latencies near_straight_pose{"near_straight_pose"};
-Latencies streamed{"streamed_setpoint_lag"};
+// Targets that refuse extrapolation, all made inside the training data's
+// range or all beyond it, and what became of them.
+struct RefusingTargets {
+  std::int32_t sent = 0;
+  std::int32_t converged = 0;
+  std::int32_t refused = 0;
+};
 
-std::uint32_t worst = 0;
-std::uint32_t cycles_run = 0;
-// Instructions of the cheapest cycle's GP mean point, and the most any cycle
-// spent beyond what its units account for.
-std::uint32_t mean_point_instructions = 0;
-std::int32_t worst_unaccounted = 0;
-std::uint32_t over_budget = 0;
-std::uint32_t poses_missing = 0;
+// What the workload's steps share: the counted cycles' tallies, the
+// sequence of the next target, the latencies per kind of request, and
+// what became of the targets that refuse extrapolation and of the silent
+// drive.
+struct Workload {
+  CycleTally tally;
+  // Instructions of a GP mean point (report_unit_costs), and the most any
+  // cycle spent beyond what its units account for.
+  std::uint32_t mean_point_instructions = 0;
+  std::int32_t worst_unaccounted = 0;
+  std::uint8_t next_sequence = 0;
+  Latencies paper_pose{"paper_pose"};
+  Latencies paper_position{"paper_position"};
+  Latencies full_range_pose{full_range_name};
+  Latencies near_straight_pose{"near_straight_pose"};
+  Latencies streamed{"streamed_setpoint_lag"};
+  // [0] made inside the training data's range, [1] beyond it.
+  RefusingTargets refusing[2];
+  // The silent drive faulted the runtime, and its return recovered it.
+  bool faulted = false;
+  bool recovered = false;
 
-// One counted cycle with the drives' exchange around it.
-void cycle() {
+  // One counted cycle with the drives' exchange around it.
+  void cycle();
+  // A target, then cycles until its request ends; returns the cycles spent.
+  int solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies* latencies,
+            bool refuse_extrapolating = false);
+};
+
+void Workload::cycle() {
   exchange_with_drives();
-  const std::uint32_t published = runtime.statistics().poses_published;
-  const std::uint32_t instructions = counted_cycle();
-  worst = std::max(worst, instructions);
+  const std::uint32_t instructions = tally.run_counted(counter, board, runtime);
   const std::int32_t accounted = std::int32_t(mean_point_instructions * (correction.training_points() +
                                                                          runtime.ik_units_last_cycle()));
   worst_unaccounted = std::max(worst_unaccounted, std::int32_t(instructions) - accounted);
-  if (instructions > kBudgetInstructions && ++over_budget <= 5) {
-    // The first few, with what the cycle did: enough to tell which work
-    // is under-charged.
-    console::console_write("over budget: cycle ");
-    console::console_write_int(static_cast<std::int32_t>(cycles_run));
-    console::console_write(", ");
-    console::console_write_int(static_cast<std::int32_t>(instructions));
-    console::console_write(" instructions, IK units ");
-    console::console_write_int(static_cast<std::int32_t>(runtime.ik_units_last_cycle()));
+  // The first few over the budget, with what the cycle did: enough to tell
+  // which work is under-charged.
+  if (tally.among_first_over_budget(5)) {
+    tally.print_over_budget(runtime, [] {});
     console::console_write(runtime.ik_running() ? ", request running\n" : ", no request running\n");
   }
-  if (runtime.state() == firmware::RuntimeState::run && runtime.statistics().poses_published != published + 1) {
-    ++poses_missing;
-  }
-  ++cycles_run;
 }
 
-std::uint8_t next_sequence = 0;
-// Targets refusing extrapolation, [0] made inside the training data's range,
-// [1] beyond it.
-std::int32_t refusing_targets[2] = {};
-std::int32_t refusing_converged[2] = {};
-std::int32_t refusing_refused[2] = {};
-
-// A target, then cycles until its request ends; returns the cycles spent.
-int solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies* latencies,
-          bool refuse_extrapolating = false) {
+int Workload::solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies* latencies,
+                    bool refuse_extrapolating) {
   const std::uint8_t sequence = next_sequence++;
   deliver_target(target, mode, false, sequence, refuse_extrapolating);
   int spent = 0;
@@ -181,11 +180,12 @@ int solve(const model::Pose<float>& target, protocol::TargetMode mode, Latencies
 
 // What each kind of IK work costs on this core, in instructions: the
 // figures behind the work-unit costs the board's architecture file states
-// (model/arch/<arch>). A training point of the mean is the unit.
+// (model/arch/<arch>). A training point of the mean is the unit; returns
+// its instructions.
 firmware::Solver probe_solver;
 firmware::SolverCorrection probe_correction(correction);
 
-void report_unit_costs(const model::ImageView& image) {
+std::uint32_t report_unit_costs(const model::ImageView& image) {
   const std::uint32_t points = correction.training_points();
   model::JointVector<float> bend = model::JointVector<float>::Zero(2 * segments);
   for (int s = 0; s < segments; ++s) bend[2 * s] = 0.1f;
@@ -241,8 +241,8 @@ void report_unit_costs(const model::ImageView& image) {
     console::console_write(label);
     console::console_write_int(static_cast<std::int32_t>(value));
   };
-  mean_point_instructions = (mean + points / 2) / points;
-  write("unit costs (instructions): mean point ", mean_point_instructions);
+  const std::uint32_t mean_point = (mean + points / 2) / points;
+  write("unit costs (instructions): mean point ", mean_point);
   write(", gradient point ", (gradient + points / 2) / points);
   const char* const names[3] = {"; nominal jacobian mean ", "; nominal step mean ", "; outer step mean "};
   for (int i = 0; i < 3; ++i) {
@@ -283,6 +283,7 @@ void report_unit_costs(const model::ImageView& image) {
   write("; setpoints ", setpoints);
   write("; report ", report);
   console::console_write("\n");
+  return mean_point;
 }
 
 firmware::HysteresisTracker probe_tracker;
@@ -389,11 +390,21 @@ bool sagged_pose_matches_host() {
   return false;
 }
 
-}  // namespace
+// The steps of main are inlined into it, where their code was before it was
+// split into them, so that the compiler weighs this file as it did. The
+// program's copy of the IK solver (probe_solver's, which the program links
+// for the runtime too) depends on it: with the steps as functions of their
+// own, a clone of forward_kinematics_bend for the runtime's geometry made
+// the solver's evaluate_pose small enough to inline, and the outer step's
+// count rose 1 % on the Cortex-M7.
+#define WORKLOAD_STEP inline __attribute__((always_inline))
 
-int main() {
+// The start: the runtime in RUN with the image bound, the counter
+// calibrated, what the model is and what its work costs, and the image's
+// blocks (hysteresis, compliance) as the program was linked to expect.
+WORKLOAD_STEP bool start(Workload& workload) {
   model::ImageView image{};
-  if (!cdcr::qemu_programs::start_counting(board, runtime, correction, image)) return 1;
+  if (!cdcr::qemu_programs::start_counting(board, runtime, correction, image)) return false;
   segments = runtime.geometry().segment_count;
   counter.calibrate();
   console::console_write("model: ");
@@ -401,17 +412,17 @@ int main() {
   console::console_write(" training points; IK work per cycle ");
   console::console_write_int(static_cast<std::int32_t>(runtime.ik_units_per_cycle()));
   console::console_write(" units\n");
-  report_unit_costs(image);
+  workload.mean_point_instructions = report_unit_costs(image);
   const bool with_hysteresis = cdcr::qemu_programs::kExpectHysteresisBlock;
   if (runtime.hysteresis().active() != with_hysteresis) {
     console::console_write(with_hysteresis ? "FAIL: the image's hysteresis block is not tracked\n"
                                            : "FAIL: a hysteresis block where the image has none\n");
-    return 1;
+    return false;
   }
   if (with_hysteresis) {
     if (runtime.hysteresis().known()) {
       console::console_write("FAIL: the hysteresis state is known at power-up\n");
-      return 1;
+      return false;
     }
     report_hysteresis_costs(image);
   }
@@ -419,48 +430,56 @@ int main() {
   if (runtime.compliance().empty() == with_compliance) {
     console::console_write(with_compliance ? "FAIL: the image's compliance block is not bound\n"
                                            : "FAIL: a compliance block where the image has none\n");
-    return 1;
+    return false;
   }
   if (with_compliance) report_compliance_costs();
+  return true;
+}
 
-  // The drives start where golden case 0 has them.
+// The drives start where golden case 0 has them; forward-only cycles.
+WORKLOAD_STEP void forward_only_cycles(Workload& workload) {
   for (int s = 0; s < segments; ++s) {
     for (int k = 0; k < 4; ++k) drives.lengths_mm[s][k] = float(cdcr::qemu_golden::kCablesMm[0][4 * s + k]);
   }
-  // Forward-only cycles.
-  for (int i = 0; i < 100; ++i) cycle();
+  for (int i = 0; i < 100; ++i) workload.cycle();
+}
 
-  // Targets anywhere in the paper's workspace, pose and position, with an
-  // unreachable one every eighth.
+// Targets anywhere in the paper's workspace, pose and position, with an
+// unreachable one every eighth.
+WORKLOAD_STEP void paper_workspace_targets(Workload& workload) {
   for (int t = 0; t < 240; ++t) {
     if (t % 8 == 7) {
       model::Pose<float> far;
       far.position_mm = model::Vec3<float>(900.0f, 0.0f, 50.0f);
-      solve(far, protocol::TargetMode::position, nullptr);
+      workload.solve(far, protocol::TargetMode::position, nullptr);
     } else if (t % 3 == 0) {
-      solve(reachable_target(0.2f), protocol::TargetMode::position, &paper_position);
+      workload.solve(reachable_target(0.2f), protocol::TargetMode::position, &workload.paper_position);
     } else {
-      solve(reachable_target(0.2f), protocol::TargetMode::pose, &paper_pose);
+      workload.solve(reachable_target(0.2f), protocol::TargetMode::pose, &workload.paper_pose);
     }
   }
+}
 
-  // Pose targets that refuse extrapolation, inside the training data's
-  // range and beyond it (bends to 0.45 rad): the solution's check (range,
-  // then the variance in IK's slices) within the same budget.
+// Pose targets that refuse extrapolation, inside the training data's
+// range and beyond it (bends to 0.45 rad): the solution's check (range,
+// then the variance in IK's slices) within the same budget.
+WORKLOAD_STEP void targets_refusing_extrapolation(Workload& workload) {
   for (int t = 0; t < 40; ++t) {
     const int beyond = t % 2;
-    solve(reachable_target(beyond ? 0.45f : 0.15f), protocol::TargetMode::pose, nullptr, true);
-    ++refusing_targets[beyond];
+    workload.solve(reachable_target(beyond ? 0.45f : 0.15f), protocol::TargetMode::pose, nullptr, true);
+    RefusingTargets& refusing = workload.refusing[beyond];
+    ++refusing.sent;
     const protocol::IkOutcome outcome = runtime.last_ik_report().outcome;
-    refusing_converged[beyond] += outcome == protocol::IkOutcome::converged ? 1 : 0;
-    refusing_refused[beyond] += outcome == protocol::IkOutcome::refused_extrapolating ? 1 : 0;
+    refusing.converged += outcome == protocol::IkOutcome::converged ? 1 : 0;
+    refusing.refused += outcome == protocol::IkOutcome::refused_extrapolating ? 1 : 0;
   }
+}
 
-  // A streamed circle, 40 mm radius at 100 mm/s: a TRACKING position target
-  // every cycle. It lies inside the workspace: at the height where the robot,
-  // every segment bent the same way, reaches 120 mm off its axis, centred
-  // 10 mm off the axis (points there need S-shaped bends of about the same
-  // size). First the robot goes to the circle's start.
+// The streamed circle's centre: at the height where the robot, every
+// segment bent the same way, reaches 120 mm off its axis (found by
+// bisection), 10 mm off the axis (points there need S-shaped bends of
+// about the same size).
+WORKLOAD_STEP model::Vec3<float> streamed_circle_center() {
   float low = 0.0f, high = 0.5f;
   model::Vec3<float> rim;
   for (int i = 0; i < 40; ++i) {
@@ -472,90 +491,106 @@ int main() {
     rim = model::forward_kinematics_bend(model::bend_from_joints(equal_bend), runtime.geometry()).position_mm;
     (rim.head<2>().norm() < 120.0f ? low : high) = 0.5f * (low + high);
   }
-  const model::Vec3<float> center(10.0f, 0.0f, rim.z());
+  return model::Vec3<float>(10.0f, 0.0f, rim.z());
+}
+
+// A streamed circle, 40 mm radius at 100 mm/s: a TRACKING position target
+// every cycle, inside the workspace. First the robot goes to the circle's
+// start.
+WORKLOAD_STEP void streamed_circle(Workload& workload) {
+  const model::Vec3<float> center = streamed_circle_center();
   const auto on_circle = [&](int step) {
     const float angle = 2.5e-3f * float(step);  // 100 mm/s at 1 kHz on a 40 mm radius
     model::Pose<float> p;
     p.position_mm = center + model::Vec3<float>(40.0f * std::cos(angle), 40.0f * std::sin(angle), 0.0f);
     return p;
   };
-  solve(on_circle(0), protocol::TargetMode::position, nullptr);
+  workload.solve(on_circle(0), protocol::TargetMode::position, nullptr);
   // How far the drives lag: the compensated model's tip at the setpoints
   // they hold, against the target of this cycle, in cycles of path (0.1 mm
   // each at 100 mm/s and 1 kHz).
   constexpr float kPathPerCycleMm = 0.1f;
   model::Vec3<float> held_tip = compensated_tip(runtime.setpoint_joints()).position_mm;
   for (int step = 1; step <= 800; ++step) {
-    deliver_target(on_circle(step), protocol::TargetMode::position, true, next_sequence++);
+    deliver_target(on_circle(step), protocol::TargetMode::position, true, workload.next_sequence++);
     const std::uint32_t before = runtime.setpoints_published();
-    cycle();
+    workload.cycle();
     if (runtime.setpoints_published() != before) held_tip = compensated_tip(runtime.setpoint_joints()).position_mm;
     const float lag = (held_tip - on_circle(step).position_mm).norm() / kPathPerCycleMm;
-    if (step > 20) streamed.add(static_cast<int>(std::ceil(lag)), true);
+    if (step > 20) workload.streamed.add(static_cast<int>(std::ceil(lag)), true);
   }
-  while (runtime.ik_running()) cycle();
+  while (runtime.ik_running()) workload.cycle();
+}
 
-  // Superseding targets: a new one every 3 cycles.
+// Superseding targets: a new one every 3 cycles.
+WORKLOAD_STEP void superseding_targets(Workload& workload) {
   for (int t = 0; t < 40; ++t) {
     deliver_target(reachable_target(0.2f), t % 2 ? protocol::TargetMode::pose : protocol::TargetMode::position, false,
-                   next_sequence++);
-    for (int i = 0; i < 3; ++i) cycle();
+                   workload.next_sequence++);
+    for (int i = 0; i < 3; ++i) workload.cycle();
   }
-  // A drive falls silent while a request runs, and comes back.
-  deliver_target(reachable_target(0.2f), protocol::TargetMode::pose, false, next_sequence++);
-  cycle();
-  silent_segment = segments - 1;
-  for (int i = 0; i < 30; ++i) cycle();
-  const bool faulted = runtime.state() == firmware::RuntimeState::fault;
-  silent_segment = -1;
-  for (int i = 0; i < 10; ++i) cycle();
-  const bool recovered = runtime.state() == firmware::RuntimeState::run;
-  while (runtime.ik_running()) cycle();
+}
 
-  // Pose targets over the full design range, each from a straight start.
+// A drive falls silent while a request runs, and comes back.
+WORKLOAD_STEP void silent_drive(Workload& workload) {
+  deliver_target(reachable_target(0.2f), protocol::TargetMode::pose, false, workload.next_sequence++);
+  workload.cycle();
+  silent_segment = segments - 1;
+  for (int i = 0; i < 30; ++i) workload.cycle();
+  workload.faulted = runtime.state() == firmware::RuntimeState::fault;
+  silent_segment = -1;
+  for (int i = 0; i < 10; ++i) workload.cycle();
+  workload.recovered = runtime.state() == firmware::RuntimeState::run;
+  while (runtime.ik_running()) workload.cycle();
+}
+
+// Pose targets over the full design range, each from a straight start.
+WORKLOAD_STEP void full_range_targets(Workload& workload) {
   for (int t = 0; t < 100; ++t) {
     const model::JointVector<float> straight = model::JointVector<float>::Zero(2 * segments);
     const model::Pose<float> straight_target = model::forward_kinematics_bend(straight, runtime.geometry());
-    solve(straight_target, protocol::TargetMode::position, nullptr);
-    solve(reachable_target(0.97f * 1.5707963f), protocol::TargetMode::pose, &full_range_pose);
+    workload.solve(straight_target, protocol::TargetMode::position, nullptr);
+    workload.solve(reachable_target(0.97f * 1.5707963f), protocol::TargetMode::pose, &workload.full_range_pose);
   }
+}
 
-  // Pose targets near the straight robot (every segment bent at most 0.06
-  // rad), where the roll about the backbone is weakly actuated, each from
-  // the last one's setpoints.
-  for (int t = 0; t < 60; ++t) solve(reachable_target(0.06f), protocol::TargetMode::pose, &near_straight_pose);
+// Pose targets near the straight robot (every segment bent at most 0.06
+// rad), where the roll about the backbone is weakly actuated, each from
+// the last one's setpoints.
+WORKLOAD_STEP void near_straight_targets(Workload& workload) {
+  for (int t = 0; t < 60; ++t) {
+    workload.solve(reachable_target(0.06f), protocol::TargetMode::pose, &workload.near_straight_pose);
+  }
+}
 
-  paper_pose.report();
-  paper_position.report();
-  full_range_pose.report();
-  near_straight_pose.report();
-  streamed.report();
+// The latencies, the targets refusing extrapolation and the cycles' overhead.
+WORKLOAD_STEP void report_workload(Workload& workload) {
+  workload.paper_pose.report();
+  workload.paper_position.report();
+  workload.full_range_pose.report();
+  workload.near_straight_pose.report();
+  workload.streamed.report();
   for (int beyond = 0; beyond < 2; ++beyond) {
+    const RefusingTargets& refusing = workload.refusing[beyond];
     console::console_write(beyond ? "targets refusing extrapolation, made beyond the data: n "
                                   : "targets refusing extrapolation, made inside the data: n ");
-    console::console_write_int(refusing_targets[beyond]);
+    console::console_write_int(refusing.sent);
     console::console_write(" converged ");
-    console::console_write_int(refusing_converged[beyond]);
+    console::console_write_int(refusing.converged);
     console::console_write(" refused ");
-    console::console_write_int(refusing_refused[beyond]);
+    console::console_write_int(refusing.refused);
     console::console_write("\n");
   }
   console::console_write("cycle overhead (beyond the units spent): at most ");
-  console::console_write_int(worst_unaccounted);
+  console::console_write_int(workload.worst_unaccounted);
   console::console_write(" instructions\n");
-  cdcr::qemu_programs::report_worst_cycle(worst, cycles_run);
-  bool ok = true;
-  if (over_budget > 0) {
-    console::console_write("FAIL: cycles over budget: ");
-    console::console_write_int(static_cast<std::int32_t>(over_budget));
-    console::console_write("\n");
-    ok = false;
-  }
-  if (poses_missing > 0) {
-    console::console_write("FAIL: cycles in RUN without a pose\n");
-    ok = false;
-  }
-  if (!faulted || !recovered) {
+}
+
+// What the runtime did with the workload: every cycle within budget with
+// its pose, the silent drive's fault and recovery, the targets' outcomes.
+WORKLOAD_STEP bool workload_passes(const Workload& workload) {
+  bool ok = workload.tally.report();
+  if (!workload.faulted || !workload.recovered) {
     console::console_write("FAIL: the silent drive did not fault the runtime, or its return did not recover it\n");
     ok = false;
   }
@@ -567,30 +602,59 @@ int main() {
   // the targets within a request's cycles, still has one refused on the
   // M4F. One made beyond it may have one too (the robot is redundant), but
   // not all of them do.
-  if (refusing_refused[0] > (cdcr::qemu_programs::kExpectComplianceBlock ? 1 : 0)) {
+  if (workload.refusing[0].refused > (cdcr::qemu_programs::kExpectComplianceBlock ? 1 : 0)) {
     console::console_write("FAIL: targets made inside the data were refused as extrapolating\n");
     ok = false;
   }
   // Reachable pose targets in the paper's workspace and near the straight
   // robot all converge (not with the payload model and its sag: see above).
+  const Latencies& paper = workload.paper_pose;
+  const Latencies& near_straight = workload.near_straight_pose;
   if (!cdcr::qemu_programs::kExpectComplianceBlock &&
-      (paper_pose.converged < paper_pose.count || near_straight_pose.converged < near_straight_pose.count)) {
+      (paper.converged < paper.count || near_straight.converged < near_straight.count)) {
     console::console_write("FAIL: reachable pose targets did not converge\n");
     ok = false;
   }
-  if (refusing_refused[1] == 0) {
+  if (workload.refusing[1].refused == 0) {
     console::console_write("FAIL: no target made beyond the data was refused\n");
     ok = false;
   }
-  if (with_hysteresis && !runtime.hysteresis().known()) {
+  return ok;
+}
+
+// What the image's blocks and the run's length must be at the end.
+WORKLOAD_STEP bool run_passes(const Workload& workload) {
+  bool ok = true;
+  if (cdcr::qemu_programs::kExpectHysteresisBlock && !runtime.hysteresis().known()) {
     console::console_write("FAIL: the drives' moves did not make the hysteresis state known\n");
     ok = false;
   }
   if (cdcr::qemu_programs::kExpectComplianceBlock && !sagged_pose_matches_host()) ok = false;
-  if (cycles_run < 2000) {
+  if (workload.tally.cycles_run() < 2000) {
     console::console_write("FAIL: fewer than 2,000 cycles\n");
     ok = false;
   }
+  return ok;
+}
+
+}  // namespace
+
+int main() {
+  // Static: the latencies' samples (8 KiB) would take most of the 12 KiB
+  // stack.
+  static Workload workload;
+  if (!start(workload)) return 1;
+  forward_only_cycles(workload);
+  paper_workspace_targets(workload);
+  targets_refusing_extrapolation(workload);
+  streamed_circle(workload);
+  superseding_targets(workload);
+  silent_drive(workload);
+  full_range_targets(workload);
+  near_straight_targets(workload);
+  report_workload(workload);
+  const bool workload_ok = workload_passes(workload);
+  const bool ok = run_passes(workload) && workload_ok;
   console::console_write(ok ? "PASS\n" : "FAIL\n");
   return ok ? 0 : 1;
 }

@@ -22,6 +22,7 @@
 #include <cdcr/firmware/update/update_sender.hpp>
 
 #include "board.hpp"
+#include "cycle_tally.hpp"
 #include "golden_check.hpp"
 #include "instruction_count.hpp"
 #include "workload.hpp"
@@ -31,8 +32,6 @@ namespace {
 namespace console = cdcr::cortexm;
 using namespace cdcr::qemu_programs;  // the workload, and its model, firmware and protocol
 
-constexpr std::uint32_t kBudgetInstructions = cdcr::boards::mps2::kCycleBudgetInstructions;
-
 // A RAM flash of two slots (peer_workload.hpp).
 cdcr::qemu_programs::UpdateFlash flash;
 cdcr::boards::mps2::Board board;
@@ -40,8 +39,6 @@ firmware::Runtime runtime(cdcr::qemu_programs::hal_with_flash(board, flash), cdc
 firmware::Correction correction;
 
 cdcr::boards::mps2::InstructionCounter counter{board.timer};
-
-std::uint32_t counted_cycle() { return cdcr::qemu_programs::counted_cycle(counter, board, runtime); }
 
 // What the update's charges stand for on this core: 64 bytes of the
 // verification pass (SHA-256 and the parser's scan), the most of 16 such.
@@ -82,7 +79,7 @@ class HostSide final : public cdcr::hal::CanBus {
 };
 
 HostSide host;
-std::uint32_t cycles_run = 0;
+CycleTally tally;
 // The transfer under way (firmware/update/update_sender.hpp, as `cdcr
 // deploy` sends), silent for 200 cycles before it asks again.
 firmware::UpdateSender* sender = nullptr;
@@ -91,7 +88,7 @@ firmware::UpdateSender* sender = nullptr;
 void exchange() {
   drives.exchange(board.can, [](const cdcr::hal::CanFrame& frame) {
     if (sender != nullptr && protocol::update_report::kMessage.carries(frame.id)) {
-      sender->on_report(frame, cycles_run, host);
+      sender->on_report(frame, tally.cycles_run(), host);
     }
   });
 }
@@ -108,23 +105,19 @@ enum Phase { kTransfer, kCommit, kSwitch, kOther, kPhases };
 const char* const kPhaseNames[kPhases] = {"transfer", "commit (hash, CRC, parse, header)", "switch", "other"};
 std::uint32_t worst_of[kPhases] = {};
 std::uint32_t cycles_of[kPhases] = {};
-std::uint32_t worst = 0;
-std::uint32_t over_budget = 0;
-std::uint32_t poses_missing = 0;
 std::uint32_t switches = 0;
 
 // One counted cycle: the drives' frames, the sender's (what the mailbox has
 // room for beside them and a target's), a target every 40 cycles.
 void cycle() {
   exchange();
-  if (cycles_run % 40 == 0) deliver_target();
-  if (sender != nullptr) sender->pump(cycles_run, host, 32 - segments - 3);
+  if (tally.cycles_run() % 40 == 0) deliver_target();
+  if (sender != nullptr) sender->pump(tally.cycles_run(), host, 32 - segments - 3);
   const firmware::ModelUpdate& update = runtime.model_update();
   const protocol::UpdateState before = update.state();
   const int slot_before = update.active_slot();
   const std::uint32_t sequence_before = update.active_sequence();
-  const std::uint32_t published = runtime.statistics().poses_published;
-  const std::uint32_t instructions = counted_cycle();
+  const std::uint32_t instructions = tally.run_counted(counter, board, runtime);
   Phase phase = kOther;
   if (update.active_slot() != slot_before || update.active_sequence() != sequence_before) {
     phase = kSwitch;
@@ -136,24 +129,16 @@ void cycle() {
   }
   worst_of[phase] = std::max(worst_of[phase], instructions);
   cycles_of[phase] += 1;
-  worst = std::max(worst, instructions);
-  if (instructions > kBudgetInstructions && ++over_budget <= 12) {
-    console::console_write("over budget: cycle ");
-    console::console_write_int(static_cast<std::int32_t>(cycles_run));
-    console::console_write(" (");
-    console::console_write(kPhaseNames[phase]);
-    console::console_write(", update state ");
-    console::console_write_int(static_cast<std::int32_t>(before));
-    console::console_write("), ");
-    console::console_write_int(static_cast<std::int32_t>(instructions));
-    console::console_write(" instructions, IK units ");
-    console::console_write_int(static_cast<std::int32_t>(runtime.ik_units_last_cycle()));
+  if (tally.among_first_over_budget(12)) {
+    tally.print_over_budget(runtime, [&] {
+      console::console_write(" (");
+      console::console_write(kPhaseNames[phase]);
+      console::console_write(", update state ");
+      console::console_write_int(static_cast<std::int32_t>(before));
+      console::console_write(")");
+    });
     console::console_write("\n");
   }
-  if (runtime.state() == firmware::RuntimeState::run && runtime.statistics().poses_published != published + 1) {
-    ++poses_missing;
-  }
-  ++cycles_run;
 }
 
 // Cycles until the sender is done (committed and switched) or refused.
@@ -163,7 +148,7 @@ bool transfer(const std::uint8_t* image, std::uint32_t size, int expected_slot) 
   // runs once a cycle: the 201st silent cycle.
   update.resend_after = 199;
   sender = &update;
-  update.start(host, cycles_run);
+  update.start(host, tally.cycles_run());
   for (int i = 0; i < 20'000 && update.outcome() == firmware::UpdateSender::Outcome::running; ++i) cycle();
   for (int i = 0; i < 20; ++i) cycle();
   sender = nullptr;
@@ -231,19 +216,7 @@ int main() {
     console::console_write_int(static_cast<std::int32_t>(cycles_of[p]));
     console::console_write(" cycles\n");
   }
-  cdcr::qemu_programs::report_worst_cycle(worst, cycles_run);
-  if (over_budget > 0) {
-    console::console_write("FAIL: cycles over budget: ");
-    console::console_write_int(static_cast<std::int32_t>(over_budget));
-    console::console_write("\n");
-    ok = false;
-  }
-  if (poses_missing > 0) {
-    console::console_write("FAIL: cycles in RUN without a pose: ");
-    console::console_write_int(static_cast<std::int32_t>(poses_missing));
-    console::console_write("\n");
-    ok = false;
-  }
+  ok = tally.report() && ok;
   if (switches != 3) {
     console::console_write("FAIL: expected 3 switches\n");
     ok = false;

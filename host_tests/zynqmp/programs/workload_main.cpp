@@ -384,13 +384,28 @@ void replay_golden_cases(int rounds) {
   }
 }
 
-std::uint8_t next_sequence = 0;
+// The update's image: the board's with another creation time (the same
+// model under another digest).
 alignas(8) std::uint8_t updated_image[64 * 1024];
-int targets_sent = 0;
-int targets_converged = 0;
-int reports_seen = 0;
-int setpoints_at_drives = 0;
-double worst_reached_mm = 0;
+
+// What became of the planner's targets, on the bus.
+struct TargetOutcomes {
+  int sent = 0;
+  int converged = 0;
+  int final_reports = 0;             // their final IK_REPORT on the bus
+  int setpoints_at_every_drive = 0;  // converged, and their setpoints reached every drive
+  double worst_reached_mm = 0;       // how far from a converged target the pose ended
+};
+
+// What the scenario's steps hand on to each other: the planner's next
+// sequence number, what became of its targets (checked once the streamed
+// path is over), and the POSE_UNCERTAINTY frames by the end of the
+// forward-only periods.
+struct Scenario {
+  std::uint8_t next_sequence = 0;
+  TargetOutcomes targets;
+  int uncertainty_frames_forward = 0;
+};
 
 bool final_report_for(int reports_before, std::uint8_t sequence) {
   return bus.ik_reports > reports_before && bus.ik_report.sequence == sequence;
@@ -401,8 +416,8 @@ bool final_report_for(int reports_before, std::uint8_t sequence) {
 // the new lengths, and the runtime publishes the pose there. A converged
 // target's setpoints must have reached every drive, and the pose must be
 // at the target.
-void solve(const cdcr::model::Pose<float>& target, protocol::TargetMode mode) {
-  const std::uint8_t sequence = next_sequence++;
+void solve(Scenario& scenario, const cdcr::model::Pose<float>& target, protocol::TargetMode mode) {
+  const std::uint8_t sequence = scenario.next_sequence++;
   const int reports_before = bus.ik_reports;
   int setpoints_before[firmware::kMaxSegments];
   for (int s = 0; s < drives.segments; ++s) setpoints_before[s] = setpoint_frames[s];
@@ -410,81 +425,87 @@ void solve(const cdcr::model::Pose<float>& target, protocol::TargetMode mode) {
   deliver_target(peer, target, mode, false, sequence);
   exchange_with_drives();
   end_period();
-  targets_sent += 1;
+  TargetOutcomes& targets = scenario.targets;
+  targets.sent += 1;
   for (int spent = 1; !final_report_for(reports_before, sequence) && spent < firmware::kMaxIkCycles + 3; ++spent) {
     period();
   }
   period();
   period();
   if (!final_report_for(reports_before, sequence)) return;
-  reports_seen += 1;
+  targets.final_reports += 1;
   if (bus.ik_report.outcome != protocol::IkOutcome::converged) return;
-  targets_converged += 1;
+  targets.converged += 1;
   bool every_drive = true;
   for (int s = 0; s < drives.segments; ++s) every_drive = every_drive && setpoint_frames[s] > setpoints_before[s];
-  setpoints_at_drives += every_drive ? 1 : 0;
+  targets.setpoints_at_every_drive += every_drive ? 1 : 0;
   double distance_sq = 0;
   for (int i = 0; i < 3; ++i) {
     const double d = bus.position_mm[i] - static_cast<double>(target.position_mm[i]);
     distance_sq += d * d;
   }
   const double reached_mm = std::sqrt(distance_sq);
-  if (!(reached_mm <= worst_reached_mm)) worst_reached_mm = reached_mm;
+  if (!(reached_mm <= targets.worst_reached_mm)) targets.worst_reached_mm = reached_mm;
 }
 
-// The peer's scenario; its checks counted in checks.hpp's failures.
-void run_peer() {
+// The peer's own work before the cycles start, which would otherwise take
+// the periods' room: can1 started, the planner's model (the image the
+// board carries, the same file) bound, and the update's image made.
+// Returns the image's size.
+std::uint32_t prepare_planner() {
   check(peer.controller.start(r5f::kCanTiming), "can1 starts at 1 Mbit/s");
   cdcr::model::ImageView image{};
-  // The planner has the model the board carries (the same image file).
   check(bind_board_image(planner_files, correction, image), "the image binds");
   print("model: ", image.training_points, " training points\n");
   drives.segments = geometry.segment_count;
-  // The update's image and its digest, made before the cycles start: the
-  // peer's own work, which would otherwise take the periods' room.
   const cdcr::hal::MemoryRegion region = planner_files.model_storage.model_region();
   const std::uint32_t image_size = static_cast<std::uint32_t>(region.size_bytes);
   check(image_size <= sizeof(updated_image), "the image fits the update's buffer");
-  if (failures != 0) return;
-  copy_with_other_creation_time(region.data, image_size, updated_image);
-  firmware::UpdateSender update(updated_image, image_size);
+  if (failures == 0) copy_with_other_creation_time(region.data, image_size, updated_image);
+  return image_size;
+}
 
-  // Ready: the runtime starts its cycles a period from about now; the
-  // peer's first period comes half a period before the runtime's first.
+// Ready: the runtime starts its cycles a period from about now; the peer's
+// first period comes half a period before the runtime's first.
+void signal_ready() {
   next_release_ns = peer_clock.now_ns() + kPeriodNs / 2;
   peer_state = kPeerReady;
+}
 
-  // 1. The host's cable sets, one a cycle, four rounds.
-  replay_golden_cases(4);
-
-  // 2. The drives start where golden case 0 has them; forward-only cycles.
+// The drives start where golden case 0 has them; forward-only periods,
+// with POSE_UNCERTAINTY on the bus.
+void forward_only_periods(Scenario& scenario) {
   for (int s = 0; s < drives.segments; ++s) {
     for (int k = 0; k < 4; ++k) drives.lengths_mm[s][k] = float(golden::kCablesMm[0][4 * s + k]);
   }
   const int uncertainty_after_replay = bus.uncertainty_frames;
   for (int i = 0; i < 200; ++i) period();
-  const int uncertainty_forward = bus.uncertainty_frames;
+  scenario.uncertainty_frames_forward = bus.uncertainty_frames;
   check(bus.uncertainty_frames > uncertainty_after_replay, "POSE_UNCERTAINTY on the bus between targets");
   check(bus.uncertainty.r95_position_mm > 0 && bus.uncertainty.r95_position_mm < 65,
         "the r95 position radius is a length");
+}
 
-  // Targets in the paper's workspace, pose and position, one in eight
-  // unreachable.
+// Targets in the paper's workspace, pose and position, one in eight
+// unreachable.
+void paper_workspace_targets(Scenario& scenario) {
   for (int t = 0; t < 48; ++t) {
     if (t % 8 == 7) {
       cdcr::model::Pose<float> far;
       far.position_mm = cdcr::model::Vec3<float>(900.0f, 0.0f, 50.0f);
-      solve(far, protocol::TargetMode::position);
+      solve(scenario, far, protocol::TargetMode::position);
     } else {
       const bool pose = t % 3 != 0;
-      solve(reachable_target(random_numbers, correction, geometry, 0.2f),
+      solve(scenario, reachable_target(random_numbers, correction, geometry, 0.2f),
             pose ? protocol::TargetMode::pose : protocol::TargetMode::position);
     }
   }
+}
 
-  // A streamed path: a TRACKING target every period, the compensated tip
-  // of joints that move smoothly (reachable by construction). Then periods
-  // until the last one's final report is in, the first of 100 more.
+// A streamed path: a TRACKING target every period, the compensated tip
+// of joints that move smoothly (reachable by construction). Then periods
+// until the last one's final report is in, the first of 100 more.
+void streamed_path(Scenario& scenario) {
   cdcr::model::JointVector<float> joints(2 * drives.segments);
   int reports_before_last = 0;
   std::uint8_t last_sequence = 0;
@@ -496,7 +517,7 @@ void run_peer() {
     const cdcr::model::Pose<float> tip = compensated_tip(correction, geometry, joints);
     begin_period();
     reports_before_last = bus.ik_reports;
-    last_sequence = next_sequence++;
+    last_sequence = scenario.next_sequence++;
     deliver_target(peer, tip, protocol::TargetMode::position, true, last_sequence);
     exchange_with_drives();
     end_period();
@@ -506,54 +527,58 @@ void run_peer() {
   }
   check(final_report_for(reports_before_last, last_sequence), "the streamed path's last target ends");
   for (int i = 1; i < 100; ++i) period();
+}
 
-  print("targets: ", targets_sent, " sent, ", targets_converged, " converged, ", reports_seen,
-        " with their final IK_REPORT on the bus, ", setpoints_at_drives,
+// What became of the targets, on the bus.
+void check_targets(const Scenario& scenario) {
+  const TargetOutcomes& targets = scenario.targets;
+  print("targets: ", targets.sent, " sent, ", targets.converged, " converged, ", targets.final_reports,
+        " with their final IK_REPORT on the bus, ", targets.setpoints_at_every_drive,
         " converged with their setpoints at every drive; pose at the target within ");
-  zynqmp::console_write_fixed(worst_reached_mm, 4);
+  zynqmp::console_write_fixed(targets.worst_reached_mm, 4);
   print(" mm; POSE_UNCERTAINTY frames ", bus.uncertainty_frames, "\n");
-  check(reports_seen == targets_sent, "every target's final IK_REPORT is on the bus");
-  check(targets_converged >= targets_sent * 3 / 4, "most targets converge");
-  check(setpoints_at_drives == targets_converged, "every converged target's setpoints reach every drive");
-  check(worst_reached_mm <= 0.1, "the pose the drives' lengths give is within 0.1 mm of the converged target");
-  check(bus.uncertainty_frames > uncertainty_forward, "POSE_UNCERTAINTY while targets come and go");
+  check(targets.final_reports == targets.sent, "every target's final IK_REPORT is on the bus");
+  check(targets.converged >= targets.sent * 3 / 4, "most targets converge");
+  check(targets.setpoints_at_every_drive == targets.converged, "every converged target's setpoints reach every drive");
+  check(targets.worst_reached_mm <= 0.1, "the pose the drives' lengths give is within 0.1 mm of the converged target");
+  check(bus.uncertainty_frames > scenario.uncertainty_frames_forward, "POSE_UNCERTAINTY while targets come and go");
   check_equal(static_cast<std::uint32_t>(reported_rejected_frames), 0, "STATS: no frame rejected before the faults");
+}
 
-  // 3. A model update over CAN, targets going on meanwhile. The runtime
-  // runs the image the board carries (no slot) before it, slot A after it.
+// A model update over CAN, targets going on meanwhile. The runtime runs
+// the image the board carries (no slot) before it, slot A after it.
+void model_update(Scenario& scenario, firmware::UpdateSender& update) {
   const int update_start_period = periods_run;
-  {
-    update.resend_after = 199;
-    sender = &update;
-    for (int i = 0; i < 8'000 && update.outcome() == firmware::UpdateSender::Outcome::running; ++i) {
-      begin_period();
-      if (i == 0) update.start(peer, periods_run);
-      if (i % 40 == 0) {
-        deliver_target(peer, reachable_target(random_numbers, correction, geometry, 0.2f),
-                       protocol::TargetMode::pose, false, next_sequence++);
-      }
-      exchange_with_drives();
-      sender->pump(periods_run, peer, kUpdateFramesPerCycle);
-      end_period();
+  update.resend_after = 199;
+  sender = &update;
+  for (int i = 0; i < 8'000 && update.outcome() == firmware::UpdateSender::Outcome::running; ++i) {
+    begin_period();
+    if (i == 0) update.start(peer, periods_run);
+    if (i % 40 == 0) {
+      deliver_target(peer, reachable_target(random_numbers, correction, geometry, 0.2f), protocol::TargetMode::pose,
+                     false, scenario.next_sequence++);
     }
-    for (int i = 0; i < 20; ++i) period();
-    sender = nullptr;
-    const bool committed = update.outcome() == firmware::UpdateSender::Outcome::committed;
-    print("model update: ", update.total_blocks(), " blocks, ", update.frames_sent(), " frames, ", update.rewinds(),
-          " rewinds, ", update.restarts(), " restarts over ", periods_run - update_start_period,
-          " cycles; outcome ", committed ? "committed" : "not committed", "; UPDATE_REPORT: state ",
-          static_cast<int>(last_update_report.state), ", active slot ", last_update_report.active_slot,
-          "; STATUS state ", bus.reported_state, "\n");
-    check(committed, "the model update commits");
+    exchange_with_drives();
+    sender->pump(periods_run, peer, kUpdateFramesPerCycle);
+    end_period();
   }
+  for (int i = 0; i < 20; ++i) period();
+  sender = nullptr;
+  const bool committed = update.outcome() == firmware::UpdateSender::Outcome::committed;
+  print("model update: ", update.total_blocks(), " blocks, ", update.frames_sent(), " frames, ", update.rewinds(),
+        " rewinds, ", update.restarts(), " restarts over ", periods_run - update_start_period, " cycles; outcome ",
+        committed ? "committed" : "not committed", "; UPDATE_REPORT: state ",
+        static_cast<int>(last_update_report.state), ", active slot ", last_update_report.active_slot,
+        "; STATUS state ", bus.reported_state, "\n");
+  check(committed, "the model update commits");
   check(last_update_report.state == protocol::UpdateState::committed && last_update_report.active_slot == kWireSlotA,
         "UPDATE_REPORT: the runtime switched to the new model in slot A");
   check(bus.reported_state == static_cast<int>(RuntimeState::run), "STATUS: the runtime runs the new model");
-  // The new model's poses: the host's, as before the update.
-  replay_golden_cases(1);
+}
 
-  // 4. Bus faults. A foreign identifier the acceptance filters keep out,
-  // and a cable frame of the wrong length: rejected, counted, nothing else.
+// A foreign identifier the acceptance filters keep out, and a cable frame
+// of the wrong length: rejected, counted, nothing else.
+void bad_frames() {
   begin_period();
   CanFrame foreign;
   foreign.id = 0x7F0;
@@ -571,10 +596,12 @@ void run_peer() {
   check_equal(static_cast<std::uint32_t>(reported_rejected_frames), 1,
               "STATS: the short cable frame is rejected and counted, the foreign identifier has no effect");
   check(bus.reported_state == static_cast<int>(RuntimeState::run), "STATUS: bad frames leave the runtime in RUN");
+}
 
-  // A flood: more frames in one period than the controller's RX FIFO and
-  // the driver's ring hold together. The overflow's count is the
-  // runtime's core's to check.
+// A flood: more frames in one period than the controller's RX FIFO and
+// the driver's ring hold together. The overflow's count is the runtime's
+// core's to check.
+void flood() {
   const std::int64_t overruns_before_flood = reported_overruns;
   const int poses_before_flood = bus.pose_frames;
   begin_period();
@@ -596,8 +623,10 @@ void run_peer() {
               "STATUS: no release missed in the flood");
   check(bus.pose_frames - poses_before_flood >= 3 * 50, "poses go on through the flood");
   check(bus.reported_state == static_cast<int>(RuntimeState::run), "STATUS: the flood leaves the runtime in RUN");
+}
 
-  // The drives go silent, then come back.
+// The drives go silent, then come back.
+void silent_drives() {
   drives_report = false;
   for (int i = 0; i < 3 * firmware::kStaleInputCycles; ++i) period();
   print("drives silent: STATUS state ", bus.reported_state, ", fault ", bus.reported_fault, "\n");
@@ -607,7 +636,10 @@ void run_peer() {
   for (int i = 0; i < 3 * firmware::kStatusEveryCycles; ++i) period();
   print("drives back: STATUS state ", bus.reported_state, "\n");
   check(bus.reported_state == static_cast<int>(RuntimeState::run), "STATUS reports RUN once the drives are back");
+}
 
+// Periods until 2,000 have run, then the peer's own figures.
+void finish_scenario() {
   while (periods_run < 2000) period();
   finish_work();
   print("peer: ", periods_run, " periods on the second core, the longest's work ",
@@ -616,6 +648,31 @@ void run_peer() {
   check_equal(periods_late, 0, "peer periods whose work ran past the limit");
   check_equal(static_cast<std::uint32_t>(reported_overruns), 0, "STATUS: releases missed");
   check_equal(peer.refused, 0, "frames can1 could not send");
+}
+
+// The peer's scenario; its checks counted in checks.hpp's failures.
+void run_peer() {
+  const std::uint32_t image_size = prepare_planner();
+  if (failures != 0) return;
+  // The update's digest, made before the cycles start as its image is.
+  firmware::UpdateSender update(updated_image, image_size);
+  Scenario scenario;
+  signal_ready();
+  // 1. The host's cable sets, one a cycle, four rounds.
+  replay_golden_cases(4);
+  // 2. The mixed workload.
+  forward_only_periods(scenario);
+  paper_workspace_targets(scenario);
+  streamed_path(scenario);
+  check_targets(scenario);
+  // 3. A model update; the new model's poses are the host's, as before it.
+  model_update(scenario, update);
+  replay_golden_cases(1);
+  // 4. Bus faults.
+  bad_frames();
+  flood();
+  silent_drives();
+  finish_scenario();
 }
 
 }  // namespace
