@@ -428,6 +428,11 @@ def mean_errors(poses_a, poses_b):
     return float(np.mean(position)), float(np.mean(orientation)), float(np.max(position))
 
 
+def pose_fields(pose):
+    """A measured pose as the dataset's x,y,z,qw,qx,qy,qz fields."""
+    return ["{:.6f}".format(v) for v in pose[:3, 3]] + ["{:.8f}".format(v) for v in quaternion(pose[:3, :3])]
+
+
 def write_csv(path, data, seed, session, robot, cables="cables", payload=False):
     """The dataset CSV: t_s, cables, pose; with payload the rows are independent samples (the project takes no
     time column with a payload column): cables, payload_kg, pose."""
@@ -448,7 +453,7 @@ def write_csv(path, data, seed, session, robot, cables="cables", payload=False):
         for t, lengths, mass, pose in zip(data["t_s"], data[cables], data["payload_kg"], data["measured"]):
             values = ([] if payload else ["{:.3f}".format(t)]) + ["{:.6f}".format(c) for c in lengths]
             values += ["{:.6f}".format(mass)] if payload else []
-            values += ["{:.6f}".format(v) for v in pose[:3, 3]] + ["{:.8f}".format(v) for v in quaternion(pose[:3, :3])]
+            values += pose_fields(pose)
             f.write(",".join(values) + "\n")
 
 # --- the real-like robot: tendon statics, capstan friction, collections ------
@@ -867,7 +872,7 @@ def write_real_like_csv(path, data, seed, session, robot, collection, cables="ca
         f.write(",".join(names) + "\n")
         for t, lengths, pose in zip(data["t_s"], data[cables], data["measured"]):
             values = ["{:.3f}".format(t)] + ["{:.6f}".format(c) for c in lengths]
-            values += ["{:.6f}".format(v) for v in pose[:3, 3]] + ["{:.8f}".format(v) for v in quaternion(pose[:3, :3])]
+            values += pose_fields(pose)
             f.write(",".join(values) + "\n")
 
 
