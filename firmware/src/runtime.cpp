@@ -217,6 +217,8 @@ void Runtime::update_pose() {
     if (const model::Status s = estimate_pose(hysteresis_.track(latest_cables_mm_), estimate);
         s == model::Status::ok) {
       latest_pose_ = estimate;
+      // IK's corrections take the cables' residuals as last measured.
+      model_.correction.set_cable_residuals(estimate.cable_residuals);
       has_pose_ = true;
       last_valid_cycle_ = cycle_;
       if (state_ == RuntimeState::fault) enter(mode());

@@ -21,6 +21,9 @@ struct SyntheticModelOptions {
   std::uint32_t seed = 20200921;
   // One more input after the bend pairs: the payload, 0 to 1 kg.
   bool payload_input = false;
+  // The cable-fit encoding: after the bend pairs, each segment's common
+  // mode (-1.5 to 0 mm) and pair imbalance (-1 to 1 mm).
+  bool cable_residuals = false;
   // The correction's size: the output means and scales of the position
   // outputs times the first, of the rotation outputs times the second (a
   // trained model's correction is millimetres and milliradians).
@@ -60,24 +63,29 @@ inline training::TrainedModel synthetic_trained_model(const SyntheticModelOption
   const auto uniform = [&rng](double low, double high) { return std::uniform_real_distribution<double>(low, high)(rng); };
 
   training::TrainedModel m;
-  m.encoding = options.encoding;
+  m.encoding = options.cable_residuals ? model::InputEncoding::bend_vector_cable_fit : options.encoding;
   m.geometry = model::RobotGeometry<double>::uniform(options.segments, 120.0, 67.0);
   m.geometry.segments[options.segments - 1].backbone_length_mm = 95.5;  // not all segments alike
 
   const int n = options.training_points;
-  const int d = 2 * options.segments + (options.payload_input ? 1 : 0);
+  const int residuals = options.cable_residuals ? 2 * options.segments : 0;
+  const int d = 2 * options.segments + residuals + (options.payload_input ? 1 : 0);
   m.inputs.resize(n, d);
   for (int i = 0; i < n; ++i) {
     for (int s = 0; s < options.segments; ++s) {
       const double alpha_rad = uniform(-3.0, 3.0);
       const double theta_rad = uniform(0.05, 1.2);
-      if (options.encoding == model::InputEncoding::bend_vector) {
+      if (m.encoding != model::InputEncoding::joint_angles) {
         m.inputs(i, 2 * s) = theta_rad * std::cos(alpha_rad);
         m.inputs(i, 2 * s + 1) = theta_rad * std::sin(alpha_rad);
       } else {
         m.inputs(i, 2 * s) = alpha_rad;
         m.inputs(i, 2 * s + 1) = theta_rad;
       }
+    }
+    for (int s = 0; s < options.segments && residuals > 0; ++s) {
+      m.inputs(i, 2 * options.segments + 2 * s) = uniform(-1.5, 0.0);
+      m.inputs(i, 2 * options.segments + 2 * s + 1) = uniform(-1.0, 1.0);
     }
     if (options.payload_input) m.inputs(i, d - 1) = uniform(0.0, 1.0);
   }

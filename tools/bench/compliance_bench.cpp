@@ -58,10 +58,10 @@ Outcome train_and_test(const TrainingSet& all, const TrainingSet& test, const Ro
   const TrainedModel searched = train(train_set, g, search_options, &report);
   const TrainingSet validation = all.subset(split.test);
   Outcome o;
-  o.validation = evaluate(validation, predict_error_twists(searched, validation.bends, validation.payload_kg)).compensated;
+  o.validation = evaluate(validation, predict_error_twists(searched, validation)).compensated;
   o.log_marginal_likelihood = report.log_marginal_likelihood;
   const TrainedModel model = refit(searched, shipped.kind, all);
-  o.test = evaluate(test, predict_error_twists(model, test.bends, test.payload_kg)).compensated;
+  o.test = evaluate(test, predict_error_twists(model, test)).compensated;
   return o;
 }
 

@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """What makes the real robot's recordings hard, measured on the independent robot's real-like files.
 
-    real_like_bench.py babbling FILE.csv [--report ROBOT.json] [--train-rows 1500] [--json]
+    real_like_bench.py babbling FILE.csv [--report ROBOT.json] [--train-rows 1500] [--cdcr CDCR] [--json]
     real_like_bench.py repeatability FILE.csv [--report ROBOT.json] [--json]
 
 babbling: the rows in order, the first 80 % to train and the last 20 % to
@@ -14,7 +14,11 @@ test (as the lab's), then
     given all cables, and given only the two differences l3 - l1, l2 - l4;
     at most --train-rows training rows, evenly spaced;
   - the noise floor of the robot's report (--report: independent_robot.py's
-    JSON, the first session's), when given.
+    JSON, the first session's), when given;
+  - with --cdcr (the cdcr executable): the project's model, `cdcr train` on
+    the rows scikit-learn's GP got (as independent samples: no t_s) and on
+    the whole first 80 % as the sequence it is, each `cdcr eval`uated on the
+    last 20 %: the compensated mean position error and the encoding chosen.
 repeatability: the same split, and
   - the same command from the same previous one: the mean over pairs of
     such visits of |p_a - p_b| / sqrt(2), from the file alone (commands told
@@ -28,7 +32,9 @@ import argparse
 import json
 import math
 import os
+import subprocess
 import sys
+import tempfile
 
 import numpy as np
 
@@ -36,6 +42,44 @@ sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import independent_robot as robot  # noqa: E402
 
 TRAIN_SHARE = 0.8
+
+
+def write_rows(path, source, rows, with_time):
+    """The source CSV's comment lines, header and the given data rows (0-based), optionally without t_s."""
+    with open(source) as f:
+        lines = f.read().splitlines()
+    comments = [line for line in lines if line.startswith("#")]
+    table = [line for line in lines if not line.startswith("#")]
+    header, data = table[0], table[1:]
+    drop = not with_time and header.startswith("t_s,")
+
+    def cut(line):
+        return line.split(",", 1)[1] if drop else line
+
+    with open(path, "w") as f:
+        f.write("\n".join([line for line in comments if not (drop and "t_s" in line)] + [cut(header)] +
+                          [cut(data[i]) for i in rows]) + "\n")
+
+
+def cdcr_json(cdcr, *arguments):
+    done = subprocess.run([cdcr, *arguments, "--json"], capture_output=True, text=True)
+    if done.returncode != 0:
+        sys.exit("real_like_bench.py: error: cdcr {} failed: {}".format(arguments[0], done.stderr.strip()))
+    return json.loads(done.stdout)
+
+
+def cdcr_model(cdcr, source, train_rows, test_rows, with_time, length_mm, radius_mm):
+    """cdcr train on train_rows, cdcr eval on test_rows: the compensated error, the encoding, the cable fit's counts."""
+    with tempfile.TemporaryDirectory() as work:
+        train, test, image = (os.path.join(work, name) for name in ("train.csv", "test.csv", "model.img"))
+        write_rows(train, source, train_rows, with_time)
+        write_rows(test, source, test_rows, with_time)
+        trained = cdcr_json(cdcr, "train", "--data", train, "--out", image, "--holdout", "0", "--segments", "1",
+                            "--length", str(length_mm), "--radius", str(radius_mm))
+        evaluated = cdcr_json(cdcr, "eval", "--model", image, "--data", test)
+    return {"compensated_mm": evaluated["compensated"]["position_mm"], "encoding": trained["encoding"],
+            "model": trained["model"]["reason"], "cable_inputs": trained["cable_inputs"],
+            "extrapolating": evaluated["extrapolating"]}
 
 
 def read(path):
@@ -79,7 +123,7 @@ def split(n):
     return int(round(TRAIN_SHARE * n))
 
 
-def babbling(path, train_rows):
+def babbling(path, train_rows, cdcr=None):
     length_mm, radius_mm, cables, position = read(path)
     n = len(cables)
     cut = split(n)
@@ -96,6 +140,10 @@ def babbling(path, train_rows):
         predicted, kernel = fit_gp(inputs[pick], position[pick], inputs[cut:])
         out[name] = mean_distance(predicted, position[cut:])
         out[name.replace("_mm", "_kernel")] = str(kernel)
+    if cdcr:
+        test = list(range(cut, n))
+        out["cdcr_same_rows"] = cdcr_model(cdcr, path, pick, test, False, length_mm, radius_mm)
+        out["cdcr_sequence"] = cdcr_model(cdcr, path, range(cut), test, True, length_mm, radius_mm)
     return out
 
 
@@ -142,9 +190,10 @@ def main(argv=None):
     parser.add_argument("file", help="a session CSV of independent_robot.py")
     parser.add_argument("--report", help="independent_robot.py's --report JSON: adds the first session's floor")
     parser.add_argument("--train-rows", type=int, default=1500, help="babbling: training rows used (default 1500)")
+    parser.add_argument("--cdcr", help="babbling: the cdcr executable, to measure the project's model too")
     parser.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     args = parser.parse_args(argv)
-    out = babbling(args.file, args.train_rows) if args.collection == "babbling" else repeatability(args.file)
+    out = babbling(args.file, args.train_rows, args.cdcr) if args.collection == "babbling" else repeatability(args.file)
     if args.report:
         with open(args.report) as f:
             out["noise_floor_mm"] = json.load(f)["sessions"][0]["noise_floor"]["position_mm"]

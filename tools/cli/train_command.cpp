@@ -117,8 +117,40 @@ TrainingSets training_sets_for(const TrainCommandOptions& o, const dataset::Data
   return sets;
 }
 
+// --encoding auto: the residuals of the cable fit join the bend where the
+// evidence on the training rows keeps them. An encoding given by name must
+// read every row on the board.
+std::optional<training::CableInputChoice> choose_encoding(const TrainCommandOptions& o, TrainingSets& sets,
+                                                          const dataset::Dataset& data,
+                                                          const model::RobotGeometry<double>& geometry,
+                                                          training::TrainingOptions& options) {
+  const int beyond_limit =
+      sets.all.beyond_limit_rows + (sets.validation_data ? sets.validation.beyond_limit_rows : 0);
+  if (o.training.encoding != "auto") {
+    if (!model::takes_cable_residuals(options.encoding) && beyond_limit > 0) {
+      throw InputError(fmt::format(
+          "{}: {} rows bend beyond the limit or the anchors' reach, which --encoding {} cannot read on the board; "
+          "use --encoding auto or bend-vector+cable-fit, or raise --theta-max",
+          o.data_path, beyond_limit, o.training.encoding));
+    }
+    return std::nullopt;
+  }
+  if (sets.train.size() < 2) return std::nullopt;  // reported with the other counts below
+  training::CableInputChoice choice;
+  try {
+    choice = training::choose_cable_inputs(sets.train, options, beyond_limit > 0);
+  } catch (const std::invalid_argument& e) {
+    throw InputError(fmt::format("{}: {}", o.data_path, e.what()));
+  }
+  if (choice.encoding != options.encoding) {
+    options.encoding = choice.encoding;
+    sets = training_sets_for(o, data, geometry, options.encoding);
+  }
+  return choice;
+}
+
 CommandOutput run_train(const TrainCommandOptions& o) {
-  const training::TrainingOptions options = training_options_for(o);
+  training::TrainingOptions options = training_options_for(o);
   const dataset::Dataset data = load_dataset(o.data_path, true);
   const model::RobotGeometry<double> design = geometry_for(data, o.geometry);
 
@@ -138,6 +170,7 @@ CommandOutput run_train(const TrainCommandOptions& o) {
       calibration_skipped = e.what();
     }
   }
+  const std::optional<training::CableInputChoice> cable_inputs = choose_encoding(o, sets, data, geometry, options);
   const training::TrainingSet& all = sets.all;
   const training::TrainingSet& train_set = sets.train;
   const training::TrainingSet& validation_set = sets.validation;
@@ -200,6 +233,10 @@ CommandOutput run_train(const TrainCommandOptions& o) {
   run.data_has_time = data.has_time;
   run.payload = payload ? &*payload : nullptr;
   run.payload_input = all.has_payload();
+  run.cable_inputs = cable_inputs ? &*cable_inputs : nullptr;
+  run.data_rows = all.size();
+  run.far_from_consistent_rows = all.far_from_consistent_rows;
+  run.beyond_limit_rows = all.beyond_limit_rows;
   run.seconds = seconds;
   CommandOutput output;
   output.text = o.json ? train_report_json(run) : train_report_text(run);

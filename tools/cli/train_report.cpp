@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 
+#include "cdcr/model/cable_fit.hpp"
 #include "json_output.hpp"
 
 namespace cdcr::cli {
@@ -220,6 +221,43 @@ std::string compliance_text(const TrainRun& run) {
 
 }  // namespace
 
+Json cable_inputs_json(const TrainRun& run) {
+  Json j = {{"data_rows", run.data_rows},
+            {"far_from_consistent_rows", run.far_from_consistent_rows},
+            {"beyond_limit_rows", run.beyond_limit_rows}};
+  if (run.cable_inputs == nullptr) {
+    j["choice"] = nullptr;
+    return j;
+  }
+  const training::CableInputChoice& c = *run.cable_inputs;
+  j["choice"] = {{"encoding", model::to_string(c.encoding)},
+                 {"searched", c.searched},
+                 {"bend_only_log_likelihood", c.searched ? Json(c.bend_only_log_likelihood) : Json(nullptr)},
+                 {"with_residuals_log_likelihood", c.searched ? Json(c.with_residuals_log_likelihood) : Json(nullptr)},
+                 {"extra_parameters", c.extra_parameters},
+                 {"search_rows", c.search_rows},
+                 {"largest_residual_mm", c.largest_residual_mm},
+                 {"reason", c.reason}};
+  return j;
+}
+
+// Said only when the cables are not all consistent: data that are stay
+// reported as they were.
+std::string cable_inputs_text(const TrainRun& run) {
+  std::string t;
+  if (run.far_from_consistent_rows > 0 || run.beyond_limit_rows > 0) {
+    t += fmt::format("  cable fit: {} of {} rows far from constant curvature (a residual over {} mm), {} beyond the "
+                     "bend limit or the anchors' reach\n",
+                     run.far_from_consistent_rows, run.data_rows, model::kFarFromConsistentMm, run.beyond_limit_rows);
+  }
+  if (run.cable_inputs != nullptr && (run.cable_inputs->searched || run.beyond_limit_rows > 0)) {
+    t += fmt::format("  cable residuals as inputs: {} ({})\n",
+                     run.cable_inputs->encoding == model::InputEncoding::bend_vector_cable_fit ? "yes" : "no",
+                     run.cable_inputs->reason);
+  }
+  return t;
+}
+
 std::string train_report_json(const TrainRun& run) {
   const training::ExportResult& r = *run.result;
   const training::TrainedModel& m = r.model;
@@ -250,6 +288,7 @@ std::string train_report_json(const TrainRun& run) {
   }
   j["calibration_skipped"] = run.calibration_skipped.empty() ? Json(nullptr) : Json(run.calibration_skipped);
   j["encoding"] = model::to_string(m.encoding);
+  j["cable_inputs"] = cable_inputs_json(run);
   j["payload_input"] = m.has_payload_input();
   j["default_payload_kg"] = m.has_payload_input() ? Json(m.default_payload_kg) : Json(nullptr);
   j["kernel"] = run.kernel;
@@ -314,6 +353,7 @@ std::string train_report_text(const TrainRun& run) {
   } else if (!run.calibration_skipped.empty()) {
     t += fmt::format("  design geometry: not calibrated ({})\n", run.calibration_skipped);
   }
+  t += cable_inputs_text(run);
   t += fmt::format("  encoding {}, kernel {} squared exponential, hyperparameters shared by the 6 outputs\n",
                    model::to_string(m.encoding), run.kernel);
   if (m.has_payload_input()) {

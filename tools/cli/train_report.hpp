@@ -6,6 +6,7 @@
 #include <string>
 
 #include "pipeline/train_and_export.hpp"
+#include "train/cable_inputs.hpp"
 #include "train/calibration.hpp"
 #include "train/model_selection.hpp"
 
@@ -33,6 +34,13 @@ struct TrainRun {
   // motion sequence, or --no-compliance).
   const training::PayloadExport* payload = nullptr;
   bool payload_input = false;  // the model takes the payload
+  // The choice of the cables' residuals as inputs (null: an encoding given
+  // by --encoding), and the rows the cable fit found far from consistent or
+  // beyond the bend limit, of `data_rows`.
+  const training::CableInputChoice* cable_inputs = nullptr;
+  int data_rows = 0;
+  int far_from_consistent_rows = 0;
+  int beyond_limit_rows = 0;
   double seconds = 0;
 };
 

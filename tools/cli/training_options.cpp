@@ -9,8 +9,11 @@ namespace cdcr::cli {
 
 void add_training_flags(CLI::App& command, TrainingFlags& flags, bool with_encoding) {
   if (with_encoding) {
-    command.add_option("--encoding", flags.encoding, "GP input encoding")
-        ->check(CLI::IsMember({"bend-vector", "joint-angles"}))
+    command
+        .add_option("--encoding", flags.encoding,
+                    "GP input encoding; auto: the bend vector, and the cables' residuals beside it where the "
+                    "evidence keeps them (bend-vector+cable-fit)")
+        ->check(CLI::IsMember({"auto", "bend-vector", "bend-vector+cable-fit", "joint-angles"}))
         ->capture_default_str();
   }
   command.add_option("--kernel", flags.kernel, "Length scales: one per input (ard) or one for all (isotropic, the paper's)")
@@ -22,6 +25,7 @@ void add_training_flags(CLI::App& command, TrainingFlags& flags, bool with_encod
 
 model::InputEncoding parse_encoding(const std::string& name) {
   if (name == "joint-angles") return model::InputEncoding::joint_angles;
+  if (name == "bend-vector+cable-fit") return model::InputEncoding::bend_vector_cable_fit;
   return model::InputEncoding::bend_vector;
 }
 

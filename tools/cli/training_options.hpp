@@ -13,7 +13,9 @@ class App;
 namespace cdcr::cli {
 
 struct TrainingFlags {
-  std::string encoding = "bend-vector";
+  // auto: the bend vector, with the cables' residuals when the evidence
+  // says so (train/cable_inputs.hpp).
+  std::string encoding = "auto";
   std::string kernel = "ard";
   int restarts = 2;
   unsigned long long seed = 1;
@@ -22,6 +24,7 @@ struct TrainingFlags {
 // with_encoding: whether the command takes a single --encoding.
 void add_training_flags(CLI::App& command, TrainingFlags& flags, bool with_encoding = true);
 
+// "auto" reads as the bend vector, the choice's starting point.
 model::InputEncoding parse_encoding(const std::string& name);
 
 // Throws InputError for out-of-range values.

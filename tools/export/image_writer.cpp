@@ -122,6 +122,13 @@ void check_parses(ImageBuffer& image, std::uint32_t size) {
   }
 }
 
+// The cable-fit encoding is 2.4's; the blocks' minor versions are older, so
+// it is put after them.
+void put_encoding_version(ImageBuffer& image, model::InputEncoding encoding) {
+  if (!model::takes_cable_residuals(encoding)) return;
+  image.put_field(model::image_field::version_minor, model::kImageVersionMinorCableFit);
+}
+
 // The counts the image is laid out for, once the model has them consistently.
 struct ModelDims {
   int points;
@@ -136,7 +143,7 @@ ModelDims checked_dims(const training::TrainedModel& model) {
   const int n = model.training_points();
   const int d = model.input_dims();
   const int segments = model.geometry.segment_count;
-  const int extra = d - 2 * segments;
+  const int extra = d - model::encoded_input_count(model.encoding, segments);
   if (n < 1 || extra < 0 || extra > model::kMaxExtraInputs || model.alpha.rows() != n || model.alpha.cols() != model::kImageOutputs ||
       model.input_mean.size() != d || model.input_scale.size() != d || model.length_scales.size() != d) {
     throw std::invalid_argument("trained model has inconsistent dimensions");
@@ -311,6 +318,7 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   // byte for byte.
   put_hysteresis(image, layout.hysteresis_offset, model.hysteresis);
   put_compliance(image, layout.compliance_offset, model.compliance);
+  put_encoding_version(image, model.encoding);
   put_metadata(image, layout.metadata_offset, model, dims.rows_fitted);
   put_checksum(image, layout.total_size);
   check_parses(image, layout.total_size);
@@ -352,6 +360,7 @@ std::vector<std::uint8_t> with_blocks(const std::vector<std::uint8_t>& image,
   out.put_field(model::image_field::metadata_offset, layout.metadata_offset);
   put_hysteresis(out, layout.hysteresis_offset, hysteresis);
   put_compliance(out, layout.compliance_offset, compliance);
+  put_encoding_version(out, view.encoding);
   put_checksum(out, layout.total_size);
   check_parses(out, layout.total_size);
   return out.take();

@@ -87,7 +87,7 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   };
   add_variance(searched, train_set);
   if (validation_set.size() > 0) {
-    const Eigen::MatrixXd predicted = predict_error_twists(searched, validation_set.bends, validation_set.payload_kg);
+    const Eigen::MatrixXd predicted = predict_error_twists(searched, validation_set);
     r.validation = evaluate(validation_set, predicted);
     const std::vector<std::uint8_t> image = exporting::write_image(searched);
     r.firmware.samples = validation_set.size();
@@ -117,7 +117,7 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   // write the final one with the figures; the payload is identical.
   const TrainingSet& fidelity_set = r.validation.samples > 0 ? validation_set : fitted_set;
   const std::vector<model::Pose<double>> double_poses =
-      compensated_poses(fidelity_set, predict_error_twists(r.model, fidelity_set.bends, fidelity_set.payload_kg));
+      compensated_poses(fidelity_set, predict_error_twists(r.model, fidelity_set));
   const std::vector<std::uint8_t> first_image = exporting::write_image(r.model);
   const model::ImageView view = parsed(first_image);
   for (const FirmwareAccumulator accumulator :
@@ -216,7 +216,7 @@ SequenceExport train_and_export_sequence(const dataset::Dataset& data, const std
   if (validation_set.size() > 0) {
     const TrainedModel& joints_only = out.identification.joints_only;
     out.joints_only_validation =
-        evaluate(validation_set, predict_error_twists(joints_only, validation_set.bends, validation_set.payload_kg));
+        evaluate(validation_set, predict_error_twists(joints_only, validation_set));
   }
   return out;
 }

@@ -37,7 +37,7 @@ LearningCurvePoint measured_point(const TrainingSet& train_set, const TrainingSe
   p.training_samples = train_set.size();
   p.model_points = static_cast<int>(c.shared.inputs.rows());
   p.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-  p.compensated = evaluate(test, c.predict(test.bends, test.payload_kg)).compensated;
+  p.compensated = evaluate(test, c.predict(test)).compensated;
   return p;
 }
 

@@ -68,7 +68,8 @@ Eigen::MatrixXd denormalised(const Eigen::MatrixXd& m, const Eigen::VectorXd& me
   return (m.array().rowwise() * scale.transpose().array()).rowwise() + mean.transpose().array();
 }
 
-// At most `count` rows of x and y, drawn at random without repetition.
+}  // namespace
+
 std::pair<Eigen::MatrixXd, Eigen::MatrixXd> random_rows(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
                                                         int count, std::uint64_t seed) {
   if (count >= x.rows()) return {x, y};
@@ -80,8 +81,6 @@ std::pair<Eigen::MatrixXd, Eigen::MatrixXd> random_rows(const Eigen::MatrixXd& x
   std::sort(order.begin(), order.end());
   return {x(order, Eigen::all), y(order, Eigen::all)};
 }
-
-}  // namespace
 
 Eigen::MatrixXd inducing_inputs(const Eigen::MatrixXd& x, int m, int iterations, std::uint64_t seed) {
   Eigen::MatrixXd z = initial_inducing_inputs(x, m, seed);
@@ -177,17 +176,22 @@ TrainedModel refit(const TrainedModel& model, ModelKind kind, const TrainingSet&
 }
 
 namespace {
-// The model's inputs for these rows: the payload only if the model takes it.
-Eigen::MatrixXd inputs_for(const TrainedModel& model, const Eigen::MatrixXd& bends, const Eigen::VectorXd& payload_kg) {
-  if (!model.has_payload_input()) return encode_rows(bends, model.encoding);
-  if (payload_kg.size() == 0) throw std::invalid_argument("the model takes a payload input and the rows have none");
-  return model_inputs(bends, payload_kg, model.encoding);
+// The model's inputs for these rows: the cable residuals and the payload
+// only if the model takes them.
+Eigen::MatrixXd inputs_for(const TrainedModel& model, const Eigen::MatrixXd& bends,
+                           const Eigen::MatrixXd& cable_residuals, const Eigen::VectorXd& payload_kg) {
+  if (model.has_payload_input() && payload_kg.size() == 0) {
+    throw std::invalid_argument("the model takes a payload input and the rows have none");
+  }
+  if (model::takes_cable_residuals(model.encoding) && cable_residuals.rows() != bends.rows()) {
+    throw std::invalid_argument("the model takes the cables' residuals and the rows have none");
+  }
+  return model_inputs(bends, cable_residuals, model.has_payload_input() ? payload_kg : Eigen::VectorXd(),
+                      model.encoding);
 }
-}  // namespace
 
-Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends,
-                                     const Eigen::VectorXd& payload_kg) {
-  const Eigen::MatrixXd x = normalise(inputs_for(model, bends, payload_kg), model.input_mean, model.input_scale);
+Eigen::MatrixXd predict_at(const TrainedModel& model, const Eigen::MatrixXd& inputs) {
+  const Eigen::MatrixXd x = normalise(inputs, model.input_mean, model.input_scale);
   const Eigen::MatrixXd train_x = normalise(model.inputs, model.input_mean, model.input_scale);
   Eigen::MatrixXd y(x.rows(), 6);
   for (int k = 0; k < 6; ++k) {
@@ -198,6 +202,16 @@ Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::Mat
     y.col(k) = kernel_matrix(x, train_x, h) * model.alpha.col(k);
   }
   return (y.array().rowwise() * model.output_scale.transpose().array()).rowwise() + model.output_mean.transpose().array();
+}
+}  // namespace
+
+Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends,
+                                     const Eigen::VectorXd& payload_kg) {
+  return predict_at(model, inputs_for(model, bends, Eigen::MatrixXd(), payload_kg));
+}
+
+Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const TrainingSet& rows) {
+  return predict_at(model, inputs_for(model, rows.bends, rows.cable_residuals, rows.payload_kg));
 }
 
 Compensator fit_compensator(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
@@ -221,9 +235,11 @@ Compensator fit_compensator(const TrainingSet& set, const model::RobotGeometry<d
   return c;
 }
 
-Eigen::MatrixXd Compensator::predict(const Eigen::MatrixXd& bends, const Eigen::VectorXd& payload_kg) const {
-  if (sharing == HyperparameterSharing::shared) return predict_error_twists(shared, bends, payload_kg);
-  const Eigen::MatrixXd x = normalise(inputs_for(shared, bends, payload_kg), shared.input_mean, shared.input_scale);
+Eigen::MatrixXd Compensator::predict(const TrainingSet& rows) const {
+  if (sharing == HyperparameterSharing::shared) return predict_error_twists(shared, rows);
+  const Eigen::MatrixXd x =
+      normalise(inputs_for(shared, rows.bends, rows.cable_residuals, rows.payload_kg), shared.input_mean,
+                shared.input_scale);
   Eigen::MatrixXd y(x.rows(), 6);
   for (int k = 0; k < 6; ++k) y.col(k) = per_output[k].predict(x);
   return (y.array().rowwise() * shared.output_scale.transpose().array()).rowwise() +

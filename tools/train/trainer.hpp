@@ -77,16 +77,24 @@ TrainedModel train(const TrainingSet& set, const model::RobotGeometry<double>& g
 // inputs and gets new weights.
 TrainedModel refit(const TrainedModel& model, ModelKind kind, const TrainingSet& set);
 
+// At most `count` rows of x and y, drawn at random without repetition (in
+// their order): the rows a sparse model's hyperparameter search sees.
+std::pair<Eigen::MatrixXd, Eigen::MatrixXd> random_rows(const Eigen::MatrixXd& x, const Eigen::MatrixXd& y,
+                                                        int count, std::uint64_t seed);
+
 // M inducing inputs for normalised rows x: k-means++ seeds, then
 // `iterations` of Lloyd's algorithm (a centre with no rows stays put).
 Eigen::MatrixXd inducing_inputs(const Eigen::MatrixXd& x, int m, int iterations, std::uint64_t seed);
 
 // Double-precision error twists (rows, (v, omega)) for stacked bend vectors
 // and, for a model with the payload input, their payloads (throws
-// std::invalid_argument when such a model gets none; a model without the
-// input ignores them).
+// std::invalid_argument when such a model gets none, or when the model takes
+// the cables' residuals; a model without the input ignores them).
 Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends,
                                      const Eigen::VectorXd& payload_kg = {});
+
+// The same for rows of a training set, with whatever inputs the model takes.
+Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const TrainingSet& rows);
 
 // A fitted compensator of either sharing mode, for measurements that compare
 // them; only the shared one can be exported.
@@ -96,7 +104,7 @@ struct Compensator {
   // per_output: the normalisation is in `shared`, the six GPs here.
   std::vector<GaussianProcess> per_output;
 
-  Eigen::MatrixXd predict(const Eigen::MatrixXd& bends, const Eigen::VectorXd& payload_kg = {}) const;
+  Eigen::MatrixXd predict(const TrainingSet& rows) const;
 };
 
 Compensator fit_compensator(const TrainingSet& set, const model::RobotGeometry<double>& geometry,

@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "cdcr/model/cable_fit.hpp"
 #include "cdcr/model/chain.hpp"
 #include "cdcr/model/compensation.hpp"
 
@@ -18,6 +19,7 @@ TrainingSet TrainingSet::subset(const std::vector<int>& rows) const {
   const bool has_commanded = commanded_mm.rows() > 0;
   if (has_commanded) s.commanded_mm.resize(n, commanded_mm.cols());
   s.bends.resize(n, bends.cols());
+  s.cable_residuals.resize(n, cable_residuals.cols());
   s.inputs.resize(n, inputs.cols());
   if (has_payload()) s.payload_kg.resize(n);
   s.error_twists.resize(n, 6);
@@ -25,6 +27,7 @@ TrainingSet TrainingSet::subset(const std::vector<int>& rows) const {
     s.cables_mm.row(i) = cables_mm.row(rows[i]);
     if (has_commanded) s.commanded_mm.row(i) = commanded_mm.row(rows[i]);
     s.bends.row(i) = bends.row(rows[i]);
+    s.cable_residuals.row(i) = cable_residuals.row(rows[i]);
     s.inputs.row(i) = inputs.row(rows[i]);
     if (has_payload()) s.payload_kg[i] = payload_kg[rows[i]];
     s.error_twists.row(i) = error_twists.row(rows[i]);
@@ -45,14 +48,27 @@ Eigen::MatrixXd encode_rows(const Eigen::MatrixXd& bends, model::InputEncoding e
   return inputs;
 }
 
-Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::VectorXd& payload_kg,
-                             model::InputEncoding encoding) {
-  if (payload_kg.size() == 0) return encode_rows(bends, encoding);
-  if (payload_kg.size() != bends.rows()) throw std::invalid_argument("one payload per row is needed");
-  Eigen::MatrixXd inputs(bends.rows(), bends.cols() + 1);
+Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::MatrixXd& cable_residuals,
+                             const Eigen::VectorXd& payload_kg, model::InputEncoding encoding) {
+  const bool with_residuals = model::takes_cable_residuals(encoding);
+  if (with_residuals && (cable_residuals.rows() != bends.rows() || cable_residuals.cols() != bends.cols())) {
+    throw std::invalid_argument("the cable-fit encoding needs the cables' residuals of every row");
+  }
+  if (payload_kg.size() != 0 && payload_kg.size() != bends.rows()) {
+    throw std::invalid_argument("one payload per row is needed");
+  }
+  const Eigen::Index residual_cols = with_residuals ? cable_residuals.cols() : 0;
+  Eigen::MatrixXd inputs(bends.rows(), bends.cols() + residual_cols + (payload_kg.size() > 0 ? 1 : 0));
   inputs.leftCols(bends.cols()) = encode_rows(bends, encoding);
-  inputs.col(bends.cols()) = payload_kg;
+  if (with_residuals) inputs.middleCols(bends.cols(), residual_cols) = cable_residuals;
+  if (payload_kg.size() > 0) inputs.rightCols(1) = payload_kg;
   return inputs;
+}
+
+TrainingSet with_encoding(const TrainingSet& set, model::InputEncoding encoding) {
+  TrainingSet s = set;
+  s.inputs = model_inputs(s.bends, s.cable_residuals, s.payload_kg, encoding);
+  return s;
 }
 
 TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGeometry<double>& geometry,
@@ -67,13 +83,22 @@ TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGe
   TrainingSet s;
   s.cables_mm = data.cables_mm;
   s.bends.resize(n, dims);
+  s.cable_residuals.resize(n, dims);
   s.error_twists.resize(n, 6);
   for (int i = 0; i < n; ++i) {
     const model::CableVector<double> cables = data.cables_mm.row(i).transpose();
     model::JointVector<double> joints;
-    if (const model::Status st = model::joints_from_cables(cables, geometry, joints); st != model::Status::ok) {
+    model::CableResiduals<double> residuals;
+    bool beyond_limit = false;
+    int far_segments = 0;
+    if (const model::Status st =
+            model::fit_measured_cables(cables, geometry, joints, residuals, 0.0, &beyond_limit, &far_segments);
+        st != model::Status::ok) {
       throw std::invalid_argument("sample " + std::to_string(i + 1) + ": " + model::to_string(st));
     }
+    s.far_from_consistent_rows += far_segments > 0 ? 1 : 0;
+    s.beyond_limit_rows += beyond_limit ? 1 : 0;
+    s.cable_residuals.row(i) = residuals.transpose();
     const model::JointVector<double> bend = model::bend_from_joints(joints);
     const model::Pose<double> nominal = model::forward_kinematics_bend(bend, geometry);
     s.bends.row(i) = bend.transpose();
@@ -82,7 +107,7 @@ TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGe
     s.measured.push_back(data.poses[i]);
   }
   if (data.has_payload && with_payload) s.payload_kg = data.payload_kg;
-  s.inputs = model_inputs(s.bends, s.payload_kg, encoding);
+  s.inputs = model_inputs(s.bends, s.cable_residuals, s.payload_kg, encoding);
   return s;
 }
 

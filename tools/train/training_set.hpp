@@ -1,9 +1,9 @@
 #pragma once
 // Turns a measured dataset into GP training pairs: inputs are the encoded
-// joint variables of each sample (nominal inverse of the commanded cables),
+// joint variables of each sample (the least-squares fit of all its cables,
+// model/cable_fit.hpp), with the fit's residuals for the cable-fit encoding,
 // outputs the tip error twists of eq. (18), ordered (v, omega). A dataset
-// with a payload column gives one more input, the payload (kg), after the
-// encoded joints.
+// with a payload column gives one more input, the payload (kg), last.
 
 #include <cstdint>
 #include <vector>
@@ -23,11 +23,18 @@ struct TrainingSet {
   // then holds the effective ones); empty otherwise.
   Eigen::MatrixXd commanded_mm;
   Eigen::MatrixXd bends;         // samples x 2n, stacked bend vectors
+  Eigen::MatrixXd cable_residuals;  // samples x 2n, the cable fit's [common mode, pair imbalance] per segment
   Eigen::VectorXd payload_kg;    // samples, or empty: the data carried no payload column
   Eigen::MatrixXd inputs;        // samples x D, encoded (and the payload last, when there is one)
   Eigen::MatrixXd error_twists;  // samples x 6
   std::vector<model::Pose<double>> nominal;
   std::vector<model::Pose<double>> measured;
+
+  // Rows with a segment far from consistent with constant curvature
+  // (model::far_from_consistent), and rows that bend a segment beyond its
+  // theta_max (trained on; the runtime refuses such cables).
+  int far_from_consistent_rows = 0;
+  int beyond_limit_rows = 0;
 
   int size() const { return static_cast<int>(inputs.rows()); }
   bool has_payload() const { return payload_kg.size() > 0; }
@@ -44,18 +51,24 @@ struct Split {
 Split random_split(int samples, int test_count, std::uint64_t seed);
 
 // Throws std::invalid_argument naming the sample (1-based data row) whose
-// cables the nominal model rejects, or if the dataset has no poses or a
-// segment count other than the geometry's. The payload column, when the
-// dataset has one, becomes an input unless with_payload is false.
+// cables are impossible (not finite, not positive), or if the dataset has no
+// poses or a segment count other than the geometry's; cables inconsistent
+// with constant curvature, or beyond the bend limit, are rows like any
+// other (and counted). The payload column, when the dataset has one,
+// becomes an input unless with_payload is false.
 TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGeometry<double>& geometry,
                               model::InputEncoding encoding, bool with_payload = true);
 
 // Encoded GP inputs for stacked bend vectors (rows).
 Eigen::MatrixXd encode_rows(const Eigen::MatrixXd& bends, model::InputEncoding encoding);
 
-// The GP inputs: the encoded bends, then the payload column when payload_kg
-// is not empty (one value per row).
-Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::VectorXd& payload_kg,
-                             model::InputEncoding encoding);
+// The GP inputs: the encoded bends, the cable residuals when the encoding
+// takes them, then the payload column when payload_kg is not empty (one
+// value per row).
+Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::MatrixXd& cable_residuals,
+                             const Eigen::VectorXd& payload_kg, model::InputEncoding encoding);
+
+// The same rows with their inputs in another encoding.
+TrainingSet with_encoding(const TrainingSet& set, model::InputEncoding encoding);
 
 }  // namespace cdcr::training

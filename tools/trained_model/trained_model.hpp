@@ -77,8 +77,11 @@ struct TrainedModel {
 
   int training_points() const { return static_cast<int>(inputs.rows()); }  // the points, N or M
   int input_dims() const { return static_cast<int>(inputs.cols()); }
-  // Inputs after the bend pairs: 1 when the model takes the payload.
-  int extra_inputs() const { return input_dims() - 2 * geometry.segment_count; }
+  // Inputs after the encoding's (the bend pairs, and the cable residuals for
+  // the cable-fit encoding): 1 when the model takes the payload.
+  int extra_inputs() const {
+    return input_dims() - model::encoded_input_count(encoding, geometry.segment_count);
+  }
   bool has_payload_input() const { return extra_inputs() > 0; }
 
   // Records the range of the rows the model is fitted on (rows x D, raw).

@@ -257,7 +257,7 @@ TEST(PayloadTraining, TheChosenSagIsExportedAndTheImagePathFollowsTheTrainer) {
   // and payloads against the double trainer's sagged nominal pose and GP.
   const std::vector<model::Pose<double>> double_poses = compensated_poses(
       with_compliance(validation_set, design, out.choice.model),
-      predict_error_twists(out.result.model, validation_set.bends, validation_set.payload_kg));
+      predict_error_twists(out.result.model, validation_set));
   const Fidelity f = compare_poses(
       double_poses, firmware_poses(view, validation_set.cables_mm, FirmwareAccumulator::compensated_float32,
                                    validation_set.payload_kg));

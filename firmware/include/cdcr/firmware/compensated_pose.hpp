@@ -33,8 +33,10 @@ model::Status estimate_compensated_pose(const Geometry& geometry, const GpCorrec
   }
   estimate.pose = result.compensated;
   estimate.joints = result.joints;
+  estimate.cable_residuals = result.cable_residuals;
   estimate.compensated = true;
-  correction.kernel_coordinates(model::bend_from_joints(result.joints), estimate.kernel_coordinates);
+  correction.kernel_coordinates(model::bend_from_joints(result.joints), result.cable_residuals,
+                                estimate.kernel_coordinates);
   estimate.outside_range = uncertainty.outside_range(estimate.kernel_coordinates);
   return model::Status::ok;
 }

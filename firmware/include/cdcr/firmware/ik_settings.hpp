@@ -63,7 +63,7 @@ model::IkPreference<S, Max> ik_preference(const model::RobotGeometry<S, Max>& ge
   const int columns = 2 * geometry.segment_count;
   preference.centre.setZero(columns);
   preference.weight.setZero(columns);
-  if (image == nullptr || image->encoding != model::InputEncoding::bend_vector || image->input_min == nullptr ||
+  if (image == nullptr || image->encoding == model::InputEncoding::joint_angles || image->input_min == nullptr ||
       image->segment_count != geometry.segment_count) {
     return preference;
   }

@@ -94,6 +94,9 @@ Joints commanded_joints(const RobotModel& model, const Joints& solver_joints);
 struct PoseEstimate {
   Pose pose;
   Joints joints;
+  // What the cables say beyond the bend, for a model that takes it
+  // (cable_fit.hpp); empty otherwise.
+  model::CableResiduals<Scalar, kMaxSegments> cable_residuals;
   bool compensated = false;
   // Outside the input range the model was fitted on (never in DEGRADED).
   bool outside_range = false;

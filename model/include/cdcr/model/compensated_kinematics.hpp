@@ -4,6 +4,7 @@
 // -> compensated pose (eqs. 5, 13, 16, 19); with an image's compliance block
 // the nominal pose is the one sagged under the tip payload.
 
+#include "cdcr/model/cable_fit.hpp"
 #include "cdcr/model/chain.hpp"
 #include "cdcr/model/compensation.hpp"
 #include "cdcr/model/flash_image.hpp"
@@ -31,6 +32,9 @@ Status geometry_from_image(const ImageView& image, RobotGeometry<S, Max>& geomet
 template <typename S, int Max = kMaxSegments>
 struct ForwardResult {
   JointVector<S, Max> joints;
+  // The cables' residuals (cable_fit.hpp), for a correction that takes them;
+  // empty otherwise.
+  CableResiduals<S, Max> cable_residuals;
   Pose<S> nominal;
   Twist<S> error_twist = Twist<S>::Zero();
   Pose<S> compensated;
@@ -40,17 +44,28 @@ struct ForwardResult {
 // in joints_from_cables. nominal_shape(bend) gives the bends whose plain
 // kinematics is the nominal pose: the bend itself, or (with a compliance
 // model) the bends sagged under the payload. The GP correction stays
-// evaluated at the commanded bends, as it was trained.
+// evaluated at the commanded bends, as it was trained. A correction with the
+// cable-fit encoding takes what the cables say beyond the bend, and takes
+// every possible cable set (fit_measured_cables): it was trained on rows
+// beyond the bend limit and the anchors' reach; its extrapolation flag says
+// where it has not seen them. Otherwise the cables must be within the
+// limits (joints_from_cables).
 template <typename S, typename Accumulator, int Max, typename Arch, typename NominalShape>
 Status compensated_forward_with(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
                                 const GpCorrection<S, Accumulator, Max, Arch>& correction,
                                 ForwardResult<S, Max>& result, S cable_resolution_mm, NominalShape&& nominal_shape) {
   JointVector<S, Max> joints;
-  if (const Status s = joints_from_cables(cables_mm, geometry, joints, cable_resolution_mm); s != Status::ok) return s;
+  CableResiduals<S, Max> residuals;
+  const Status s = correction.takes_cable_residuals()
+                       ? fit_measured_cables(cables_mm, geometry, joints, residuals, cable_resolution_mm)
+                       : joints_from_cables(cables_mm, geometry, joints, cable_resolution_mm);
+  if (s != Status::ok) return s;
   const JointVector<S, Max> bend = bend_from_joints(joints);
   result.joints = joints;
+  result.cable_residuals = residuals;
   result.nominal = forward_kinematics_bend(nominal_shape(bend), geometry);
-  result.error_twist = correction.predict(bend);
+  result.error_twist =
+      correction.takes_cable_residuals() ? correction.predict(bend, residuals) : correction.predict(bend);
   result.compensated = compensate(result.error_twist, result.nominal);
   return Status::ok;
 }

@@ -37,6 +37,9 @@ inline constexpr std::uint16_t kImageVersionMinorHysteresis = 2;
 // 2.3: the segments' compliance under the tip load (payload_compliance.hpp),
 // in an image with the payload input. Written only for a model with one.
 inline constexpr std::uint16_t kImageVersionMinorCompliance = 3;
+// 2.4: the bend-vector-cable-fit input encoding (the cables' residuals as
+// inputs, input_encoding.hpp). Written only for a model that takes them.
+inline constexpr std::uint16_t kImageVersionMinorCableFit = 4;
 inline constexpr std::uint16_t kImageOldestVersionMajor = 1;  // still read: deployed boards carry v1 images
 inline constexpr std::uint32_t kImageHeaderSize = 64;
 inline constexpr std::uint32_t kImageBlockAlignment = 8;
@@ -873,6 +876,7 @@ struct DeclaredImage {
   std::uint32_t input_dims = 0;
   std::uint32_t segments = 0;
   std::uint32_t extra = 0;
+  InputEncoding encoding = InputEncoding::bend_vector;
   std::uint32_t rank = 0;
   std::uint32_t hysteresis_cables = 0;
   std::uint32_t hysteresis_operators = 0;
@@ -1056,6 +1060,13 @@ bool check_kind(Run& run, const std::uint8_t* bytes, DeclaredImage& h) {
                   Expect::known)) {
     return false;
   }
+  h.encoding = static_cast<InputEncoding>(encoding);
+  // The cable-fit encoding is v2.4's: an older image cannot declare it.
+  if (takes_cable_residuals(h.encoding) &&
+      !run.expect(!h.v1 && h.minor >= kImageVersionMinorCableFit, ImageCheckId::kind, ImageStatus::unsupported_kind,
+                  "version_minor", -1, h.minor, kImageVersionMinorCableFit, Expect::at_least)) {
+    return false;
+  }
   const std::uint8_t declared_kind = bytes[image_field::model_kind.offset];
   h.kind = h.v1 ? ImageModelKind::exact_gp : static_cast<ImageModelKind>(declared_kind);
   h.extra = h.value(bytes, image_field::extra_inputs);
@@ -1066,6 +1077,12 @@ bool check_kind(Run& run, const std::uint8_t* bytes, DeclaredImage& h) {
                     declared_kind, static_cast<std::uint8_t>(ImageModelKind::sparse_gp), Expect::known) &&
          run.expect(h.extra <= kMaxExtraInputs, ImageCheckId::kind, ImageStatus::unsupported_kind, "extra_inputs", -1,
                     h.extra, kMaxExtraInputs, Expect::at_most);
+}
+
+// The inputs the encoding gives the declared segments (a count beyond any
+// robot stays a count: the check against input_dims reports it).
+inline std::uint32_t encoded_inputs(const DeclaredImage& h) {
+  return (takes_cable_residuals(h.encoding) ? 2 + kCableResidualsPerSegment : 2) * h.segments;
 }
 
 template <typename Run>
@@ -1079,8 +1096,8 @@ bool check_dims(Run& run, const std::uint8_t* bytes, DeclaredImage& h) {
                     Expect::at_least) &&
          run.expect(h.segments >= 1, ImageCheckId::header, ImageStatus::bad_header, "segment_count", -1, h.segments,
                     1, Expect::at_least) &&
-         run.expect(h.input_dims == 2 * h.segments + h.extra, ImageCheckId::header, ImageStatus::bad_header,
-                    "input_dims", -1, h.input_dims, 2 * h.segments + h.extra, Expect::equal) &&
+         run.expect(h.input_dims == encoded_inputs(h) + h.extra, ImageCheckId::header, ImageStatus::bad_header,
+                    "input_dims", -1, h.input_dims, encoded_inputs(h) + h.extra, Expect::equal) &&
          run.expect(outputs == kImageOutputs, ImageCheckId::header, ImageStatus::bad_header, "output_dims", -1,
                     outputs, kImageOutputs, Expect::equal);
 }
@@ -1129,7 +1146,13 @@ bool check_capacity(Run& run, const DeclaredImage& h, const ImageCapacity& capac
          run.expect(h.rank <= capacity.max_variance_rank, ImageCheckId::capacity, ImageStatus::over_capacity,
                     "variance_rank", -1, h.rank, capacity.max_variance_rank, Expect::at_most) &&
          run.expect(h.extra <= capacity.max_extra_inputs, ImageCheckId::capacity, ImageStatus::over_capacity,
-                    "extra_inputs", -1, h.extra, capacity.max_extra_inputs, Expect::at_most);
+                    "extra_inputs", -1, h.extra, capacity.max_extra_inputs, Expect::at_most) &&
+         // The cable-fit encoding's inputs share the storage of a robot of
+         // the most segments: 4n + E must fit where 2n + E always does.
+         (!takes_cable_residuals(h.encoding) ||
+          run.expect(h.input_dims <= 2 * capacity.max_segments + capacity.max_extra_inputs, ImageCheckId::capacity,
+                     ImageStatus::over_capacity, "input_dims", -1, h.input_dims,
+                     2 * capacity.max_segments + capacity.max_extra_inputs, Expect::at_most));
 }
 
 // Each header field that locates a block holds a multiple of the block

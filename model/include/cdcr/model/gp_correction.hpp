@@ -25,7 +25,11 @@
 // last input, after the bend pairs. The payload is state of the correction:
 // the image's default until set_payload_kg(), and every evaluation that
 // begins after a set uses the new value, the forward path's and IK's alike.
-// The bend vector stays the only variable: the gradient is d(eps)/d(bend).
+// An image with the cable-fit encoding takes the cables' residuals after the
+// bend pairs (cable_fit.hpp): the forward path passes the measured ones with
+// the bend; IK's evaluations use those set_cable_residuals() held (the last
+// measured: IK moves the bend, not what the cables do beyond it). The bend
+// vector stays the only variable: the gradient is d(eps)/d(bend).
 
 #include <array>
 #include <cmath>
@@ -33,6 +37,7 @@
 #include <type_traits>
 
 #include "cdcr/model/arch/selected.hpp"
+#include "cdcr/model/cable_fit.hpp"
 #include "cdcr/model/chain.hpp"
 #include "cdcr/model/compensated_float.hpp"
 #include "cdcr/model/flash_image.hpp"
@@ -128,13 +133,19 @@ class GpCorrection {
     training_points_ = image.training_points;
     input_dims_ = image.input_dims;
     bend_dims_ = 2 * image.segment_count;
+    residual_dims_ = model::takes_cable_residuals(image.encoding) ? kCableResidualsPerSegment * image.segment_count : 0;
     extra_inputs_ = image.extra_inputs;
-    if (bend_dims_ + extra_inputs_ != input_dims_ || extra_inputs_ > kMaxExtraInputs) return Status::correction_failed;
-    for (int e = 0; e < extra_inputs_; ++e) extra_[e] = S(image.extra_input_default[e]);
-    // A payload model's points run in the run-time loop, and cost more.
-    mean_point_units_ = extra_inputs_ > 0 ? Arch::kWorkCosts.run_time_loop_point : 1;
-    gradient_point_units_ = extra_inputs_ > 0 ? Arch::kWorkCosts.run_time_loop_gradient_point : kGradientPointUnits;
-    gradient_granule_ = extra_inputs_ > 0 ? kBlockPoints : kChunkPoints;
+    held_inputs_ = residual_dims_ + extra_inputs_;
+    if (bend_dims_ + held_inputs_ != input_dims_ || extra_inputs_ > kMaxExtraInputs || input_dims_ > kMaxInputs) {
+      return Status::correction_failed;
+    }
+    for (int e = 0; e < residual_dims_; ++e) held_[e] = S(0);
+    for (int e = 0; e < extra_inputs_; ++e) held_[residual_dims_ + e] = S(image.extra_input_default[e]);
+    // A model with held inputs may take the run-time loop, which costs more
+    // per point; its work is counted at that price.
+    mean_point_units_ = held_inputs_ > 0 ? Arch::kWorkCosts.run_time_loop_point : 1;
+    gradient_point_units_ = held_inputs_ > 0 ? Arch::kWorkCosts.run_time_loop_gradient_point : kGradientPointUnits;
+    gradient_granule_ = held_inputs_ > 0 ? kBlockPoints : kChunkPoints;
     encoding_ = image.encoding;
     for (int d = 0; d < input_dims_; ++d) {
       input_mean_[d] = S(image.input_mean[d]);
@@ -153,11 +164,18 @@ class GpCorrection {
   int bend_dims() const { return bend_dims_; }
   bool has_payload_input() const { return extra_inputs_ > 0; }
   // The payload the next evaluations use (0 for a model without the input).
-  S payload_kg() const { return extra_inputs_ > 0 ? extra_[0] : S(0); }
+  S payload_kg() const { return extra_inputs_ > 0 ? held_[residual_dims_] : S(0); }
   // Range checks are the caller's (the runtime's); a model without a payload
   // input ignores it.
   void set_payload_kg(S payload_kg) {
-    if (extra_inputs_ > 0) extra_[0] = payload_kg;
+    if (extra_inputs_ > 0) held_[residual_dims_] = payload_kg;
+  }
+  bool takes_cable_residuals() const { return residual_dims_ > 0; }
+  // The residuals IK's evaluations use (zero until set); a model without
+  // the inputs, or residuals of another robot, leave them as they are.
+  void set_cable_residuals(const CableResiduals<S, MaxSegments>& residuals) {
+    if (residual_dims_ == 0 || residuals.size() != residual_dims_) return;
+    for (int e = 0; e < residual_dims_; ++e) held_[e] = residuals[e];
   }
   InputEncoding encoding() const { return encoding_; }
 
@@ -170,22 +188,39 @@ class GpCorrection {
   std::uint32_t smallest_gradient_slice_units() const { return gradient_granule_ * gradient_point_units_; }
 
   // z = (x - input_mean) / (input_scale * length_scale) for x = encode(bend)
-  // followed by the payload: the coordinates the points are stored in
-  // (input_dims() values).
+  // followed by the held inputs (the cable residuals, the payload): the
+  // coordinates the points are stored in (input_dims() values).
   void kernel_coordinates(const JointVector<S, MaxSegments>& bend, S* z) const {
     Input x(bend_dims_);
     encode_inputs(encoding_, bend, x);
     for (int d = 0; d < bend_dims_; ++d) z[d] = (x[d] - input_mean_[d]) * input_gain_[d];
-    for (int d = bend_dims_; d < input_dims_; ++d) z[d] = (extra_[d - bend_dims_] - input_mean_[d]) * input_gain_[d];
+    for (int d = bend_dims_; d < input_dims_; ++d) z[d] = (held_[d - bend_dims_] - input_mean_[d]) * input_gain_[d];
+  }
+
+  // The same with measured cable residuals in place of the held ones (a
+  // model without the inputs ignores them).
+  void kernel_coordinates(const JointVector<S, MaxSegments>& bend, const CableResiduals<S, MaxSegments>& residuals,
+                          S* z) const {
+    kernel_coordinates(bend, z);
+    if (residuals.size() != residual_dims_) return;
+    for (int e = 0; e < residual_dims_; ++e) {
+      const int d = bend_dims_ + e;
+      z[d] = (residuals[e] - input_mean_[d]) * input_gain_[d];
+    }
   }
 
   // The error twist eps (v, omega) for a stacked bend vector.
   Twist<S> predict(const JointVector<S, MaxSegments>& bend) const {
     S z[kMaxInputs];
     kernel_coordinates(bend, z);
-    Accumulator sums[kImageOutputs] = {};
-    with_input_count([&](auto dims) { accumulate_mean<decltype(dims)::value>(z, 0, training_points_, sums); });
-    return outputs(sums);
+    return mean_at(z);
+  }
+
+  // ... and for the cables' measured residuals beside it.
+  Twist<S> predict(const JointVector<S, MaxSegments>& bend, const CableResiduals<S, MaxSegments>& residuals) const {
+    S z[kMaxInputs];
+    kernel_coordinates(bend, residuals, z);
+    return mean_at(z);
   }
 
   // eps and d(eps)/d(bend), 6 x D.
@@ -313,6 +348,12 @@ class GpCorrection {
 
  private:
   using Terms = detail::GpPointTerms<S, Accumulator, Arch>;
+
+  Twist<S> mean_at(const S* z) const {
+    Accumulator sums[kImageOutputs] = {};
+    with_input_count([&](auto dims) { accumulate_mean<decltype(dims)::value>(z, 0, training_points_, sums); });
+    return outputs(sums);
+  }
 
   // Calls work(std::integral_constant<int, D>) with the input count D as a
   // constant for the paper's robots (2 to 4 segments), which lets the
@@ -446,11 +487,14 @@ class GpCorrection {
   std::uint32_t training_points_ = 0;
   int input_dims_ = 0;
   int bend_dims_ = 0;
+  int residual_dims_ = 0;
   int extra_inputs_ = 0;
+  int held_inputs_ = 0;
   std::uint32_t mean_point_units_ = 1;
   std::uint32_t gradient_point_units_ = kGradientPointUnits;
   std::uint32_t gradient_granule_ = kChunkPoints;
-  S extra_[kMaxExtraInputs] = {};
+  // The cable residuals, then the payload.
+  S held_[kMaxInputs] = {};
   InputEncoding encoding_ = InputEncoding::bend_vector;
   std::array<S, kMaxInputs> input_mean_{};
   std::array<S, kMaxInputs> input_gain_{};

@@ -6,6 +6,11 @@
 //   configurations that are physically close can be far apart in x.
 // * bend_vector: x = [theta_1 cos alpha_1, theta_1 sin alpha_1, ...], smooth
 //   and single-valued everywhere.
+// * bend_vector_cable_fit: the bend vector, then per segment what its cables
+//   say beyond the bend, the cable fit's common mode and pair imbalance
+//   (cable_fit.hpp), [rho_1, pi_1, rho_2, pi_2, ...] in mm. The bend is the
+//   variable (IK's); the residuals are state measured from the cables, held
+//   like the payload.
 
 #include <cmath>
 #include <cstdint>
@@ -18,24 +23,37 @@ namespace cdcr::model {
 enum class InputEncoding : std::uint8_t {
   joint_angles = 1,
   bend_vector = 2,
+  bend_vector_cable_fit = 3,
 };
 
 constexpr const char* to_string(InputEncoding encoding) {
   switch (encoding) {
     case InputEncoding::joint_angles: return "joint-angles";
     case InputEncoding::bend_vector: return "bend-vector";
+    case InputEncoding::bend_vector_cable_fit: return "bend-vector+cable-fit";
   }
   return "unknown";
 }
 
 constexpr bool is_known(InputEncoding encoding) {
-  return encoding == InputEncoding::joint_angles || encoding == InputEncoding::bend_vector;
+  return encoding == InputEncoding::joint_angles || encoding == InputEncoding::bend_vector ||
+         encoding == InputEncoding::bend_vector_cable_fit;
 }
 
-// x from the stacked bend vector.
+constexpr bool takes_cable_residuals(InputEncoding encoding) {
+  return encoding == InputEncoding::bend_vector_cable_fit;
+}
+
+// Inputs the encoding gives a robot of `segments` segments (before any
+// extra input).
+constexpr int encoded_input_count(InputEncoding encoding, int segments) {
+  return (takes_cable_residuals(encoding) ? 2 + kCableResidualsPerSegment : 2) * segments;
+}
+
+// The bend's part of x (its first 2n values) from the stacked bend vector.
 template <typename Derived, typename Out>
 void encode_inputs(InputEncoding encoding, const Eigen::MatrixBase<Derived>& bend, Eigen::MatrixBase<Out>& x) {
-  if (encoding == InputEncoding::bend_vector) {
+  if (encoding != InputEncoding::joint_angles) {
     x = bend;
   } else {
     x = joints_from_bend(bend);
@@ -47,7 +65,7 @@ void encode_inputs(InputEncoding encoding, const Eigen::MatrixBase<Derived>& ben
 // there the block is evaluated at a tiny theta so it stays finite.
 template <typename S>
 Eigen::Matrix<S, 2, 2> encoding_jacobian_block(InputEncoding encoding, const Vec2<S>& bend) {
-  if (encoding == InputEncoding::bend_vector) return Eigen::Matrix<S, 2, 2>::Identity();
+  if (encoding != InputEncoding::joint_angles) return Eigen::Matrix<S, 2, 2>::Identity();
   const S theta_sq = std::max(bend.squaredNorm(), S(1e-12));
   const S theta = std::sqrt(theta_sq);
   Eigen::Matrix<S, 2, 2> block;

@@ -17,8 +17,13 @@ inline constexpr unsigned kMaxVarianceRank = 64;
 inline constexpr int kMaxExtraInputs = 1;
 
 // GP inputs of a robot of `segments` segments: a bend pair per segment, then
-// the extra inputs.
+// the extra inputs. A model that also takes its cables' residuals must fit
+// the same count (the paper's four segments do: 4 x 4 inputs).
 constexpr int max_model_inputs(int segments) { return 2 * segments + kMaxExtraInputs; }
+
+// Inputs per segment of what its cables say beyond the bend: the cable
+// fit's common mode and pair imbalance (cable_fit.hpp).
+inline constexpr int kCableResidualsPerSegment = 2;
 inline constexpr int kMaxInputs = max_model_inputs(kMaxSegments);
 
 // Cables of the largest robot, four per segment.

@@ -1,0 +1,172 @@
+#pragma once
+// What all four cables of a segment say, not only their two differences.
+//
+// joints_from_cables (segment.hpp) reads the bend from l3 - l1 and l2 - l4
+// and ignores what the pairs' sums say. On a real robot they say a lot: a
+// slack cable, or both cables of a pair pulled against the backbone, moves
+// the tip while leaving the differences alone. The fit below keeps it.
+//
+// Eq. (2) with the backbone's length L' left free (an axially compressed
+// backbone, cables slack in common) reads l_j = m - v . e_j with
+//   m = L' s(theta),  v = r s(theta) b = 2 r sin(theta/2) (cos alpha, sin alpha),
+// s(theta) = sin(theta/2)/(theta/2) and e_j = (cos psi_j, sin psi_j) the
+// direction of cable j's anchor, psi_j = -(j - 1) 90 degrees (cables 1 to 4
+// at 0, -90, -180 and -270 degrees, the order eq. (2) numbers them). (m, v)
+// is a one-to-one change of (L', alpha, theta) for theta < pi, and the model
+// is linear in (m, v): the least-squares fit of all four cables to eq. (2)
+// is the linear one,
+//   m = mean(l),  v = ((l3 - l1)/2, (l2 - l4)/2),
+// so its bend is exactly today's (alpha = atan2(l2 - l4, l3 - l1), theta =
+// 2 asin(|v| / 2r)). What the fit leaves are the cable inputs the GP may take:
+//   * the common mode, m - L s(theta): the cables' mean length against the
+//     arc's (negative when the backbone is compressed or all cables slack);
+//   * the pairs' imbalance, ((l1 + l3) - (l2 + l4)) / 2: one pair pulled
+//     against the other, the one thing four cables say that the fit's three
+//     parameters cannot (its residual is this value, +-1/2 per cable).
+// Cables that are exactly consistent give zeros (to rounding).
+//
+// The fit refuses nothing but impossible lengths (non-finite or not
+// positive). Differences beyond the reach of the anchors (|v| > 2r) bend the
+// segment by pi, in the direction they point; such a row is far from
+// consistent and says so. The bend limit theta_max is the runtime's, not
+// the fit's: measured rows beyond it are data too.
+
+#include <algorithm>
+#include <cmath>
+
+#include "cdcr/model/geometry.hpp"
+#include "cdcr/model/segment.hpp"
+#include "cdcr/model/series.hpp"
+#include "cdcr/model/status.hpp"
+#include "cdcr/model/types.hpp"
+
+namespace cdcr::model {
+
+template <typename S>
+struct SegmentCableFit {
+  SegmentJoints<S> joints;
+  S common_mode_mm = S(0);     // mean(l) - L s(theta)
+  S pair_imbalance_mm = S(0);  // ((l1 + l3) - (l2 + l4)) / 2
+  bool beyond_reach = false;   // |l3 - l1, l2 - l4| > 4 r: theta set to pi
+};
+
+// The two residuals of a segment's cables at a bending angle theta.
+template <typename S>
+Vec2<S> segment_cable_residuals(const Vec4<S>& cables_mm, S backbone_length_mm, S theta_rad) {
+  const S mean = (cables_mm[0] + cables_mm[1] + cables_mm[2] + cables_mm[3]) / S(4);
+  return Vec2<S>(mean - backbone_length_mm * series::sinc(theta_rad / S(2)),
+                 ((cables_mm[0] + cables_mm[2]) - (cables_mm[1] + cables_mm[3])) / S(2));
+}
+
+template <typename S>
+Status fit_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry, SegmentCableFit<S>& fit) {
+  if (const Status s = geometry.validate(); s != Status::ok) return s;
+  if (!cables_mm.allFinite()) return Status::non_finite_input;
+  if (!(cables_mm.minCoeff() > S(0))) return Status::cable_length_not_positive;
+  // The same operations as joints_from_cables, so consistent cables give
+  // the same bits.
+  const S d31 = cables_mm[2] - cables_mm[0];
+  const S d24 = cables_mm[1] - cables_mm[3];
+  const S reach = S(4) * geometry.anchor_radius_mm;
+  const S chord = std::hypot(d31, d24);
+  SegmentCableFit<S> result;
+  result.beyond_reach = chord > reach;
+  const S theta = S(2) * std::asin(std::min(chord / reach, S(1)));
+  result.joints = SegmentJoints<S>{std::atan2(d24, d31), theta};
+  const Vec2<S> residuals = segment_cable_residuals(cables_mm, geometry.backbone_length_mm, theta);
+  result.common_mode_mm = residuals[0];
+  result.pair_imbalance_mm = residuals[1];
+  fit = result;
+  return Status::ok;
+}
+
+// The cables that eq. (2) gives for a fit, its residuals included: the
+// inverse of fit_cables for theta < pi (a check of both, and how a
+// simulated robot's inconsistent cables are written down).
+template <typename S>
+Vec4<S> cables_from_fit(const SegmentCableFit<S>& fit, const SegmentGeometry<S>& geometry) {
+  const Vec2<S> b = bend_from_joints(fit.joints);
+  const S s = series::sinc(fit.joints.theta_rad / S(2));
+  const S mean = geometry.backbone_length_mm * s + fit.common_mode_mm;
+  const S r = geometry.anchor_radius_mm * s;
+  const S half_imbalance = fit.pair_imbalance_mm / S(2);
+  return Vec4<S>(mean - r * b.x() + half_imbalance, mean + r * b.y() - half_imbalance,
+                 mean + r * b.x() + half_imbalance, mean - r * b.y() - half_imbalance);
+}
+
+// A row is far from consistent with constant curvature when its fit leaves
+// more than this in either residual, or its differences are beyond reach:
+// a few times what a drive's encoder and a cable's stretch under a normal
+// load account for.
+inline constexpr double kFarFromConsistentMm = 0.5;
+
+template <typename S>
+bool far_from_consistent(const SegmentCableFit<S>& fit) {
+  return fit.beyond_reach || std::abs(fit.common_mode_mm) > S(kFarFromConsistentMm) ||
+         std::abs(fit.pair_imbalance_mm) > S(kFarFromConsistentMm);
+}
+
+// Per segment, the fit's residuals stacked [common mode, pair imbalance, ...]
+// like the bend pairs.
+template <typename S, int MaxSegments = kMaxSegments>
+using CableResiduals = JointVector<S, MaxSegments>;
+
+// Every segment's fit. Writes the outputs only on success.
+template <typename S, int Max>
+Status fit_cables(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
+                  JointVector<S, Max>& joints, CableResiduals<S, Max>& residuals, int* far_segments = nullptr) {
+  if (const Status s = geometry.validate(); s != Status::ok) return s;
+  if (cables_mm.size() != 4 * geometry.segment_count) return Status::invalid_segment_count;
+  JointVector<S, Max> q(2 * geometry.segment_count);
+  CableResiduals<S, Max> rho(2 * geometry.segment_count);
+  int far = 0;
+  for (int i = 0; i < geometry.segment_count; ++i) {
+    SegmentCableFit<S> fit;
+    const Vec4<S> segment_cables = cables_mm.template segment<4>(4 * i);
+    if (const Status s = fit_cables(segment_cables, geometry.segments[i], fit); s != Status::ok) return s;
+    q[2 * i] = fit.joints.alpha_rad;
+    q[2 * i + 1] = fit.joints.theta_rad;
+    rho[2 * i] = fit.common_mode_mm;
+    rho[2 * i + 1] = fit.pair_imbalance_mm;
+    far += far_from_consistent(fit) ? 1 : 0;
+  }
+  joints = q;
+  residuals = rho;
+  if (far_segments != nullptr) *far_segments = far;
+  return Status::ok;
+}
+
+// Only the residuals, for cables whose joints are already known to be valid
+// (the runtime's forward path, after joints_from_cables).
+template <typename S, int Max>
+void cable_residuals(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
+                     const JointVector<S, Max>& joints, CableResiduals<S, Max>& residuals) {
+  residuals.resize(2 * geometry.segment_count);
+  for (int i = 0; i < geometry.segment_count; ++i) {
+    residuals.template segment<2>(2 * i) = segment_cable_residuals(
+        Vec4<S>(cables_mm.template segment<4>(4 * i)), geometry.segments[i].backbone_length_mm, joints[2 * i + 1]);
+  }
+}
+
+// The joints and residuals of measured cables as a model with the cable-fit
+// encoding takes them, in training and on the board alike:
+// joints_from_cables where it accepts the cables (a segment at its limit
+// reads as the limit, as the runtime reads it), the fit's bend where it does
+// not (beyond theta_max or the anchors' reach). Fails only for impossible
+// lengths. beyond_limit (optional) tells which.
+template <typename S, int Max>
+Status fit_measured_cables(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
+                           JointVector<S, Max>& joints, CableResiduals<S, Max>& residuals,
+                           S cable_resolution_mm = S(0), bool* beyond_limit = nullptr, int* far_segments = nullptr) {
+  JointVector<S, Max> q;
+  CableResiduals<S, Max> rho;
+  if (const Status s = fit_cables(cables_mm, geometry, q, rho, far_segments); s != Status::ok) return s;
+  const bool within = joints_from_cables(cables_mm, geometry, q, cable_resolution_mm) == Status::ok;
+  if (within) cable_residuals(cables_mm, geometry, q, rho);
+  if (beyond_limit != nullptr) *beyond_limit = !within;
+  joints = q;
+  residuals = rho;
+  return Status::ok;
+}
+
+}  // namespace cdcr::model
