@@ -115,7 +115,16 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
 
   // The metrics live inside the image, so measure on a first image and
   // write the final one with the figures; the payload is identical.
-  const TrainingSet& fidelity_set = r.validation.samples > 0 ? validation_set : fitted_set;
+  // A cable-fit model's rows may bend to near pi, where the bend's last bits
+  // follow the cables' last bit (asin near 1): its image is measured against
+  // the double path on the same float32 lengths, so that the figure is the
+  // image's arithmetic, not the float rounding of its input. (The board
+  // reads lengths in 0.01 mm steps in any case.)
+  const TrainingSet& measured_set = r.validation.samples > 0 ? validation_set : fitted_set;
+  const bool same_float_cables = model::takes_cable_residuals(r.model.encoding) && compliance.empty();
+  const TrainingSet rounded_set =
+      same_float_cables ? with_float_cables(measured_set, geometry, r.model.encoding) : TrainingSet{};
+  const TrainingSet& fidelity_set = same_float_cables ? rounded_set : measured_set;
   const std::vector<model::Pose<double>> double_poses =
       compensated_poses(fidelity_set, predict_error_twists(r.model, fidelity_set));
   const std::vector<std::uint8_t> first_image = exporting::write_image(r.model);
@@ -204,14 +213,24 @@ SequenceExport train_and_export_sequence(const dataset::Dataset& data, const std
   // simulator's hysteresis session). The search's noise floor is raised,
   // fourfold at a time, until the image meets it (there, twice: 0.734 ->
   // 0.747 mm held out, 0.070 -> 0.0015 mm float32).
+  // Where no floor meets it (an orientation correction of tens of degrees
+  // has float32 sums good to about 0.001 deg whatever the weights), the
+  // unraised model is kept: a raised floor would only have thrown its
+  // accuracy away.
   TrainingOptions raised = options;
+  ExportResult unraised;
   for (int attempt = 0; attempt < kNoiseFloorAttempts && !out.result.fidelity_met(); ++attempt) {
+    if (attempt == 0) unraised = out.result;
     raised.search.bounds.noise_variance_min =
         std::min(raised.search.bounds.noise_variance_max,
                  4.0 * std::max(raised.search.bounds.noise_variance_min, out.result.model.noise_variance[0]));
     out.result = train_and_export(effective_all.subset(train_rows), effective_validation, effective_all, geometry,
                                   raised, dataset_hash, created_unix_s, hysteresis);
     out.noise_variance_floor = raised.search.bounds.noise_variance_min;
+  }
+  if (!out.result.fidelity_met() && out.noise_variance_floor > 0.0) {
+    out.result = std::move(unraised);
+    out.noise_variance_floor = 0.0;
   }
   if (validation_set.size() > 0) {
     const TrainedModel& joints_only = out.identification.joints_only;

@@ -71,6 +71,20 @@ TrainingSet with_encoding(const TrainingSet& set, model::InputEncoding encoding)
   return s;
 }
 
+TrainingSet with_float_cables(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
+                              model::InputEncoding encoding) {
+  dataset::Dataset rows;
+  rows.segment_count = geometry.segment_count;
+  rows.cables_mm = set.cables_mm.cast<float>().cast<double>();
+  rows.poses = set.measured;
+  rows.has_poses = true;
+  rows.payload_kg = set.payload_kg;
+  rows.has_payload = set.has_payload();
+  TrainingSet rounded = make_training_set(rows, geometry, encoding);
+  rounded.commanded_mm = set.commanded_mm;
+  return rounded;
+}
+
 TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGeometry<double>& geometry,
                               model::InputEncoding encoding, bool with_payload) {
   if (!data.has_poses) throw std::invalid_argument("dataset has no measured poses (x,y,z,qw,qx,qy,qz columns)");

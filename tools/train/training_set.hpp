@@ -68,6 +68,12 @@ Eigen::MatrixXd encode_rows(const Eigen::MatrixXd& bends, model::InputEncoding e
 Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::MatrixXd& cable_residuals,
                              const Eigen::VectorXd& payload_kg, model::InputEncoding encoding);
 
+// The same rows with their cable lengths rounded to float32, as the board
+// reads them: the bends, residuals, nominal poses and error twists of those
+// lengths (not for sets whose nominal poses are sagged).
+TrainingSet with_float_cables(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
+                              model::InputEncoding encoding);
+
 // The same rows with their inputs in another encoding.
 TrainingSet with_encoding(const TrainingSet& set, model::InputEncoding encoding);
 
