@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Memory report for Cortex-M ELF files, with the budget a board must fit:
-#   code  .vectors, .text (with .rodata), .ARM.*, .init_array   <= 108 KiB
+#   code  .vectors, .text (with .rodata), .ARM.*, .init_array   <= 112 KiB
 #   RAM   .data + .bss + the .stack reservation                  <= 32 KiB
 # The model image (.cdcr_model) is reported on its own: it is flashed
 # separately and sized by the model, not the firmware.
@@ -14,8 +14,9 @@ set -euo pipefail
 # 104 KiB since the payload's sag (payload_compliance.hpp: Newton steps with
 # the moments' Jacobian and a small solve, and its inverse for IK) took the
 # Cortex-M7 program 5.4 KB further, past 96 KiB; 108 KiB since IK's
-# preference among redundant solutions (its null-space step, 4 KB).
-readonly code_budget=$((108 * 1024))
+# preference among redundant solutions (its null-space step, 4 KB); 112 KiB
+# since the cable fit's residuals as GP inputs (6 KB).
+readonly code_budget=$((112 * 1024))
 readonly ram_budget=$((32 * 1024))
 size_tool=${CDCR_SIZE:-arm-none-eabi-size}
 

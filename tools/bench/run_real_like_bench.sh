@@ -13,17 +13,22 @@
 #     in 8 directions) each reached twice from each other one, 544 rows in
 #     order, per seed: the same command from the same previous one, a
 #     joints-only GP and a GP also given the sign of each cable's last move.
+# With --cdcr, the babbling runs also train and evaluate the project's model
+# (cdcr train on the same rows as the GP, and on the first 80 % as a
+# sequence; cdcr eval on the last 20 %).
 # Needs numpy and scikit-learn (the sklearn group); builds nothing. Writes to
 # $BUILD_DIR/real_like_bench/.
 #
-#   bash tools/bench/run_real_like_bench.sh [--seeds "1 2"] [--rows 4022]
+#   bash tools/bench/run_real_like_bench.sh [--seeds "1 2"] [--rows 4022] [--cdcr build/bin/cdcr]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 
 seeds="1 2"
 rows=4022
+cdcr_option=()
 while [ $# -gt 0 ]; do
   case $1 in
+    --cdcr) cdcr_option=(--cdcr "$2"); shift 2 ;;
     --seeds) seeds=$2; shift 2 ;;
     --rows) rows=$2; shift 2 ;;
     *) echo "run_real_like_bench.sh: error: unknown option '$1'" >&2; exit 2 ;;
@@ -39,7 +44,7 @@ for seed in $seeds; do
   nice -n 19 "$python" tools/bench/independent_robot.py --preset lab-1seg --collection babbling --seed "$seed" \
     --rows "$rows,1" --out-dir "$work_dir/babbling$seed" --report "$work_dir/babbling$seed.json" >/dev/null
   nice -n 19 "$python" tools/bench/real_like_bench.py babbling "$work_dir/babbling$seed/session0.csv" \
-    --report "$work_dir/babbling$seed.json" | tee "$work_dir/babbling$seed.txt"
+    --report "$work_dir/babbling$seed.json" "${cdcr_option[@]}" | tee "$work_dir/babbling$seed.txt"
   echo "== repeatability, seed $seed =="
   nice -n 19 "$python" tools/bench/independent_robot.py --preset lab-1seg --collection repeatability \
     --seed "$seed" --rows 1,1 --out-dir "$work_dir/repeatability$seed" \

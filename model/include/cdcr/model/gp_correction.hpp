@@ -216,7 +216,8 @@ class GpCorrection {
     return mean_at(z);
   }
 
-  // ... and for the cables' measured residuals beside it.
+  // ... and for the cables' measured residuals beside it (empty ones for a
+  // model without them).
   Twist<S> predict(const JointVector<S, MaxSegments>& bend, const CableResiduals<S, MaxSegments>& residuals) const {
     S z[kMaxInputs];
     kernel_coordinates(bend, residuals, z);
