@@ -5,6 +5,7 @@
 #include <random>
 #include <stdexcept>
 
+#include "cdcr/firmware/compensated_pose.hpp"
 #include "sparse_gp.hpp"
 
 namespace cdcr::training {
@@ -43,6 +44,14 @@ Normalisation normalisation_of(const TrainingSet& set) {
   Normalisation n;
   n.input_mean = set.inputs.colwise().mean().transpose();
   n.input_scale = column_scale(set.inputs, n.input_mean);
+  // The board reads the cables in the protocol's steps: a residual that
+  // varies by less over the rows is rounding, and normalised by its own
+  // spread would turn the board's rounding into large kernel coordinates.
+  if (model::takes_cable_residuals(set.encoding)) {
+    for (Eigen::Index c = set.bends.cols(); c < set.bends.cols() + set.cable_residuals.cols(); ++c) {
+      n.input_scale[c] = std::max(n.input_scale[c], double(firmware::kCableResolutionMm));
+    }
+  }
   n.output_mean = set.error_twists.colwise().mean().transpose();
   n.output_scale = column_scale(set.error_twists, n.output_mean);
   return n;

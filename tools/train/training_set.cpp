@@ -14,6 +14,7 @@ namespace cdcr::training {
 
 TrainingSet TrainingSet::subset(const std::vector<int>& rows) const {
   TrainingSet s;
+  s.encoding = encoding;
   const auto n = static_cast<Eigen::Index>(rows.size());
   s.cables_mm.resize(n, cables_mm.cols());
   const bool has_commanded = commanded_mm.rows() > 0;
@@ -67,6 +68,7 @@ Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::MatrixXd
 
 TrainingSet with_encoding(const TrainingSet& set, model::InputEncoding encoding) {
   TrainingSet s = set;
+  s.encoding = encoding;
   s.inputs = model_inputs(s.bends, s.cable_residuals, s.payload_kg, encoding);
   return s;
 }
@@ -122,6 +124,7 @@ TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGe
   }
   if (data.has_payload && with_payload) s.payload_kg = data.payload_kg;
   s.inputs = model_inputs(s.bends, s.cable_residuals, s.payload_kg, encoding);
+  s.encoding = encoding;
   return s;
 }
 

@@ -26,6 +26,7 @@ struct TrainingSet {
   Eigen::MatrixXd cable_residuals;  // samples x 2n, the cable fit's [common mode, pair imbalance] per segment
   Eigen::VectorXd payload_kg;    // samples, or empty: the data carried no payload column
   Eigen::MatrixXd inputs;        // samples x D, encoded (and the payload last, when there is one)
+  model::InputEncoding encoding = model::InputEncoding::bend_vector;  // of `inputs`
   Eigen::MatrixXd error_twists;  // samples x 6
   std::vector<model::Pose<double>> nominal;
   std::vector<model::Pose<double>> measured;

@@ -166,6 +166,26 @@ TEST(CableInputs, RowsBeyondTheLimitLeaveOnlyTheCableFit) {
   EXPECT_LT(r.firmware.compensated.position_mm, 0.5 * r.firmware.initial.position_mm);
 }
 
+// Consistent cables written as a CSV writes them (to 1 um) leave residuals
+// of rounding only; with rows beyond the limit the cable fit is the only
+// choice all the same, and the board's float32 residuals (and its 0.01 mm
+// steps) must not move the model: the residuals are normalised by at least
+// the protocol's step.
+TEST(CableInputs, RoundingResidualsDoNotMoveTheBoardsModel) {
+  model::RobotGeometry<double> g = lab_segment();
+  dataset::Dataset data = pulled_against_each_other(g, 160, 0.0, 8);
+  data.cables_mm = (data.cables_mm * 1e6).array().round() / 1e6;
+  g.segments[0].theta_max_rad = 0.9;
+  TrainingOptions cable_fit = quick_options();
+  cable_fit.encoding = model::InputEncoding::bend_vector_cable_fit;
+  const TrainingSet all = make_training_set(data, g, cable_fit.encoding);
+  ASSERT_GT(all.beyond_limit_rows, 10);
+  ASSERT_GT(all.cable_residuals.cwiseAbs().maxCoeff(), 0.0);
+  const ExportResult r = trained(all, g, cable_fit);
+  EXPECT_TRUE(r.fidelity_met()) << r.fidelity.max_position_mm << " mm, " << r.fidelity.max_orientation_deg << " deg";
+  EXPECT_NEAR(r.firmware.compensated.position_mm, r.validation.compensated.position_mm, 0.01);
+}
+
 TEST(CableInputs, TheParserRefusesTheEncodingInAnOlderImageAndAWrongInputCount) {
   const model::RobotGeometry<double> g = lab_segment();
   TrainingOptions cable_fit = quick_options();
