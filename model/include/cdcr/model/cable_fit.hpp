@@ -60,19 +60,14 @@ Vec2<S> segment_cable_residuals(const Vec4<S>& cables_mm, S backbone_length_mm, 
 
 template <typename S>
 Status fit_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry, SegmentCableFit<S>& fit) {
-  if (const Status s = geometry.validate(); s != Status::ok) return s;
-  if (!cables_mm.allFinite()) return Status::non_finite_input;
-  if (!(cables_mm.minCoeff() > S(0))) return Status::cable_length_not_positive;
-  // The same operations as joints_from_cables, so consistent cables give
-  // the same bits.
-  const S d31 = cables_mm[2] - cables_mm[0];
-  const S d24 = cables_mm[1] - cables_mm[3];
-  const S reach = S(4) * geometry.anchor_radius_mm;
-  const S chord = std::hypot(d31, d24);
+  // The differences joints_from_cables reads, so consistent cables give the
+  // same bits.
+  const CableDifferences<S> d = cable_differences(cables_mm, geometry);
+  if (d.status != Status::ok) return d.status;
   SegmentCableFit<S> result;
-  result.beyond_reach = chord > reach;
-  const S theta = S(2) * std::asin(std::min(chord / reach, S(1)));
-  result.joints = SegmentJoints<S>{std::atan2(d24, d31), theta};
+  result.beyond_reach = d.chord > d.reach;
+  const S theta = S(2) * std::asin(std::min(d.chord / d.reach, S(1)));
+  result.joints = SegmentJoints<S>{std::atan2(d.d24, d.d31), theta};
   const Vec2<S> residuals = segment_cable_residuals(cables_mm, geometry.backbone_length_mm, theta);
   result.common_mode_mm = residuals[0];
   result.pair_imbalance_mm = residuals[1];
@@ -101,9 +96,13 @@ Vec4<S> cables_from_fit(const SegmentCableFit<S>& fit, const SegmentGeometry<S>&
 inline constexpr double kFarFromConsistentMm = 0.5;
 
 template <typename S>
+bool far_from_consistent(S common_mode_mm, S pair_imbalance_mm) {
+  return std::abs(common_mode_mm) > S(kFarFromConsistentMm) || std::abs(pair_imbalance_mm) > S(kFarFromConsistentMm);
+}
+
+template <typename S>
 bool far_from_consistent(const SegmentCableFit<S>& fit) {
-  return fit.beyond_reach || std::abs(fit.common_mode_mm) > S(kFarFromConsistentMm) ||
-         std::abs(fit.pair_imbalance_mm) > S(kFarFromConsistentMm);
+  return fit.beyond_reach || far_from_consistent(fit.common_mode_mm, fit.pair_imbalance_mm);
 }
 
 // Per segment, the fit's residuals stacked [common mode, pair imbalance, ...]
@@ -160,9 +159,21 @@ Status fit_measured_cables(const CableVector<S, Max>& cables_mm, const RobotGeom
                            S cable_resolution_mm = S(0), bool* beyond_limit = nullptr, int* far_segments = nullptr) {
   JointVector<S, Max> q;
   CableResiduals<S, Max> rho;
-  if (const Status s = fit_cables(cables_mm, geometry, q, rho, far_segments); s != Status::ok) return s;
+  // The fit only where the runtime's map refuses: on the cycle's path the
+  // common case costs the map and the residuals, no more.
   const bool within = joints_from_cables(cables_mm, geometry, q, cable_resolution_mm) == Status::ok;
-  if (within) cable_residuals(cables_mm, geometry, q, rho);
+  if (within) {
+    cable_residuals(cables_mm, geometry, q, rho);
+    if (far_segments != nullptr) {
+      // Within reach: only the residuals can make a segment far.
+      *far_segments = 0;
+      for (int i = 0; i < geometry.segment_count; ++i) {
+        *far_segments += far_from_consistent(rho[2 * i], rho[2 * i + 1]) ? 1 : 0;
+      }
+    }
+  } else if (const Status s = fit_cables(cables_mm, geometry, q, rho, far_segments); s != Status::ok) {
+    return s;
+  }
   if (beyond_limit != nullptr) *beyond_limit = !within;
   joints = q;
   residuals = rho;

@@ -1079,10 +1079,11 @@ bool check_kind(Run& run, const std::uint8_t* bytes, DeclaredImage& h) {
                     h.extra, kMaxExtraInputs, Expect::at_most);
 }
 
-// The inputs the encoding gives the declared segments (a count beyond any
-// robot stays a count: the check against input_dims reports it).
+// The inputs the encoding gives the declared segments (segment_count is a
+// u16: any declared count stays an int, and the check against input_dims
+// reports one beyond any robot).
 inline std::uint32_t encoded_inputs(const DeclaredImage& h) {
-  return (takes_cable_residuals(h.encoding) ? 2 + kCableResidualsPerSegment : 2) * h.segments;
+  return static_cast<std::uint32_t>(encoded_input_count(h.encoding, static_cast<int>(h.segments)));
 }
 
 template <typename Run>

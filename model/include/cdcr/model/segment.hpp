@@ -39,6 +39,33 @@ SegmentJoints<S> joints_from_bend(const Vec2<S>& b) {
   return SegmentJoints<S>{std::atan2(b.y(), b.x()), b.norm()};
 }
 
+// What eqs. (3)-(5) read of a segment's cables: the differences l3 - l1 and
+// l2 - l4, and their chord. `status` is not ok for impossible lengths (or
+// geometry); the differences are then not computed.
+template <typename S>
+struct CableDifferences {
+  Status status = Status::ok;
+  S d31 = S(0), d24 = S(0), chord = S(0), reach = S(0);  // reach = 4 r, the largest chord
+};
+
+template <typename S>
+CableDifferences<S> cable_differences(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry) {
+  CableDifferences<S> d;
+  if (const Status s = geometry.validate(); s != Status::ok) {
+    d.status = s;
+  } else if (!cables_mm.allFinite()) {
+    d.status = Status::non_finite_input;
+  } else if (!(cables_mm.minCoeff() > S(0))) {
+    d.status = Status::cable_length_not_positive;
+  } else {
+    d.d31 = cables_mm[2] - cables_mm[0];
+    d.d24 = cables_mm[1] - cables_mm[3];
+    d.reach = S(4) * geometry.anchor_radius_mm;
+    d.chord = std::hypot(d.d31, d.d24);
+  }
+  return d;
+}
+
 // Eqs. (2)-(5). alpha = atan2(l2 - l4, l3 - l1): eq. (4) as printed has the
 // opposite sign and loses the quadrant; this form reproduces Table 1.
 // cable_resolution_mm: the step of the measured lengths (the drives report
@@ -47,13 +74,10 @@ SegmentJoints<S> joints_from_bend(const Vec2<S>& b) {
 template <typename S>
 Status joints_from_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry, SegmentJoints<S>& joints,
                           S cable_resolution_mm = S(0)) {
-  if (const Status s = geometry.validate(); s != Status::ok) return s;
-  if (!cables_mm.allFinite()) return Status::non_finite_input;
-  if (!(cables_mm.minCoeff() > S(0))) return Status::cable_length_not_positive;
-  const S d31 = cables_mm[2] - cables_mm[0];
-  const S d24 = cables_mm[1] - cables_mm[3];
-  const S reach = S(4) * geometry.anchor_radius_mm;
-  const S chord = std::hypot(d31, d24);
+  const CableDifferences<S> d = cable_differences(cables_mm, geometry);
+  if (d.status != Status::ok) return d.status;
+  const S reach = d.reach;
+  const S chord = d.chord;
   if (chord > reach) return Status::cable_difference_out_of_range;
   const S theta = S(2) * std::asin(chord / reach);
   // Cables that cables_from_joints computed at theta = theta_max read back up
@@ -68,7 +92,7 @@ Status joints_from_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& ge
       return Status::theta_beyond_limit;
     }
   }
-  joints = SegmentJoints<S>{std::atan2(d24, d31), std::min(theta, geometry.theta_max_rad)};
+  joints = SegmentJoints<S>{std::atan2(d.d24, d.d31), std::min(theta, geometry.theta_max_rad)};
   return Status::ok;
 }
 
