@@ -69,6 +69,13 @@ void HysteresisTracker::homed(const Geometry& geometry) {
   uncertainty_mm_.setZero(model_.cables);
 }
 
+void HysteresisTracker::hold_history(Correction& correction) const {
+  if (!active_ || !correction.takes_history()) return;
+  Scalar history[model::kMaxCables];
+  model::history_inputs(state_, model_, history);
+  correction.set_history_inputs(history);
+}
+
 void HysteresisTracker::commanded_for(Cables& cables_mm) const {
   if (!active_ || !state_.has_position) return;
   for (int c = 0; c < model_.cables; ++c) cables_mm[c] = model::commanded_for_effective(state_, model_, c, cables_mm[c]);

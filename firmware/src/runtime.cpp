@@ -214,8 +214,9 @@ void Runtime::update_pose() {
     PoseEstimate estimate;
     // The hysteresis state moves with every complete set; the pose is that
     // of the effective lengths.
-    if (const model::Status s = estimate_pose(hysteresis_.track(latest_cables_mm_), estimate);
-        s == model::Status::ok) {
+    const Cables& effective_mm = hysteresis_.track(latest_cables_mm_);
+    hysteresis_.hold_history(model_.correction);
+    if (const model::Status s = estimate_pose(effective_mm, estimate); s == model::Status::ok) {
       latest_pose_ = estimate;
       // IK's corrections take the cables' residuals as last measured.
       model_.correction.set_cable_residuals(estimate.cable_residuals);

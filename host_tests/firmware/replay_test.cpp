@@ -245,10 +245,12 @@ TEST(RuntimeReplay, ThePayloadColumnMustMatchTheImage) {
 // A motion sequence of two sessions with a hysteresis image: the replay
 // carries the state from row to row, each session from home, and its poses
 // are the runtime's on the effective lengths of a float32 run of the
-// operator written out here.
-TEST(RuntimeReplay, AHysteresisImageCarriesTheStateOverTheSequence) {
+// operator written out here; with the history inputs, given where each
+// cable last moved, read from the same run.
+void expect_replay_carries_the_state(bool history, const char* folder) {
   test_support::SyntheticModelOptions options;
   options.hysteresis_operators = 2;
+  options.history = history;
   const training::TrainedModel trained = test_support::synthetic_trained_model(options);
   const std::vector<std::uint8_t> image = exporting::write_image(trained);
   test_support::SimulatedPlatform platform(image);
@@ -275,7 +277,7 @@ TEST(RuntimeReplay, AHysteresisImageCarriesTheStateOverTheSequence) {
     data.time_s[i] = 0.1 * i + (i >= 35 ? 60.0 : 0.0);
   }
   data.session_starts = {0, 35};
-  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / "cdcr_runtime_replay_sequence";
+  const std::filesystem::path dir = std::filesystem::path(::testing::TempDir()) / folder;
   write_replay_inputs(dir, image, data);
   ASSERT_EQ(run_replay(dir, "model.img", "cables.csv"), 0);
   const dataset::Dataset written = dataset::read_dataset_csv((dir / "cables.csv").string());
@@ -298,6 +300,9 @@ TEST(RuntimeReplay, AHysteresisImageCarriesTheStateOverTheSequence) {
     model::update_hysteresis(state, h, commanded);
     Cables effective;
     model::effective_lengths(state, h, effective);
+    float row_history[8];
+    model::history_inputs(state, h, row_history);
+    runtime.set_history_inputs(row_history);
     PoseEstimate expected, joints_only;
     ASSERT_EQ(runtime.estimate_pose(effective, expected), model::Status::ok);
     ASSERT_EQ(runtime.estimate_pose(commanded, joints_only), model::Status::ok);
@@ -308,6 +313,14 @@ TEST(RuntimeReplay, AHysteresisImageCarriesTheStateOverTheSequence) {
         std::max(largest_effect_mm, double((expected.pose.position_mm - joints_only.pose.position_mm).norm()));
   }
   EXPECT_GT(largest_effect_mm, 0.1) << "the hysteresis must matter on these rows";
+}
+
+TEST(RuntimeReplay, AHysteresisImageCarriesTheStateOverTheSequence) {
+  expect_replay_carries_the_state(false, "cdcr_runtime_replay_sequence");
+}
+
+TEST(RuntimeReplay, AHistoryImageTakesWhereEachCableLastMovedOnEveryRow) {
+  expect_replay_carries_the_state(true, "cdcr_runtime_replay_history");
 }
 
 // An image that models the cables' hysteresis needs the rows as a motion

@@ -18,7 +18,9 @@
 #include "cdcr/model/image_hysteresis.hpp"
 #include "cdcr/model/pose_error_summary.hpp"
 #include "runtime_test_fixture.hpp"
+#include "train/evaluation.hpp"
 #include "train/predictive_variance.hpp"
+#include "../support/synthetic_trained_model.hpp"
 #include "../support/variance_block.hpp"
 
 #include "../support/image_in_double.hpp"
@@ -379,6 +381,53 @@ TEST_F(RuntimeHysteresisTest, IkReachesATargetApproachedFromEitherSide) {
   const Cables from_above = runtime->setpoints_mm();
   // The same effective lengths, commanded differently from either side.
   EXPECT_GT((from_below - from_above).cwiseAbs().maxCoeff(), 0.1f);
+}
+
+// An image with the history inputs: after every cable set the runtime holds
+// where each cable last moved, read from the tracker's state (the block's
+// last operator, 0 while unknown), and its pose is the image's float32 path
+// given those inputs (training::firmware_poses, the trainer's check of the
+// image); the inputs matter, so a runtime that did not hold them would not
+// give it.
+TEST_F(RuntimeHysteresisTest, TheTrackersHistoryIsTheCorrectionsHistoryInputs) {
+  test_support::SyntheticModelOptions o;
+  o.hysteresis_operators = 2;
+  o.history = true;
+  o.training_points = 12;
+  boot_with(test_support::synthetic_trained_model(o));
+  ASSERT_TRUE(runtime->correction().takes_history());
+  model::ImageView view{};
+  ASSERT_EQ(model::parse_image(image.data(), image.size(), view), model::ImageStatus::ok);
+  model::HysteresisState<float> host;
+  model::reset_unknown(host, host_model);
+  std::mt19937 rng(8);
+  std::uniform_real_distribution<double> alpha(-3.0, 3.0), theta(0.02, 0.3);
+  double largest_effect_mm = 0.0;
+  bool saw_unknown = false, saw_known = false;
+  for (int leg = 0; leg < 12; ++leg) {
+    const Cables received = cycle_at(cables_at(alpha(rng), theta(rng)));
+    model::update_hysteresis(host, host_model, received);
+    Cables effective;
+    model::effective_lengths(host, host_model, effective);
+    Eigen::MatrixXd history(1, 8);
+    float values[8];
+    model::history_inputs(host, host_model, values);
+    for (int c = 0; c < 8; ++c) history(0, c) = values[c];
+    (host.known() ? saw_known : saw_unknown) = true;
+    const Eigen::MatrixXd rows = effective.cast<double>().transpose();
+    const model::Pose<double> expected =
+        training::firmware_poses(view, rows, training::FirmwareAccumulator::float64, {}, history).front();
+    ASSERT_LT((runtime->latest_pose().pose.position_mm.cast<double>() - expected.position_mm).norm(), 1e-4)
+        << "leg " << leg;
+    const model::Pose<double> without =
+        training::firmware_poses(view, rows, training::FirmwareAccumulator::float64, {},
+                                 Eigen::MatrixXd::Zero(1, 8))
+            .front();
+    largest_effect_mm = std::max(largest_effect_mm, (without.position_mm - expected.position_mm).norm());
+  }
+  EXPECT_TRUE(saw_unknown);
+  EXPECT_TRUE(saw_known);
+  EXPECT_GT(largest_effect_mm, 0.01);
 }
 
 }  // namespace

@@ -207,5 +207,75 @@ TEST_F(FlashImageHysteresis, TheExporterRefusesAModelWithTheWrongCounts) {
   EXPECT_THROW(exporting::write_image(bad), std::invalid_argument);
 }
 
+// The history encodings (v2.5): where each cable last moved, read from the
+// block's last operator, after the bend pairs: D = 2n + 4n.
+class FlashImageHistory : public FlashImageHysteresis {
+ protected:
+  static test_support::SyntheticModelOptions history_options() {
+    test_support::SyntheticModelOptions o = options();
+    o.history = true;
+    return o;
+  }
+  training::TrainedModel history_model = test_support::synthetic_trained_model(history_options());
+  Bytes history_image = exporting::write_image(history_model);
+  std::size_t history_at(int array, int i) const {
+    const ImageLayout l =
+        image_layout(static_cast<std::uint32_t>(history_model.training_points()), 12, 2, kImageVersionMajor, 0, 0,
+                     image_hysteresis_floats(8, 2));
+    return l.hysteresis_offset + 4 * (16 * array + i);
+  }
+};
+
+TEST_F(FlashImageHistory, IsA25ImageWithTwelveInputs) {
+  ImageView view{};
+  ASSERT_EQ(parse_image(history_image.data(), history_image.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.version_minor, kImageVersionMinorHistory);
+  EXPECT_EQ(view.encoding, InputEncoding::bend_vector_history);
+  EXPECT_EQ(view.input_dims, 12u);
+  // Without the history the same kind of model stays a 2.2 image.
+  ASSERT_EQ(parse_image(image.data(), image.size(), view), ImageStatus::ok);
+  EXPECT_EQ(view.version_minor, kImageVersionMinorHysteresis);
+}
+
+TEST_F(FlashImageHistory, WhatTheHistoryNeedsIsCheckedUnderAValidCrc) {
+  // An older minor version cannot declare the encoding.
+  Bytes older = history_image;
+  put<std::uint16_t>(older, image_field::version_minor.offset, kImageVersionMinorCableFit);
+  reseal(older);
+  ImageFinding first;
+  EXPECT_EQ(parse_all_ways(older, first), ImageStatus::unsupported_kind);
+  EXPECT_STREQ(first.field, "version_minor");
+  // The inputs must be the encoding's.
+  Bytes dims = history_image;
+  put<std::uint16_t>(dims, image_field::input_dims.offset, 8);
+  reseal(dims);
+  EXPECT_EQ(parse_all_ways(dims, first), ImageStatus::bad_header);
+  EXPECT_STREQ(first.field, "input_dims");
+  // Without a hysteresis block there is no state to read.
+  Bytes without = history_image;
+  without[image_field::hysteresis_cables.offset] = 0;
+  without[image_field::hysteresis_operators.offset] = 0;
+  reseal(without);
+  EXPECT_EQ(parse_all_ways(without, first), ImageStatus::bad_header);
+  EXPECT_STREQ(first.field, "history_without_hysteresis");
+  // The last operator's width divides its lag: zero is refused there, and
+  // only there.
+  Bytes zero_width = history_image;
+  put<float>(zero_width, history_at(0, 2 * 3 + 1), 0.0f);
+  reseal(zero_width);
+  EXPECT_EQ(parse_all_ways(zero_width, first), ImageStatus::invalid_parameters);
+  EXPECT_STREQ(first.field, "hysteresis_history_width");
+  EXPECT_EQ(first.index, 2 * 3 + 1);
+  Bytes zero_first = history_image;
+  put<float>(zero_first, history_at(0, 2 * 3), 0.0f);
+  put<float>(zero_first, history_at(2, 2 * 3), 0.0f);  // its homing lag within the width
+  reseal(zero_first);
+  EXPECT_EQ(parse_all_ways(zero_first, first), ImageStatus::ok) << first.field;
+  // The exporter refuses a history model without the block.
+  training::TrainedModel no_block = history_model;
+  no_block.hysteresis = HysteresisModel<double>{};
+  EXPECT_THROW(exporting::write_image(no_block), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace cdcr::model

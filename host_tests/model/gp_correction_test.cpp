@@ -336,5 +336,63 @@ TEST_P(GpCorrectionPayload, TheMeanFollowsThePayloadAsTheTrainerPredictsIt) {
   EXPECT_EQ(reference.value(too_long, eps), Status::correction_failed);
 }
 
+// A model with everything held: the cable residuals, the history and the
+// payload, in that order after the bend pairs (the trainer's model_inputs).
+// The board's mean against the trainer's double prediction on the same
+// rows, held values set as the runtime sets them; each held input moves the
+// correction.
+TEST(GpCorrectionHistory, TheHeldInputsAreTheTrainersInTheirOrder) {
+  test_support::SyntheticModelOptions options;
+  options.segments = 2;
+  options.training_points = 29;
+  options.cable_residuals = true;
+  options.history = true;
+  options.payload_input = true;
+  options.hysteresis_operators = 1;
+  const BoundModel b = test_support::synthetic_image(options);
+  ASSERT_EQ(b.view.encoding, InputEncoding::bend_vector_cable_fit_history);
+  ASSERT_EQ(b.view.input_dims, 4 + 4 + 8 + 1);
+  GpCorrection<double, double> correction;
+  ASSERT_EQ(correction.bind(b.view), Status::ok);
+  EXPECT_TRUE(correction.takes_history());
+  EXPECT_EQ(correction.history_dims(), 8);
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  training::TrainingSet rows;
+  rows.encoding = b.view.encoding;
+  rows.bends.resize(6, 4);
+  rows.cable_residuals.resize(6, 4);
+  rows.history_inputs.resize(6, 8);
+  rows.payload_kg.resize(6);
+  for (int q = 0; q < 6; ++q) {
+    rows.bends.row(q) = random_bend(2, rng).transpose();
+    for (int e = 0; e < 4; ++e) rows.cable_residuals(q, e) = unit(rng);
+    for (int e = 0; e < 8; ++e) rows.history_inputs(q, e) = unit(rng);
+    rows.payload_kg[q] = 0.5 + 0.5 * unit(rng);
+  }
+  const Eigen::MatrixXd expected = training::predict_error_twists(b.trained, rows);
+  for (int q = 0; q < 6; ++q) {
+    const JointVector<double> bend = rows.bends.row(q).transpose();
+    const CableResiduals<double> residuals = rows.cable_residuals.row(q).transpose();
+    const Eigen::VectorXd history = rows.history_inputs.row(q).transpose();
+    correction.set_history_inputs(history.data());
+    correction.set_payload_kg(rows.payload_kg[q]);
+    const Twist<double> eps = correction.predict(bend, residuals);
+    for (int k = 0; k < 6; ++k) {
+      const double scale =
+          b.trained.output_scale[k] * b.trained.signal_variance[k] + std::abs(b.trained.output_mean[k]);
+      EXPECT_NEAR(eps[k], expected(q, k), 2e-6 * scale) << "query " << q;
+    }
+    // The payload stayed where it was set, after the history.
+    EXPECT_EQ(correction.payload_kg(), rows.payload_kg[q]);
+  }
+  const JointVector<double> bend = rows.bends.row(0).transpose();
+  const CableResiduals<double> residuals = rows.cable_residuals.row(0).transpose();
+  const Twist<double> before = correction.predict(bend, residuals);
+  Eigen::VectorXd flipped = -rows.history_inputs.row(0).transpose();
+  correction.set_history_inputs(flipped.data());
+  EXPECT_GT((correction.predict(bend, residuals) - before).norm(), 1e-3);
+}
+
 }  // namespace
 }  // namespace cdcr::model

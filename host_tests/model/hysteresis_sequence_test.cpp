@@ -71,6 +71,37 @@ TEST(HysteresisSequence, EachSessionStartsAtHomeAndCarriesItsStateFromRowToRow) 
   EXPECT_GT((effective.cast<double>() - commanded).cwiseAbs().maxCoeff(), 0.3);
 }
 
+// The history inputs of every row are those of the state the effective
+// lengths' run leaves there, session by session.
+TEST(HysteresisSequence, HistoryInputsFollowTheSameState) {
+  const RobotGeometry<float> geometry = RobotGeometry<float>::uniform(2, 120.0f, 67.0f);
+  const HysteresisModel<float> h = two_operator_model(geometry);
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> step(-0.8, 0.8);
+  Eigen::MatrixXd commanded(25, 8);
+  CableVector<float> approach, home;
+  homing_waypoints(geometry, approach, home);
+  for (int i = 0; i < commanded.rows(); ++i) {
+    for (int c = 0; c < 8; ++c) commanded(i, c) = home[c] + (i == 0 ? 0.0 : commanded(i - 1, c) - home[c]) + step(rng);
+  }
+  const std::vector<int> sessions = {0, 10};
+  Eigen::MatrixXf history(25, 8);
+  ASSERT_EQ(history_inputs_over_sequence(h, geometry, commanded, sessions.data(), 2, history), Status::ok);
+  HysteresisState<float> state;
+  bool moved_both_ways = false;
+  for (int i = 0; i < commanded.rows(); ++i) {
+    if (i == 0 || i == 10) ASSERT_EQ(start_at_home(state, h, geometry), Status::ok);
+    const CableVector<float> row = commanded.row(i).transpose().cast<float>();
+    update_hysteresis(state, h, row);
+    for (int c = 0; c < 8; ++c) {
+      const float expected = 0.5f * (state.lag_low_mm[c][1] + state.lag_high_mm[c][1]) / 0.7f;
+      ASSERT_FLOAT_EQ(history(i, c), expected) << "row " << i << " cable " << c;
+    }
+  }
+  for (int c = 0; c < 8; ++c) moved_both_ways |= history.col(c).maxCoeff() > 0.9f && history.col(c).minCoeff() < -0.9f;
+  EXPECT_TRUE(moved_both_ways);
+}
+
 TEST(HysteresisSequence, RefusesRowsOfAnotherCableCount) {
   const RobotGeometry<float> geometry = RobotGeometry<float>::uniform(2, 120.0f, 67.0f);
   const HysteresisModel<float> h = two_operator_model(geometry);

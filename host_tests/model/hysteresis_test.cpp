@@ -287,6 +287,41 @@ HysteresisState<double> random_state(const HysteresisModel<double>& m, std::mt19
   return s;
 }
 
+// --- the history inputs --------------------------------------------------
+
+// Where the cable last moved, from the last operator: 0 while nothing is
+// known, +-1 once it has moved twice the width one way, the lag over the
+// width inside a reversal (by hand: a move back by d from the upper stop
+// leaves the lag at w - d). A weight of 0 leaves the effective length the
+// commanded one.
+TEST(Hysteresis, HistoryInputsAreTheLastOperatorsLagOverItsWidth) {
+  const HysteresisModel<double> m = make_model(1, {0.5, 0.2}, {0.6, 0.0});
+  HysteresisState<double> s;
+  reset_unknown(s, m);
+  double h[1] = {7.0};
+  history_inputs(s, m, h);
+  EXPECT_EQ(h[0], 0.0);
+  move_to(s, m, 10.0);
+  move_to(s, m, 10.5);  // 0.5 mm up: the interval [-0.2, 0.2] + 0.5 closes at the upper stop
+  history_inputs(s, m, h);
+  EXPECT_DOUBLE_EQ(h[0], 1.0);
+  move_to(s, m, 10.45);  // 0.05 mm back: lag 0.15
+  history_inputs(s, m, h);
+  EXPECT_NEAR(h[0], 0.15 / 0.2, 1e-12);
+  move_to(s, m, 9.0);
+  history_inputs(s, m, h);
+  EXPECT_DOUBLE_EQ(h[0], -1.0);
+  // Only the first operator lags the effective length: its lag is -0.5 after
+  // the long move down, weight 0.6.
+  EXPECT_NEAR(effective_of(s, m), 9.0 + 0.6 * 0.5, 1e-12);
+  // Half known: after 0.2 mm up from power-up the interval is [0, 0.2].
+  reset_unknown(s, m);
+  move_to(s, m, 10.0);
+  move_to(s, m, 10.2);
+  history_inputs(s, m, h);
+  EXPECT_NEAR(h[0], 0.5, 1e-12);
+}
+
 TEST(Hysteresis, CommandedForEffectiveInvertsTheOperatorInBothDirections) {
   std::mt19937_64 rng(17);
   std::uniform_real_distribution<double> unit(0.0, 1.0);

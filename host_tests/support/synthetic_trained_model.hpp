@@ -24,6 +24,10 @@ struct SyntheticModelOptions {
   // The cable-fit encoding: after the bend pairs, each segment's common
   // mode (-1.5 to 0 mm) and pair imbalance (-1 to 1 mm).
   bool cable_residuals = false;
+  // A history encoding: after the residuals, where each cable last moved
+  // (-1 to 1, 4 per segment); needs hysteresis_operators, whose last
+  // operator keeps it.
+  bool history = false;
   // The correction's size: the output means and scales of the position
   // outputs times the first, of the rotation outputs times the second (a
   // trained model's correction is millimetres and milliradians).
@@ -64,12 +68,14 @@ inline training::TrainedModel synthetic_trained_model(const SyntheticModelOption
 
   training::TrainedModel m;
   m.encoding = options.cable_residuals ? model::InputEncoding::bend_vector_cable_fit : options.encoding;
+  m.encoding = model::with_history(m.encoding, options.history);
   m.geometry = model::RobotGeometry<double>::uniform(options.segments, 120.0, 67.0);
   m.geometry.segments[options.segments - 1].backbone_length_mm = 95.5;  // not all segments alike
 
   const int n = options.training_points;
   const int residuals = options.cable_residuals ? 2 * options.segments : 0;
-  const int d = 2 * options.segments + residuals + (options.payload_input ? 1 : 0);
+  const int history = options.history ? 4 * options.segments : 0;
+  const int d = 2 * options.segments + residuals + history + (options.payload_input ? 1 : 0);
   m.inputs.resize(n, d);
   for (int i = 0; i < n; ++i) {
     for (int s = 0; s < options.segments; ++s) {
@@ -87,6 +93,7 @@ inline training::TrainedModel synthetic_trained_model(const SyntheticModelOption
       m.inputs(i, 2 * options.segments + 2 * s) = uniform(-1.5, 0.0);
       m.inputs(i, 2 * options.segments + 2 * s + 1) = uniform(-1.0, 1.0);
     }
+    for (int c = 0; c < history; ++c) m.inputs(i, 2 * options.segments + residuals + c) = uniform(-1.0, 1.0);
     if (options.payload_input) m.inputs(i, d - 1) = uniform(0.0, 1.0);
   }
   if (options.payload_input) m.default_payload_kg = 0.375;

@@ -24,7 +24,12 @@ repeatability: the same split, and
     such visits of |p_a - p_b| / sqrt(2), from the file alone (commands told
     apart by their cable values);
   - a joints-only GP (the cables) against one also given the sign of each
-    cable's last move (-1, 0, +1).
+    cable's last move (-1, 0, +1);
+  - with --cdcr: the project's model, `cdcr train` on the first 80 % as the
+    sequence it is, with and without `--no-history`, each `cdcr eval`uated
+    on the last 20 %: the compensated mean position error, whether the
+    history inputs were kept, r95's coverage and the rows flagged as
+    extrapolating.
 One segment of four cables (l1_1..l1_4) only. Needs numpy and scikit-learn.
 """
 
@@ -68,18 +73,24 @@ def cdcr_json(cdcr, *arguments):
     return json.loads(done.stdout)
 
 
-def cdcr_model(cdcr, source, train_rows, test_rows, with_time, length_mm, radius_mm):
-    """cdcr train on train_rows, cdcr eval on test_rows: the compensated error, the encoding, the cable fit's counts."""
+def cdcr_model(cdcr, source, train_rows, test_rows, with_time, length_mm, radius_mm, options=()):
+    """cdcr train on train_rows, cdcr eval on test_rows: the compensated error, the encoding, the cable fit's counts,
+    r95's coverage."""
     with tempfile.TemporaryDirectory() as work:
         train, test, image = (os.path.join(work, name) for name in ("train.csv", "test.csv", "model.img"))
         write_rows(train, source, train_rows, with_time)
         write_rows(test, source, test_rows, with_time)
         trained = cdcr_json(cdcr, "train", "--data", train, "--out", image, "--holdout", "0", "--segments", "1",
-                            "--length", str(length_mm), "--radius", str(radius_mm))
+                            "--length", str(length_mm), "--radius", str(radius_mm), *options)
         evaluated = cdcr_json(cdcr, "eval", "--model", image, "--data", test)
-    return {"compensated_mm": evaluated["compensated"]["position_mm"], "encoding": trained["encoding"],
-            "model": trained["model"]["reason"], "cable_inputs": trained["cable_inputs"],
-            "extrapolating": evaluated["extrapolating"]}
+    out = {"compensated_mm": evaluated["compensated"]["position_mm"], "encoding": trained["encoding"],
+           "model": trained["model"]["reason"], "cable_inputs": trained["cable_inputs"],
+           "extrapolating": evaluated["extrapolating"]}
+    if with_time and trained.get("hysteresis"):
+        out["history"] = trained["hysteresis"].get("history", {}).get("reason")
+    if evaluated.get("coverage"):
+        out["r95_coverage"] = evaluated["coverage"]
+    return out
 
 
 def read(path):
@@ -155,8 +166,8 @@ def command_ids(cables):
     return np.array(out)
 
 
-def repeatability(path):
-    length_mm, _, cables, position = read(path)
+def repeatability(path, cdcr=None):
+    length_mm, radius_mm, cables, position = read(path)
     n = len(cables)
     cut = split(n)
     ids = command_ids(cables)
@@ -181,6 +192,11 @@ def repeatability(path):
         predicted, kernel = fit_gp(inputs[:cut], position[:cut], inputs[cut:])
         out[name] = mean_distance(predicted, position[cut:])
         out[name.replace("_mm", "_kernel")] = str(kernel)
+    if cdcr:
+        test = list(range(cut, n))
+        out["cdcr_sequence"] = cdcr_model(cdcr, path, range(cut), test, True, length_mm, radius_mm)
+        out["cdcr_sequence_no_history"] = cdcr_model(cdcr, path, range(cut), test, True, length_mm, radius_mm,
+                                                     ("--no-history",))
     return out
 
 
@@ -190,10 +206,11 @@ def main(argv=None):
     parser.add_argument("file", help="a session CSV of independent_robot.py")
     parser.add_argument("--report", help="independent_robot.py's --report JSON: adds the first session's floor")
     parser.add_argument("--train-rows", type=int, default=1500, help="babbling: training rows used (default 1500)")
-    parser.add_argument("--cdcr", help="babbling: the cdcr executable, to measure the project's model too")
+    parser.add_argument("--cdcr", help="the cdcr executable, to measure the project's model too")
     parser.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     args = parser.parse_args(argv)
-    out = babbling(args.file, args.train_rows, args.cdcr) if args.collection == "babbling" else repeatability(args.file)
+    out = (babbling(args.file, args.train_rows, args.cdcr) if args.collection == "babbling"
+           else repeatability(args.file, args.cdcr))
     if args.report:
         with open(args.report) as f:
             out["noise_floor_mm"] = json.load(f)["sessions"][0]["noise_floor"]["position_mm"]

@@ -15,7 +15,8 @@
 #     joints-only GP and a GP also given the sign of each cable's last move.
 # With --cdcr, the babbling runs also train and evaluate the project's model
 # (cdcr train on the same rows as the GP, and on the first 80 % as a
-# sequence; cdcr eval on the last 20 %).
+# sequence; cdcr eval on the last 20 %), and the repeatability runs the
+# project's sequence model with and without the history inputs.
 # Needs numpy and scikit-learn (the sklearn group); builds nothing. Writes to
 # $BUILD_DIR/real_like_bench/.
 #
@@ -50,5 +51,5 @@ for seed in $seeds; do
     --seed "$seed" --rows 1,1 --out-dir "$work_dir/repeatability$seed" \
     --report "$work_dir/repeatability$seed.json" >/dev/null
   nice -n 19 "$python" tools/bench/real_like_bench.py repeatability "$work_dir/repeatability$seed/session0.csv" \
-    --report "$work_dir/repeatability$seed.json" | tee "$work_dir/repeatability$seed.txt"
+    --report "$work_dir/repeatability$seed.json" "${cdcr_option[@]}" | tee "$work_dir/repeatability$seed.txt"
 done

@@ -87,6 +87,22 @@ Eigen::MatrixXd effective_cables(const model::ImageView& image, const model::Hys
   return effective.cast<double>();
 }
 
+// Where each cable last moved at every row, as the board keeps it, for an
+// image with the history inputs (empty for others).
+Eigen::MatrixXd history_of(const model::ImageView& image, const model::HysteresisModel<float>& hysteresis,
+                           const Eigen::MatrixXd& cables_mm, const std::vector<int>& session_starts) {
+  if (!model::takes_history(image.encoding)) return {};
+  model::RobotGeometry<float> geometry;
+  model::geometry_from_image(image, geometry);
+  Eigen::MatrixXf history(cables_mm.rows(), cables_mm.cols());
+  if (const model::Status s = model::history_inputs_over_sequence(
+          hysteresis, geometry, cables_mm, session_starts.data(), static_cast<int>(session_starts.size()), history);
+      s != model::Status::ok) {
+    throw std::invalid_argument(std::string("hysteresis: ") + model::to_string(s));
+  }
+  return history.cast<double>();
+}
+
 // What the image and the rows hold, checked against each other before any
 // row is evaluated.
 struct EvalInputs {
@@ -151,13 +167,18 @@ EvalResults evaluate(const EvalCommandOptions& o, const EvalInputs& in) {
   EvalResults r;
   const model::ImageView& view = in.image.view;
   try {
-    r.set = training::make_training_set(in.data, in.geometry, view.encoding, in.payload_input);
+    r.set = training::make_training_set(in.data, in.geometry, model::with_history(view.encoding, false),
+                                        in.payload_input);
     // The nominal (initial) error stays that of the commanded lengths.
     const Eigen::MatrixXd cables_mm = in.with_hysteresis
                                           ? effective_cables(view, in.hysteresis, r.set.cables_mm, in.data.session_starts)
                                           : r.set.cables_mm;
-    r.compensated = training::firmware_poses(view, cables_mm, training::FirmwareAccumulator::float64, r.set.payload_kg);
-    r.estimates = training::firmware_estimates(view, cables_mm, r.set.payload_kg);
+    const Eigen::MatrixXd history =
+        in.with_hysteresis ? history_of(view, in.hysteresis, r.set.cables_mm, in.data.session_starts)
+                           : Eigen::MatrixXd();
+    r.compensated = training::firmware_poses(view, cables_mm, training::FirmwareAccumulator::float64,
+                                             r.set.payload_kg, history);
+    r.estimates = training::firmware_estimates(view, cables_mm, r.set.payload_kg, history);
     if (o.from_power_up) {
       // The first session again, from power-up: the board's own path.
       const Eigen::Index first_session_rows =

@@ -29,8 +29,9 @@ PowerUpEstimates estimates_from_power_up(const model::ImageView& image, const Ei
   for (Eigen::Index i = 0; i < cables_mm.rows(); ++i) {
     const firmware::Cables commanded = cables_mm.row(i).transpose().cast<firmware::Scalar>();
     firmware::PoseEstimate estimate;
-    if (const model::Status s = firmware::estimate_pose(*robot, tracker->track(commanded), estimate);
-        s != model::Status::ok) {
+    const firmware::Cables& effective = tracker->track(commanded);
+    tracker->hold_history(robot->correction);
+    if (const model::Status s = firmware::estimate_pose(*robot, effective, estimate); s != model::Status::ok) {
       throw std::invalid_argument("sample " + std::to_string(i + 1) + ": " + model::to_string(s));
     }
     tracker->begin_variance(*robot, estimate);

@@ -36,6 +36,8 @@ struct TrainCommandOptions {
   bool calibrate = false;
   bool ignore_payload = false;
   bool no_hysteresis = false;
+  bool no_history = false;
+  bool no_homing = false;
   bool no_compliance = false;
   bool json = false;
 };
@@ -60,6 +62,7 @@ training::TrainingOptions training_options_for(const TrainCommandOptions& o) {
     throw InputError(fmt::format("--flash-budget {} is beyond a 32-bit image size", o.flash_budget));
   }
   options.board.flash_budget_bytes = static_cast<std::uint32_t>(o.flash_budget);
+  options.offer_history = !o.no_history;
   return options;
 }
 
@@ -90,6 +93,7 @@ TrainingSets training_sets_for(const TrainCommandOptions& o, const dataset::Data
       sets.train = sets.all;
       sets.train_rows = every_row(sets.all.size());
       sets.validation_data = load_dataset(o.validation_path, true);
+      sets.validation_data->sessions_homed = !o.no_homing;
       sets.validation = training::make_training_set(*sets.validation_data, g, encoding, with_payload);
       if (sets.validation.has_payload() != sets.all.has_payload()) {
         throw InputError(fmt::format("{} {} a payload_kg column and {} {}", o.data_path,
@@ -151,7 +155,12 @@ std::optional<training::CableInputChoice> choose_encoding(const TrainCommandOpti
 
 CommandOutput run_train(const TrainCommandOptions& o) {
   training::TrainingOptions options = training_options_for(o);
-  const dataset::Dataset data = load_dataset(o.data_path, true);
+  dataset::Dataset data = load_dataset(o.data_path, true);
+  if (o.no_homing && !data.has_time) {
+    throw InputError(fmt::format(
+        "{}: --no-homing applies to a motion sequence (a t_s column), but the rows have no time", o.data_path));
+  }
+  data.sessions_homed = !o.no_homing;
   const model::RobotGeometry<double> design = geometry_for(data, o.geometry);
 
   TrainingSets sets = training_sets_for(o, data, design, options.encoding);
@@ -280,6 +289,12 @@ void register_train_command(CLI::App& app, CommandOutput& output) {
                     "Train on the cables alone even when the data have a payload_kg column");
   command->add_flag("--no-hysteresis", o->no_hysteresis,
                     "Train the joints-only model even when the data are a motion sequence (a t_s column)");
+  command->add_flag("--no-history", o->no_history,
+                    "Keep where each cable last moved out of a motion sequence's model (by default it becomes an "
+                    "input where the evidence supports it)");
+  command->add_flag("--no-homing", o->no_homing,
+                    "The sequence's sessions start at power-up without the homing move: their first rows train with "
+                    "the cables' state unknown, as the board's are after power-up");
   command->add_flag("--no-compliance", o->no_compliance,
                     "Train the payload-as-an-input model without identifying the segments' compliance under the "
                     "load, even when the data have a payload_kg column");

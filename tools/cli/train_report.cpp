@@ -76,6 +76,19 @@ Json hysteresis_json(const TrainRun& run) {
   j["likelihood_evaluations"] = id.likelihood_evaluations;
   j["hyperparameter_searches"] = id.hyperparameter_searches;
   j["refinement_gain"] = id.refinement_gain;
+  const training::HistoryChoice& h = s.history;
+  Json history_candidates = Json::array();
+  for (const training::HistoryCandidate& c : h.candidates) {
+    history_candidates.push_back({{"width_mm", c.width_mm}, {"log_marginal_likelihood", c.log_marginal_likelihood}});
+  }
+  j["history"] = {{"searched", h.searched},
+                  {"chosen", h.chosen},
+                  {"width_mm", h.chosen ? Json(h.width_mm) : Json(nullptr)},
+                  {"without_log_likelihood", h.searched ? Json(h.without_log_likelihood) : Json(nullptr)},
+                  {"candidates", history_candidates},
+                  {"extra_parameters", h.extra_parameters},
+                  {"search_rows", h.search_rows},
+                  {"reason", h.reason}};
   j["noise_variance_floor"] = s.noise_variance_floor > 0.0 ? Json(s.noise_variance_floor) : Json(nullptr);
   if (s.joints_only_validation.samples > 0) {
     j["validation"] = {{"nominal_commanded", errors_json(s.joints_only_validation.initial)},
@@ -124,6 +137,10 @@ std::string hysteresis_text(const TrainRun& run) {
     t += "\n  weights:";
     for (int k = 0; k < m.operators; ++k) t += fmt::format(" {:.3f}", m.weights[0][k]);
     t += " (every cable)\n";
+  }
+  if (s.history.searched) {
+    t += fmt::format("  where each cable last moved, as inputs: {} ({})\n", s.history.chosen ? "yes" : "no",
+                     s.history.reason);
   }
   if (s.noise_variance_floor > 0.0) {
     t += fmt::format("  noise variance kept at {:.4g} or more (normalised) for the float32 image's fidelity\n",
@@ -252,7 +269,7 @@ std::string cable_inputs_text(const TrainRun& run) {
   }
   if (run.cable_inputs != nullptr && (run.cable_inputs->searched || run.beyond_limit_rows > 0)) {
     t += fmt::format("  cable residuals as inputs: {} ({})\n",
-                     run.cable_inputs->encoding == model::InputEncoding::bend_vector_cable_fit ? "yes" : "no",
+                     model::takes_cable_residuals(run.cable_inputs->encoding) ? "yes" : "no",
                      run.cable_inputs->reason);
   }
   return t;

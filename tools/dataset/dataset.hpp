@@ -34,6 +34,10 @@ struct Dataset {
   Eigen::VectorXd time_s;
   std::vector<int> session_starts;
   bool has_time = false;
+  // Whether every session began with the homing move, as the format asks;
+  // false for a recording without it (cdcr train --no-homing): each session
+  // starts at power-up, the cables' state unknown, as the board's does.
+  bool sessions_homed = true;
   std::uint64_t content_hash = 0;              // 64-bit FNV-1a of the file's bytes
 
   int sample_count() const { return static_cast<int>(cables_mm.rows()); }

@@ -122,11 +122,14 @@ void check_parses(ImageBuffer& image, std::uint32_t size) {
   }
 }
 
-// The cable-fit encoding is 2.4's; the blocks' minor versions are older, so
-// it is put after them.
+// The cable-fit encoding is 2.4's, the history's 2.5; the blocks' minor
+// versions are older, so it is put after them.
 void put_encoding_version(ImageBuffer& image, model::InputEncoding encoding) {
-  if (!model::takes_cable_residuals(encoding)) return;
-  image.put_field(model::image_field::version_minor, model::kImageVersionMinorCableFit);
+  if (model::takes_history(encoding)) {
+    image.put_field(model::image_field::version_minor, model::kImageVersionMinorHistory);
+  } else if (model::takes_cable_residuals(encoding)) {
+    image.put_field(model::image_field::version_minor, model::kImageVersionMinorCableFit);
+  }
 }
 
 // The counts the image is laid out for, once the model has them consistently.

@@ -95,10 +95,12 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
     r.firmware.compensated = mean_errors(
         validation_set.measured,
         firmware_poses(parsed(image), validation_set.cables_mm, FirmwareAccumulator::float64,
-                       validation_set.payload_kg));
+                       validation_set.payload_kg, validation_set.history_inputs));
     if (searched.variance.rank() > 0) {
       r.validation_coverage =
-          check_coverage(validation_set.measured, firmware_estimates(parsed(image), validation_set.cables_mm, validation_set.payload_kg));
+          check_coverage(validation_set.measured,
+                         firmware_estimates(parsed(image), validation_set.cables_mm, validation_set.payload_kg,
+                                            validation_set.history_inputs));
     }
   }
 
@@ -131,7 +133,8 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
   const model::ImageView view = parsed(first_image);
   for (const FirmwareAccumulator accumulator :
        {FirmwareAccumulator::float64, FirmwareAccumulator::compensated_float32, FirmwareAccumulator::float32}) {
-    const std::vector<model::Pose<double>> float_poses = firmware_poses(view, fidelity_set.cables_mm, accumulator, fidelity_set.payload_kg);
+    const std::vector<model::Pose<double>> float_poses = firmware_poses(
+        view, fidelity_set.cables_mm, accumulator, fidelity_set.payload_kg, fidelity_set.history_inputs);
     const Fidelity f = compare_poses(double_poses, float_poses);
     r.fidelity_by_accumulator.emplace_back(accumulator, f);
     if (accumulator == FirmwareAccumulator::float32) continue;  // no firmware build sums this way
@@ -194,19 +197,29 @@ SequenceExport train_and_export_sequence(const dataset::Dataset& data, const std
                                          ? make_training_set(*validation_data, geometry, options.encoding, with_payload)
                                          : all.subset(validation_rows);
   out.identification = identify_hysteresis(data, train_rows, geometry, options, with_payload, search);
-  const model::HysteresisModel<double>& hysteresis = out.identification.model;
+  TrainingOptions sequence_options = options;
+  if (options.offer_history && out.identification.attempted) {
+    out.history =
+        choose_history_inputs(data, train_rows, out.identification.model, geometry, options, with_payload);
+  } else {
+    out.history.model = out.identification.model;
+    out.history.reason = options.offer_history ? "not offered: the hysteresis was not identified" : "not offered";
+  }
+  if (out.history.chosen) sequence_options.encoding = model::with_history(options.encoding, true);
+  const model::HysteresisModel<double>& hysteresis = out.history.model;
   if (hysteresis.empty()) {
     out.result = train_and_export(train_set, validation_set, all, geometry, options, dataset_hash, created_unix_s);
     if (out.identification.attempted) out.joints_only_validation = out.result.validation;
     return out;
   }
-  const TrainingSet effective_all = make_sequence_training_set(data, hysteresis, geometry, options.encoding, with_payload);
+  const TrainingSet effective_all =
+      make_sequence_training_set(data, hysteresis, geometry, sequence_options.encoding, with_payload);
   const TrainingSet effective_validation =
       validation_data != nullptr
-          ? make_sequence_training_set(*validation_data, hysteresis, geometry, options.encoding, with_payload)
+          ? make_sequence_training_set(*validation_data, hysteresis, geometry, sequence_options.encoding, with_payload)
           : effective_all.subset(validation_rows);
   out.result = train_and_export(effective_all.subset(train_rows), effective_validation, effective_all, geometry,
-                                options, dataset_hash, created_unix_s, hysteresis);
+                                sequence_options, dataset_hash, created_unix_s, hysteresis);
   // On the effective lengths the GP may explain the data down to a noise
   // variance ten thousand times below its signal's; its weights are then so
   // large that the image's float32 sums lose the target (0.07 mm on the
@@ -217,7 +230,7 @@ SequenceExport train_and_export_sequence(const dataset::Dataset& data, const std
   // has float32 sums good to about 0.001 deg whatever the weights), the
   // unraised model is kept: a raised floor would only have thrown its
   // accuracy away.
-  TrainingOptions raised = options;
+  TrainingOptions raised = sequence_options;
   ExportResult unraised;
   for (int attempt = 0; attempt < kNoiseFloorAttempts && !out.result.fidelity_met(); ++attempt) {
     if (attempt == 0) unraised = out.result;

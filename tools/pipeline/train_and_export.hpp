@@ -13,6 +13,7 @@
 #include "dataset/dataset.hpp"
 #include "train/compliance_identification.hpp"
 #include "train/evaluation.hpp"
+#include "train/history_inputs.hpp"
 #include "train/hysteresis_identification.hpp"
 #include "train/trainer.hpp"
 #include "train/training_set.hpp"
@@ -97,6 +98,9 @@ inline constexpr int kNoiseFloorAttempts = 4;
 struct SequenceExport {
   ExportResult result;
   HysteresisIdentification identification;
+  // Whether the GP takes where each cable last moved (searched when the
+  // identification ran and the options allow it).
+  HistoryChoice history;
   // The joints-only model of the same training rows on the validation rows
   // (samples 0 when there are none); its `initial` is the nominal model on
   // the commanded lengths.

@@ -68,10 +68,16 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
                                    "column), but the rows have no time");
   }
   Eigen::MatrixXf effective_mm(data.cables_mm.rows(), data.cables_mm.cols());
+  Eigen::MatrixXf history(data.cables_mm.rows(), data.cables_mm.cols());
   if (hysteresis.active()) {
-    const model::Status s = model::effective_lengths_over_sequence(
-        hysteresis.hysteresis_model(), runtime.geometry(), data.cables_mm, data.session_starts.data(),
-        static_cast<int>(data.session_starts.size()), effective_mm);
+    const int sessions = static_cast<int>(data.session_starts.size());
+    model::Status s = model::effective_lengths_over_sequence(hysteresis.hysteresis_model(), runtime.geometry(),
+                                                             data.cables_mm, data.session_starts.data(), sessions,
+                                                             effective_mm);
+    if (s == model::Status::ok && runtime.correction().takes_history()) {
+      s = model::history_inputs_over_sequence(hysteresis.hysteresis_model(), runtime.geometry(), data.cables_mm,
+                                              data.session_starts.data(), sessions, history);
+    }
     if (s != model::Status::ok) throw InputError(cables_path + ": hysteresis: " + model::to_string(s));
   }
   std::FILE* out = std::fopen(out_path.c_str(), "w");
@@ -84,6 +90,10 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
       std::fclose(out);
       throw InputError(cables_path + ": sample " + std::to_string(i + 1) + ": payload " +
                        std::to_string(data.payload_kg[i]) + " kg is beyond what the PAYLOAD frame carries");
+    }
+    if (runtime.correction().takes_history()) {
+      const fw::Cables row_history = history.row(i).transpose();
+      runtime.set_history_inputs(row_history.data());
     }
     fw::PoseEstimate estimate;
     if (const model::Status s = runtime.estimate_pose(cables, estimate); s != model::Status::ok) {

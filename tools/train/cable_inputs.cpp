@@ -7,20 +7,20 @@
 
 namespace cdcr::training {
 
-namespace {
-
-// The search's optimum on the trainer's search rows of `set`.
-double searched_likelihood(const TrainingSet& set, const TrainingOptions& options, int rows) {
+SearchResult search_on_rows(const TrainingSet& set, const TrainingOptions& options, int rows,
+                            const KernelHyperparameters* initial) {
   const Normalisation n = normalisation_of(set);
   const Eigen::MatrixXd x = normalise(set.inputs, n.input_mean, n.input_scale);
   const Eigen::MatrixXd y = normalise(set.error_twists, n.output_mean, n.output_scale);
   const auto [search_x, search_y] = random_rows(x, y, rows, options.search.seed);
-  return maximise_likelihood(search_x, search_y, default_initial_hyperparameters(static_cast<int>(x.cols())),
-                             options.search)
-      .log_marginal_likelihood;
+  const KernelHyperparameters start =
+      initial != nullptr ? *initial : default_initial_hyperparameters(static_cast<int>(x.cols()));
+  return maximise_likelihood(search_x, search_y, start, options.search);
 }
 
-}  // namespace
+double searched_log_likelihood(const TrainingSet& set, const TrainingOptions& options, int rows) {
+  return search_on_rows(set, options, rows, nullptr).log_marginal_likelihood;
+}
 
 CableInputChoice choose_cable_inputs(const TrainingSet& set, const TrainingOptions& options,
                                      bool beyond_limit_elsewhere) {
@@ -56,8 +56,8 @@ CableInputChoice choose_cable_inputs(const TrainingSet& set, const TrainingOptio
   c.search_rows = std::min(set.size(), std::max(2, options.sparse_search_rows));
   const TrainingSet with_residuals = with_encoding(set, model::InputEncoding::bend_vector_cable_fit);
   c.extra_parameters = options.search.isotropic ? 0 : static_cast<int>(set.cable_residuals.cols());
-  c.bend_only_log_likelihood = searched_likelihood(set, options, c.search_rows);
-  c.with_residuals_log_likelihood = searched_likelihood(with_residuals, options, c.search_rows);
+  c.bend_only_log_likelihood = searched_log_likelihood(set, options, c.search_rows);
+  c.with_residuals_log_likelihood = searched_log_likelihood(with_residuals, options, c.search_rows);
   const double gain = c.with_residuals_log_likelihood - c.bend_only_log_likelihood - c.extra_parameters;
   if (gain > 0.0) {
     c.encoding = model::InputEncoding::bend_vector_cable_fit;

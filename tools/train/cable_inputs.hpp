@@ -33,6 +33,14 @@ struct CableInputChoice {
   std::string reason;  // one line
 };
 
+// The hyperparameter search's optimum (log marginal likelihood, normalised
+// units) on `rows` of the set's rows drawn at random with the search's seed:
+// the same rows for two sets of the same size, whatever their inputs.
+double searched_log_likelihood(const TrainingSet& set, const TrainingOptions& options, int rows);
+// The same search from `initial` (null: the default start), whole.
+SearchResult search_on_rows(const TrainingSet& set, const TrainingOptions& options, int rows,
+                            const KernelHyperparameters* initial);
+
 // `set` holds the training rows in the bend-vector encoding; options as the
 // trainer's (the search, its rows and seed). beyond_limit_elsewhere: rows the
 // model must read that `set` does not hold (held-out ones) bend beyond the

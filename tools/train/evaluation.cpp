@@ -56,12 +56,17 @@ namespace {
 // accumulator: pose, radii and flags.
 template <typename Accumulator>
 std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
-                                             const Eigen::VectorXd& payload_kg) {
+                                             const Eigen::VectorXd& payload_kg,
+                                             const Eigen::MatrixXd& history_inputs) {
   if (image.extra_inputs > 0 && payload_kg.size() == 0) {
     throw std::invalid_argument("the model takes a payload input and the data have no payload_kg column");
   }
   if (image.extra_inputs > 0 && payload_kg.size() != cables_mm.rows()) {
     throw std::invalid_argument("one payload per sample is needed");
+  }
+  if (model::takes_history(image.encoding) &&
+      (history_inputs.rows() != cables_mm.rows() || history_inputs.cols() != cables_mm.cols())) {
+    throw std::invalid_argument("the model takes the cables' history and the rows have none");
   }
   firmware::Geometry geometry;
   if (const model::Status s = model::geometry_from_image(image, geometry); s != model::Status::ok) {
@@ -82,6 +87,10 @@ std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, cons
   for (Eigen::Index i = 0; i < cables_mm.rows(); ++i) {
     const firmware::Cables cables = cables_mm.row(i).transpose().cast<float>();
     if (image.extra_inputs > 0) correction.set_payload_kg(static_cast<float>(payload_kg[i]));
+    if (correction.takes_history()) {
+      const firmware::Cables history = history_inputs.row(i).transpose().cast<float>();
+      correction.set_history_inputs(history.data());
+    }
     firmware::PoseEstimate estimate;
     if (const model::Status s =
             firmware::estimate_compensated_pose(geometry, correction, uncertainty, compliance, cables, estimate);
@@ -96,25 +105,27 @@ std::vector<FirmwareEstimate> estimates_with(const model::ImageView& image, cons
 
 template <typename Accumulator>
 std::vector<model::Pose<double>> firmware_poses_with(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
-                                                     const Eigen::VectorXd& payload_kg) {
+                                                     const Eigen::VectorXd& payload_kg,
+                                             const Eigen::MatrixXd& history_inputs) {
   std::vector<model::Pose<double>> poses;
-  for (const FirmwareEstimate& e : estimates_with<Accumulator>(image, cables_mm, payload_kg)) poses.push_back(e.pose);
+  for (const FirmwareEstimate& e : estimates_with<Accumulator>(image, cables_mm, payload_kg, history_inputs)) poses.push_back(e.pose);
   return poses;
 }
 
 }  // namespace
 
 std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
-                                                FirmwareAccumulator accumulator, const Eigen::VectorXd& payload_kg) {
+                                                FirmwareAccumulator accumulator, const Eigen::VectorXd& payload_kg,
+                                                const Eigen::MatrixXd& history_inputs) {
   switch (accumulator) {
     case FirmwareAccumulator::compensated_float32:
-      return firmware_poses_with<model::CompensatedFloat>(image, cables_mm, payload_kg);
+      return firmware_poses_with<model::CompensatedFloat>(image, cables_mm, payload_kg, history_inputs);
     case FirmwareAccumulator::float32:
-      return firmware_poses_with<float>(image, cables_mm, payload_kg);
+      return firmware_poses_with<float>(image, cables_mm, payload_kg, history_inputs);
     case FirmwareAccumulator::float64:
       break;
   }
-  return firmware_poses_with<double>(image, cables_mm, payload_kg);
+  return firmware_poses_with<double>(image, cables_mm, payload_kg, history_inputs);
 }
 
 FirmwareEstimate firmware_estimate(const model::Pose<float>& pose, const model::PoseUncertainty<float>& radii) {
@@ -129,8 +140,9 @@ FirmwareEstimate firmware_estimate(const model::Pose<float>& pose, const model::
 }
 
 std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
-                                                const Eigen::VectorXd& payload_kg) {
-  return estimates_with<double>(image, cables_mm, payload_kg);
+                                                const Eigen::VectorXd& payload_kg,
+                                             const Eigen::MatrixXd& history_inputs) {
+  return estimates_with<double>(image, cables_mm, payload_kg, history_inputs);
 }
 
 CoverageCheck check_coverage(const std::vector<model::Pose<double>>& measured,

@@ -48,9 +48,12 @@ const char* to_string(FirmwareAccumulator accumulator);
 // the sample as the runtime sets a received one (throws
 // std::invalid_argument when there are none); other images ignore them. An
 // image with a compliance block sags the nominal pose under that payload.
+// An image with a history encoding takes each sample's history_inputs row
+// (where each cable last moved) the same way.
 std::vector<model::Pose<double>> firmware_poses(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
                                                 FirmwareAccumulator accumulator = FirmwareAccumulator::float64,
-                                                const Eigen::VectorXd& payload_kg = {});
+                                                const Eigen::VectorXd& payload_kg = {},
+                                                const Eigen::MatrixXd& history_inputs = {});
 
 // How far one path's poses lie from another's: the mean and largest position
 // and orientation differences.
@@ -65,7 +68,8 @@ struct FirmwareEstimate {
 // The board's float32 pose and radii, widened to double.
 FirmwareEstimate firmware_estimate(const model::Pose<float>& pose, const model::PoseUncertainty<float>& radii);
 std::vector<FirmwareEstimate> firmware_estimates(const model::ImageView& image, const Eigen::MatrixXd& cables_mm,
-                                                const Eigen::VectorXd& payload_kg = {});
+                                                const Eigen::VectorXd& payload_kg = {},
+                                                const Eigen::MatrixXd& history_inputs = {});
 
 // How well the radii describe measured poses: the share of samples whose
 // measured position lies within r95_mm of the compensated one (and the

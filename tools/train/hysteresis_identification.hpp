@@ -26,24 +26,29 @@
 
 #include "cdcr/model/geometry.hpp"
 #include "cdcr/model/hysteresis.hpp"
+#include "cdcr/model/hysteresis_sequence.hpp"
 #include "dataset/dataset.hpp"
 #include "trainer.hpp"
 
 namespace cdcr::training {
 
 // The effective cable lengths of every row of a sequence: each session
-// starts at home after the homing move (model::start_at_home), then the
-// state follows the commanded rows one by one. Throws std::invalid_argument
+// starts at home after the homing move (model::start_at_home), or at
+// power-up with the state unknown, then the state follows the commanded
+// rows one by one. Throws std::invalid_argument
 // for session starts that do not begin at row 0 or do not increase. An empty
 // model returns the commanded lengths.
 Eigen::MatrixXd effective_cables(const Eigen::MatrixXd& commanded_mm, const std::vector<int>& session_starts,
                                  const model::HysteresisModel<double>& hysteresis,
-                                 const model::RobotGeometry<double>& geometry);
+                                 const model::RobotGeometry<double>& geometry,
+                                 model::SessionStart start = model::SessionStart::homed);
 
 // The training set of a sequence with the hysteresis applied: bends, nominal
 // poses and error twists from the effective lengths of every row (the state
 // runs over all rows, so any subset of it is a valid split), and the
 // commanded lengths kept in commanded_mm. cables_mm holds the effective ones.
+// A history encoding adds where each cable last moved, from the model's last
+// operator (history_inputs).
 TrainingSet make_sequence_training_set(const dataset::Dataset& data, const model::HysteresisModel<double>& hysteresis,
                                        const model::RobotGeometry<double>& geometry, model::InputEncoding encoding,
                                        bool with_payload = true);

@@ -188,15 +188,19 @@ namespace {
 // The model's inputs for these rows: the cable residuals and the payload
 // only if the model takes them.
 Eigen::MatrixXd inputs_for(const TrainedModel& model, const Eigen::MatrixXd& bends,
-                           const Eigen::MatrixXd& cable_residuals, const Eigen::VectorXd& payload_kg) {
+                           const Eigen::MatrixXd& cable_residuals, const Eigen::MatrixXd& history_inputs,
+                           const Eigen::VectorXd& payload_kg) {
   if (model.has_payload_input() && payload_kg.size() == 0) {
     throw std::invalid_argument("the model takes a payload input and the rows have none");
   }
   if (model::takes_cable_residuals(model.encoding) && cable_residuals.rows() != bends.rows()) {
     throw std::invalid_argument("the model takes the cables' residuals and the rows have none");
   }
-  return model_inputs(bends, cable_residuals, model.has_payload_input() ? payload_kg : Eigen::VectorXd(),
-                      model.encoding);
+  if (model::takes_history(model.encoding) && history_inputs.rows() != bends.rows()) {
+    throw std::invalid_argument("the model takes the cables' history and the rows have none");
+  }
+  return model_inputs(bends, cable_residuals, history_inputs,
+                      model.has_payload_input() ? payload_kg : Eigen::VectorXd(), model.encoding);
 }
 
 Eigen::MatrixXd predict_at(const TrainedModel& model, const Eigen::MatrixXd& inputs) {
@@ -216,11 +220,12 @@ Eigen::MatrixXd predict_at(const TrainedModel& model, const Eigen::MatrixXd& inp
 
 Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const Eigen::MatrixXd& bends,
                                      const Eigen::VectorXd& payload_kg) {
-  return predict_at(model, inputs_for(model, bends, Eigen::MatrixXd(), payload_kg));
+  return predict_at(model, inputs_for(model, bends, Eigen::MatrixXd(), Eigen::MatrixXd(), payload_kg));
 }
 
 Eigen::MatrixXd predict_error_twists(const TrainedModel& model, const TrainingSet& rows) {
-  return predict_at(model, inputs_for(model, rows.bends, rows.cable_residuals, rows.payload_kg));
+  return predict_at(model,
+                    inputs_for(model, rows.bends, rows.cable_residuals, rows.history_inputs, rows.payload_kg));
 }
 
 Compensator fit_compensator(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
@@ -247,7 +252,8 @@ Compensator fit_compensator(const TrainingSet& set, const model::RobotGeometry<d
 Eigen::MatrixXd Compensator::predict(const TrainingSet& rows) const {
   if (sharing == HyperparameterSharing::shared) return predict_error_twists(shared, rows);
   const Eigen::MatrixXd x =
-      normalise(inputs_for(shared, rows.bends, rows.cable_residuals, rows.payload_kg), shared.input_mean,
+      normalise(inputs_for(shared, rows.bends, rows.cable_residuals, rows.history_inputs, rows.payload_kg),
+                shared.input_mean,
                 shared.input_scale);
   Eigen::MatrixXd y(x.rows(), 6);
   for (int k = 0; k < 6; ++k) y.col(k) = per_output[k].predict(x);

@@ -41,6 +41,9 @@ struct TrainingOptions {
   // Points of the predictive-variance factor the image carries (0: none);
   // see predictive_variance.hpp.
   int variance_rank = 64;
+  // A sequence's model may take where each cable last moved, where the
+  // evidence says so (history_inputs.hpp); false keeps it out.
+  bool offer_history = true;
 };
 
 struct TrainingReport {

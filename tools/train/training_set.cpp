@@ -21,6 +21,8 @@ TrainingSet TrainingSet::subset(const std::vector<int>& rows) const {
   if (has_commanded) s.commanded_mm.resize(n, commanded_mm.cols());
   s.bends.resize(n, bends.cols());
   s.cable_residuals.resize(n, cable_residuals.cols());
+  const bool has_history = history_inputs.rows() > 0;
+  if (has_history) s.history_inputs.resize(n, history_inputs.cols());
   s.inputs.resize(n, inputs.cols());
   if (has_payload()) s.payload_kg.resize(n);
   s.error_twists.resize(n, 6);
@@ -29,6 +31,7 @@ TrainingSet TrainingSet::subset(const std::vector<int>& rows) const {
     if (has_commanded) s.commanded_mm.row(i) = commanded_mm.row(rows[i]);
     s.bends.row(i) = bends.row(rows[i]);
     s.cable_residuals.row(i) = cable_residuals.row(rows[i]);
+    if (has_history) s.history_inputs.row(i) = history_inputs.row(rows[i]);
     s.inputs.row(i) = inputs.row(rows[i]);
     if (has_payload()) s.payload_kg[i] = payload_kg[rows[i]];
     s.error_twists.row(i) = error_twists.row(rows[i]);
@@ -50,18 +53,26 @@ Eigen::MatrixXd encode_rows(const Eigen::MatrixXd& bends, model::InputEncoding e
 }
 
 Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::MatrixXd& cable_residuals,
-                             const Eigen::VectorXd& payload_kg, model::InputEncoding encoding) {
+                             const Eigen::MatrixXd& history_inputs, const Eigen::VectorXd& payload_kg,
+                             model::InputEncoding encoding) {
   const bool with_residuals = model::takes_cable_residuals(encoding);
   if (with_residuals && (cable_residuals.rows() != bends.rows() || cable_residuals.cols() != bends.cols())) {
     throw std::invalid_argument("the cable-fit encoding needs the cables' residuals of every row");
+  }
+  const bool with_history = model::takes_history(encoding);
+  const Eigen::Index history_cols = with_history ? model::kHistoryInputsPerSegment * (bends.cols() / 2) : 0;
+  if (with_history && (history_inputs.rows() != bends.rows() || history_inputs.cols() != history_cols)) {
+    throw std::invalid_argument("a history encoding needs where every cable of every row last moved");
   }
   if (payload_kg.size() != 0 && payload_kg.size() != bends.rows()) {
     throw std::invalid_argument("one payload per row is needed");
   }
   const Eigen::Index residual_cols = with_residuals ? cable_residuals.cols() : 0;
-  Eigen::MatrixXd inputs(bends.rows(), bends.cols() + residual_cols + (payload_kg.size() > 0 ? 1 : 0));
+  Eigen::MatrixXd inputs(bends.rows(),
+                         bends.cols() + residual_cols + history_cols + (payload_kg.size() > 0 ? 1 : 0));
   inputs.leftCols(bends.cols()) = encode_rows(bends, encoding);
   if (with_residuals) inputs.middleCols(bends.cols(), residual_cols) = cable_residuals;
+  if (with_history) inputs.middleCols(bends.cols() + residual_cols, history_cols) = history_inputs;
   if (payload_kg.size() > 0) inputs.rightCols(1) = payload_kg;
   return inputs;
 }
@@ -69,7 +80,7 @@ Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::MatrixXd
 TrainingSet with_encoding(const TrainingSet& set, model::InputEncoding encoding) {
   TrainingSet s = set;
   s.encoding = encoding;
-  s.inputs = model_inputs(s.bends, s.cable_residuals, s.payload_kg, encoding);
+  s.inputs = model_inputs(s.bends, s.cable_residuals, s.history_inputs, s.payload_kg, encoding);
   return s;
 }
 
@@ -82,8 +93,12 @@ TrainingSet with_float_cables(const TrainingSet& set, const model::RobotGeometry
   rows.has_poses = true;
   rows.payload_kg = set.payload_kg;
   rows.has_payload = set.has_payload();
-  TrainingSet rounded = make_training_set(rows, geometry, encoding);
+  TrainingSet rounded = make_training_set(rows, geometry, model::with_history(encoding, false));
   rounded.commanded_mm = set.commanded_mm;
+  if (model::takes_history(encoding)) {
+    rounded.history_inputs = set.history_inputs;
+    rounded = with_encoding(rounded, encoding);
+  }
   return rounded;
 }
 
@@ -123,7 +138,11 @@ TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGe
     s.measured.push_back(data.poses[i]);
   }
   if (data.has_payload && with_payload) s.payload_kg = data.payload_kg;
-  s.inputs = model_inputs(s.bends, s.cable_residuals, s.payload_kg, encoding);
+  // The history is a sequence's state (make_sequence_training_set).
+  if (model::takes_history(encoding)) {
+    throw std::invalid_argument("the history inputs need a sequence and its hysteresis state");
+  }
+  s.inputs = model_inputs(s.bends, s.cable_residuals, Eigen::MatrixXd(), s.payload_kg, encoding);
   s.encoding = encoding;
   return s;
 }

@@ -24,6 +24,9 @@ struct TrainingSet {
   Eigen::MatrixXd commanded_mm;
   Eigen::MatrixXd bends;         // samples x 2n, stacked bend vectors
   Eigen::MatrixXd cable_residuals;  // samples x 2n, the cable fit's [common mode, pair imbalance] per segment
+  // A sequence whose model keeps the cables' history: samples x 4n, where
+  // each cable last moved (model::history_inputs); empty otherwise.
+  Eigen::MatrixXd history_inputs;
   Eigen::VectorXd payload_kg;    // samples, or empty: the data carried no payload column
   Eigen::MatrixXd inputs;        // samples x D, encoded (and the payload last, when there is one)
   model::InputEncoding encoding = model::InputEncoding::bend_vector;  // of `inputs`
@@ -63,11 +66,12 @@ TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGe
 // Encoded GP inputs for stacked bend vectors (rows).
 Eigen::MatrixXd encode_rows(const Eigen::MatrixXd& bends, model::InputEncoding encoding);
 
-// The GP inputs: the encoded bends, the cable residuals when the encoding
-// takes them, then the payload column when payload_kg is not empty (one
-// value per row).
+// The GP inputs: the encoded bends, the cable residuals and the history
+// when the encoding takes them, then the payload column when payload_kg is
+// not empty (one value per row).
 Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::MatrixXd& cable_residuals,
-                             const Eigen::VectorXd& payload_kg, model::InputEncoding encoding);
+                             const Eigen::MatrixXd& history_inputs, const Eigen::VectorXd& payload_kg,
+                             model::InputEncoding encoding);
 
 // The same rows with their cable lengths rounded to float32, as the board
 // reads them: the bends, residuals, nominal poses and error twists of those
@@ -75,7 +79,8 @@ Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::MatrixXd
 TrainingSet with_float_cables(const TrainingSet& set, const model::RobotGeometry<double>& geometry,
                               model::InputEncoding encoding);
 
-// The same rows with their inputs in another encoding.
+// The same rows with their inputs in another encoding (a history encoding
+// needs the rows' history_inputs).
 TrainingSet with_encoding(const TrainingSet& set, model::InputEncoding encoding);
 
 }  // namespace cdcr::training

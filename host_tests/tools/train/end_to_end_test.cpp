@@ -597,6 +597,10 @@ TEST(TrainEndToEnd, RowsWithoutTimeTrainTheJointsOnlyModel) {
   const CliRun flagged = run_cdcr("train --data " + train + " --out " + image + " --restarts 0 --no-hysteresis");
   ASSERT_EQ(flagged.exit_code, 0) << flagged.err;
   EXPECT_EQ(flagged.out.find("hysteresis"), std::string::npos) << flagged.out;
+  // Independent samples have no sessions to start without the homing move.
+  const CliRun no_homing = run_cdcr("train --data " + train + " --out " + image + " --restarts 0 --no-homing");
+  EXPECT_NE(no_homing.exit_code, 0);
+  EXPECT_NE(no_homing.err.find("--no-homing applies to a motion sequence"), std::string::npos) << no_homing.err;
 }
 
 // A sequence from the simulator with cable friction: cdcr train identifies

@@ -35,6 +35,31 @@ TEST(EffectiveCables, EverySessionStartsAtHomeAndTheStateRunsOverEveryRow) {
   EXPECT_EQ(effective_cables(s.data.cables_mm, s.data.session_starts, {}, geometry), s.data.cables_mm);
 }
 
+// A recording without the homing move: each session starts at power-up, the
+// lags anywhere within their widths (their midpoint 0: the first row's
+// effective lengths are its commanded ones), and once every cable has moved
+// twice its width one way the state is the homed run's, bit for bit.
+TEST(EffectiveCables, APowerUpSessionStartsUnknownAndBecomesTheHomedOne) {
+  const auto geometry = test::two_segment_geometry();
+  const auto hysteresis = test::known_hysteresis(geometry);
+  const test::SyntheticSequence s = test::synthetic_sequence(geometry, hysteresis, {120, 80}, 3);
+  const Eigen::MatrixXd homed = effective_cables(s.data.cables_mm, s.data.session_starts, hysteresis, geometry);
+  const Eigen::MatrixXd power_up = effective_cables(s.data.cables_mm, s.data.session_starts, hysteresis, geometry,
+                                                    model::SessionStart::power_up);
+  for (const int first : {0, 120}) {
+    EXPECT_EQ(power_up.row(first), s.data.cables_mm.row(first)) << "session at " << first;
+    EXPECT_GT((power_up.row(first) - homed.row(first)).cwiseAbs().maxCoeff(), 0.1);
+  }
+  // Every cable has closed its interval by the end of each session.
+  EXPECT_EQ(power_up.row(119), homed.row(119));
+  EXPECT_EQ(power_up.row(199), homed.row(199));
+  // The training set of a recording without the homing move reads it so.
+  dataset::Dataset data = s.data;
+  data.sessions_homed = false;
+  const TrainingSet set = make_sequence_training_set(data, hysteresis, geometry, model::InputEncoding::bend_vector);
+  EXPECT_EQ(set.cables_mm, power_up);
+}
+
 TEST(EffectiveCables, BadSessionStartsAreRefused) {
   const auto geometry = test::two_segment_geometry();
   const auto hysteresis = test::known_hysteresis(geometry);

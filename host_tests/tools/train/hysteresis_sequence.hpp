@@ -45,10 +45,13 @@ struct SyntheticSequence {
 
 // `session_rows`: the rows of each session; every session starts at home.
 // An empty hysteresis model records the commanded lengths' poses.
+// last_move_effect_mm: friction that is no lag of a length, a tip offset
+// along z of that size times the direction of cable 1's last move (+1
+// longer, -1 shorter, 0 before it has moved in the session).
 inline SyntheticSequence synthetic_sequence(const model::RobotGeometry<double>& geometry,
                                             const model::HysteresisModel<double>& hysteresis,
                                             const std::vector<int>& session_rows, unsigned seed,
-                                            double position_noise_mm = 0.05) {
+                                            double position_noise_mm = 0.05, double last_move_effect_mm = 0.0) {
   const int n = geometry.segment_count;
   int rows = 0;
   for (const int r : session_rows) rows += r;
@@ -69,6 +72,7 @@ inline SyntheticSequence synthetic_sequence(const model::RobotGeometry<double>& 
     d.session_starts.push_back(row);
     if (!hysteresis.empty()) model::start_at_home(state, hysteresis, geometry);
     Eigen::VectorXd bend = Eigen::VectorXd::Zero(2 * n);
+    double last_move = 0.0;
     for (int i = 0; i < count; ++i, ++row) {
       // A step of log-uniform size between 0.002 and 0.25 rad of bend.
       const double size = 0.002 * std::pow(125.0, unit(rng));
@@ -82,6 +86,7 @@ inline SyntheticSequence synthetic_sequence(const model::RobotGeometry<double>& 
       model::CableVector<double> cables;
       model::cables_from_joints(model::JointVector<double>(model::joints_from_bend(bend)), geometry, cables);
       d.cables_mm.row(row) = cables.transpose();
+      if (i > 0 && cables[0] != d.cables_mm(row - 1, 0)) last_move = cables[0] > d.cables_mm(row - 1, 0) ? 1.0 : -1.0;
       d.time_s[row] = 0.5 * row;
       model::CableVector<double> effective = cables;
       if (!hysteresis.empty()) {
@@ -98,6 +103,7 @@ inline SyntheticSequence synthetic_sequence(const model::RobotGeometry<double>& 
       error << 3.0 * std::sin(2.0 * b[0]) + 1.5 * b[3], 2.0 * std::cos(1.5 * b[1]) - 2.0, 2.5 * b[0] * b[2],
           0.01 * std::sin(b[2]), 0.008 * b[1], 0.012 * std::cos(b[3]) - 0.012;
       model::Pose<double> measured = model::compensate(error, nominal);
+      measured.position_mm.z() += last_move_effect_mm * last_move;
       for (int j = 0; j < 3; ++j) measured.position_mm[j] += position_noise_mm * gauss(rng);
       d.poses.push_back(measured);
     }

@@ -10,6 +10,10 @@
 // one direction, or at once with a HOMING frame (the robot has just ended
 // the homing move: model::start_at_home). While it is unknown the effective
 // lengths carry an error of up to +-u per cable (model::effective_lengths).
+// A model with the history inputs (input_encoding.hpp) reads where each
+// cable last moved from the block's last operator: 0 while unknown, the
+// correction's own value for "nothing known".
+//
 // A segment bends with the differences of opposite cables (l3 - l1,
 // l2 - l4), whose errors are then bounded by u_1 + u_3 and u_2 + u_4; each
 // is given the largest variance its bound allows, (u_a + u_b)^2: a lag that
@@ -47,6 +51,12 @@ class HysteresisTracker {
   const Cables& track(const Cables& commanded_mm);
   // The robot has just completed the homing move and is at home.
   void homed(const Geometry& geometry);
+
+  // Where each cable last moved (model::history_inputs), held by a
+  // correction with the history inputs for the evaluations that follow (the
+  // forward path's and IK's); a correction without them, or a tracker
+  // without a block, leaves it as it is.
+  void hold_history(Correction& correction) const;
 
   // IK's setpoints: the commanded lengths that bring each cable's effective
   // length to `cables_mm` (in place), moving in a straight line from the

@@ -93,6 +93,10 @@ class Runtime {
   Scalar payload_kg() const { return payload_kg_; }
   bool payload_received() const { return payload_received_; }
 
+  // Where each cable last moved, for an image with the history inputs: the
+  // next estimates use it. run_cycle holds the tracker's own after every
+  // complete cable set; a replay of recorded rows sets each row's.
+  void set_history_inputs(const Scalar* history) { model_.correction.set_history_inputs(history); }
   // The forward path run_cycle applies to the latest cable set (kinematics.hpp).
   model::Status estimate_pose(const Cables& cables_mm, PoseEstimate& estimate) const {
     return firmware::estimate_pose(model_, cables_mm, estimate);

@@ -40,6 +40,9 @@ inline constexpr std::uint16_t kImageVersionMinorCompliance = 3;
 // 2.4: the bend-vector-cable-fit input encoding (the cables' residuals as
 // inputs, input_encoding.hpp). Written only for a model that takes them.
 inline constexpr std::uint16_t kImageVersionMinorCableFit = 4;
+// 2.5: the history input encodings (where each cable last moved, from the
+// hysteresis block's last operator). Written only for a model that takes them.
+inline constexpr std::uint16_t kImageVersionMinorHistory = 5;
 inline constexpr std::uint16_t kImageOldestVersionMajor = 1;  // still read: deployed boards carry v1 images
 inline constexpr std::uint32_t kImageHeaderSize = 64;
 inline constexpr std::uint32_t kImageBlockAlignment = 8;
@@ -674,7 +677,8 @@ inline bool is_positive(float value) { return value > 0.0f; }
 // check_hysteresis makes), homing lags within +-width. A failure per bad
 // value, or one pass for the block. False where a stopping run must stop.
 template <typename Run>
-bool check_hysteresis_block(Run& run, const float* block, std::uint32_t cables, std::uint32_t operators) {
+bool check_hysteresis_block(Run& run, const float* block, std::uint32_t cables, std::uint32_t operators,
+                            bool history) {
   using Expect = ImageExpectation;
   const std::uint32_t count = cables * operators;
   const float* widths = block + image_hysteresis_field::widths;
@@ -699,8 +703,12 @@ bool check_hysteresis_block(Run& run, const float* block, std::uint32_t cables, 
       const bool width_finite = std::isfinite(width);
       const bool weight_finite = std::isfinite(weight);
       const bool lag_finite = std::isfinite(lag);
+      // The history inputs divide the last operator's lag by its width.
+      const bool history_operator = history && k + 1 == operators;
       if (!expect(width_finite, "hysteresis_width", i, width, 0, Expect::finite) ||
           !expect(!width_finite || width >= 0.0f, "hysteresis_width", i, width, 0, Expect::at_least) ||
+          !expect(!width_finite || !history_operator || width > 0.0f, "hysteresis_history_width", i, width, 0,
+                  Expect::positive) ||
           !expect(!width_finite || width <= max_width, "hysteresis_width", i, width, max_width, Expect::at_most) ||
           !expect(weight_finite, "hysteresis_weight", i, weight, 0, Expect::finite) ||
           !expect(!weight_finite || weight >= 0.0f, "hysteresis_weight", i, weight, 0, Expect::at_least) ||
@@ -1061,10 +1069,14 @@ bool check_kind(Run& run, const std::uint8_t* bytes, DeclaredImage& h) {
     return false;
   }
   h.encoding = static_cast<InputEncoding>(encoding);
-  // The cable-fit encoding is v2.4's: an older image cannot declare it.
-  if (takes_cable_residuals(h.encoding) &&
-      !run.expect(!h.v1 && h.minor >= kImageVersionMinorCableFit, ImageCheckId::kind, ImageStatus::unsupported_kind,
-                  "version_minor", -1, h.minor, kImageVersionMinorCableFit, Expect::at_least)) {
+  // The cable-fit encoding is v2.4's, the history's v2.5: an older image
+  // cannot declare them.
+  const std::uint32_t encoding_minor = takes_history(h.encoding)           ? kImageVersionMinorHistory
+                                       : takes_cable_residuals(h.encoding) ? kImageVersionMinorCableFit
+                                                                           : 0;
+  if (encoding_minor > 0 &&
+      !run.expect(!h.v1 && h.minor >= encoding_minor, ImageCheckId::kind, ImageStatus::unsupported_kind,
+                  "version_minor", -1, h.minor, encoding_minor, Expect::at_least)) {
     return false;
   }
   const std::uint8_t declared_kind = bytes[image_field::model_kind.offset];
@@ -1112,7 +1124,11 @@ bool check_hysteresis_counts(Run& run, const std::uint8_t* bytes, DeclaredImage&
   h.hysteresis_operators = h.value(bytes, image_field::hysteresis_operators);
   const std::uint32_t cables = h.hysteresis_cables;
   const std::uint32_t operators = h.hysteresis_operators;
-  if (cables == 0 && operators == 0) return true;
+  // The history inputs come from the block's state.
+  if (cables == 0 && operators == 0) {
+    return run.expect(!takes_history(h.encoding), ImageCheckId::header, ImageStatus::bad_header,
+                      "history_without_hysteresis", -1, cables, 4 * h.segments, Expect::equal);
+  }
   return run.expect(cables == 4 * h.segments, ImageCheckId::header, ImageStatus::bad_header, "hysteresis_cables", -1,
                     cables, 4 * h.segments, Expect::equal) &&
          run.expect(operators >= 1, ImageCheckId::header, ImageStatus::bad_header, "hysteresis_operators", -1,
@@ -1148,9 +1164,10 @@ bool check_capacity(Run& run, const DeclaredImage& h, const ImageCapacity& capac
                     "variance_rank", -1, h.rank, capacity.max_variance_rank, Expect::at_most) &&
          run.expect(h.extra <= capacity.max_extra_inputs, ImageCheckId::capacity, ImageStatus::over_capacity,
                     "extra_inputs", -1, h.extra, capacity.max_extra_inputs, Expect::at_most) &&
-         // The cable-fit encoding's inputs share the storage of a robot of
-         // the most segments: 4n + E must fit where 2n + E always does.
-         (!takes_cable_residuals(h.encoding) ||
+         // The cable-fit and history encodings' inputs share the storage of
+         // a robot of the most segments: 4n + E (8n + E, ...) must fit where
+         // 2n + E always does.
+         (encoded_inputs(h) <= 2 * h.segments ||
           run.expect(h.input_dims <= 2 * capacity.max_segments + capacity.max_extra_inputs, ImageCheckId::capacity,
                      ImageStatus::over_capacity, "input_dims", -1, h.input_dims,
                      2 * capacity.max_segments + capacity.max_extra_inputs, Expect::at_most));
@@ -1399,7 +1416,8 @@ bool check_optional_blocks(Run& run, const ImageBlocks& b, const DeclaredImage& 
                h.hysteresis_operators, 0, ImageExpectation::at_least);
   }
   if (b.hysteresis != nullptr &&
-      !check_hysteresis_block(run, b.hysteresis, h.hysteresis_cables, h.hysteresis_operators)) {
+      !check_hysteresis_block(run, b.hysteresis, h.hysteresis_cables, h.hysteresis_operators,
+                              takes_history(h.encoding))) {
     return false;
   }
   if (b.compliance == nullptr && Run::kEveryCheck) {

@@ -29,7 +29,9 @@
 // bend pairs (cable_fit.hpp): the forward path passes the measured ones with
 // the bend; IK's evaluations use those set_cable_residuals() held (the last
 // measured: IK moves the bend, not what the cables do beyond it). The bend
-// vector stays the only variable: the gradient is d(eps)/d(bend).
+// vector stays the only variable: the gradient is d(eps)/d(bend). An image
+// with a history encoding takes where each cable last moved after the
+// residuals, held like the payload (set_history_inputs).
 
 #include <array>
 #include <cmath>
@@ -134,13 +136,16 @@ class GpCorrection {
     input_dims_ = image.input_dims;
     bend_dims_ = 2 * image.segment_count;
     residual_dims_ = model::takes_cable_residuals(image.encoding) ? kCableResidualsPerSegment * image.segment_count : 0;
+    history_dims_ = model::takes_history(image.encoding) ? kHistoryInputsPerSegment * image.segment_count : 0;
     extra_inputs_ = image.extra_inputs;
-    held_inputs_ = residual_dims_ + extra_inputs_;
+    held_inputs_ = residual_dims_ + history_dims_ + extra_inputs_;
     if (bend_dims_ + held_inputs_ != input_dims_ || extra_inputs_ > kMaxExtraInputs || input_dims_ > kMaxInputs) {
       return Status::correction_failed;
     }
-    for (int e = 0; e < residual_dims_; ++e) held_[e] = S(0);
-    for (int e = 0; e < extra_inputs_; ++e) held_[residual_dims_ + e] = S(image.extra_input_default[e]);
+    // Residuals and history zero (consistent cables; nothing known of the
+    // history) until set.
+    for (int e = 0; e < residual_dims_ + history_dims_; ++e) held_[e] = S(0);
+    for (int e = 0; e < extra_inputs_; ++e) held_[payload_index() + e] = S(image.extra_input_default[e]);
     // A model with held inputs may take the run-time loop, which costs more
     // per point; its work is counted at that price.
     mean_point_units_ = held_inputs_ > 0 ? Arch::kWorkCosts.run_time_loop_point : 1;
@@ -164,11 +169,11 @@ class GpCorrection {
   int bend_dims() const { return bend_dims_; }
   bool has_payload_input() const { return extra_inputs_ > 0; }
   // The payload the next evaluations use (0 for a model without the input).
-  S payload_kg() const { return extra_inputs_ > 0 ? held_[residual_dims_] : S(0); }
+  S payload_kg() const { return extra_inputs_ > 0 ? held_[payload_index()] : S(0); }
   // Range checks are the caller's (the runtime's); a model without a payload
   // input ignores it.
   void set_payload_kg(S payload_kg) {
-    if (extra_inputs_ > 0) held_[residual_dims_] = payload_kg;
+    if (extra_inputs_ > 0) held_[payload_index()] = payload_kg;
   }
   bool takes_cable_residuals() const { return residual_dims_ > 0; }
   // The residuals IK's evaluations use (zero until set); a model without
@@ -176,6 +181,14 @@ class GpCorrection {
   void set_cable_residuals(const CableResiduals<S, MaxSegments>& residuals) {
     if (residual_dims_ == 0 || residuals.size() != residual_dims_) return;
     for (int e = 0; e < residual_dims_; ++e) held_[e] = residuals[e];
+  }
+  bool takes_history() const { return history_dims_ > 0; }
+  int history_dims() const { return history_dims_; }
+  // Where each cable last moved (hysteresis.hpp, history_inputs; zero until
+  // set), for every evaluation that begins after the set: the forward path's
+  // and IK's alike. A model without the inputs ignores them.
+  void set_history_inputs(const S* history) {
+    for (int e = 0; e < history_dims_; ++e) held_[residual_dims_ + e] = history[e];
   }
   InputEncoding encoding() const { return encoding_; }
 
@@ -489,13 +502,15 @@ class GpCorrection {
   int input_dims_ = 0;
   int bend_dims_ = 0;
   int residual_dims_ = 0;
+  int history_dims_ = 0;
   int extra_inputs_ = 0;
   int held_inputs_ = 0;
   std::uint32_t mean_point_units_ = 1;
   std::uint32_t gradient_point_units_ = kGradientPointUnits;
   std::uint32_t gradient_granule_ = kChunkPoints;
-  // The cable residuals, then the payload.
+  // The cable residuals, the history, then the payload.
   S held_[kMaxInputs] = {};
+  int payload_index() const { return residual_dims_ + history_dims_; }
   InputEncoding encoding_ = InputEncoding::bend_vector;
   std::array<S, kMaxInputs> input_mean_{};
   std::array<S, kMaxInputs> input_gain_{};

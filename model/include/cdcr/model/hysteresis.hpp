@@ -199,6 +199,22 @@ void effective_lengths(const HysteresisState<S>& state, const HysteresisModel<S>
   }
 }
 
+// The history inputs of the GP (input_encoding.hpp): per cable, where it
+// last moved, read from the model's last operator as its lag's midpoint over
+// its width: +1 after a move of at least twice the width towards a longer
+// cable, -1 towards a shorter one, in between inside a reversal, and 0 while
+// nothing is known (at power-up, both ends of the interval at +-width). An
+// operator of weight 0 keeps this history without moving the effective
+// lengths. `out` receives state.cables values.
+template <typename S, typename Out>
+void history_inputs(const HysteresisState<S>& state, const HysteresisModel<S>& model, Out& out) {
+  const int k = state.operators - 1;
+  for (int c = 0; c < state.cables; ++c) {
+    const S width = model.widths_mm[c][k];
+    out[c] = width > S(0) ? S(0.5) * (state.lag_low_mm[c][k] + state.lag_high_mm[c][k]) / width : S(0);
+  }
+}
+
 // The commanded length of one cable that brings its effective length to
 // `effective_target_mm`, moving in a straight line from the state's position
 // (the inverse of update_hysteresis and effective_lengths on the

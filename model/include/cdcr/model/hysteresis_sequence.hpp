@@ -1,9 +1,12 @@
 #pragma once
-// The effective cable lengths of every row of a motion sequence
-// (hysteresis.hpp): the state is carried from row to row, each session
-// starts after the homing move (start_at_home), and the cables move from one
-// row to the next in a straight line. The host tools' replay and evaluation
-// run it in float32 on an image's block, as the board does.
+// The effective cable lengths and history inputs of every row of a motion
+// sequence (hysteresis.hpp): the state is carried from row to row, each
+// session starts after the homing move (start_at_home) or at power-up with
+// the state unknown (a recording without the homing move), and the cables
+// move from one row to the next in a straight line. The host tools' replay
+// and evaluation run it in float32 on an image's block, as the board does.
+
+#include <cstdint>
 
 #include <Eigen/Core>
 
@@ -11,30 +14,69 @@
 
 namespace cdcr::model {
 
-// commanded_mm: rows x cables (any scalar, converted to S row by row);
-// session_starts: the first row of every session, increasing, the first 0
-// (none: one session from row 0). effective_mm, sized rows x cables by the
-// caller, receives the effective lengths.
-template <typename S, int MaxSegments, typename DerivedIn, typename DerivedOut>
-Status effective_lengths_over_sequence(const HysteresisModel<S>& model, const RobotGeometry<S, MaxSegments>& geometry,
-                                       const Eigen::MatrixBase<DerivedIn>& commanded_mm, const int* session_starts,
-                                       int session_count, Eigen::MatrixBase<DerivedOut>& effective_mm) {
+// How every session of a sequence starts.
+enum class SessionStart : std::uint8_t {
+  homed,     // after the homing move: the state is the block's homing state
+  power_up,  // without it: the state unknown, the first row only its position
+};
+
+// Runs the state over the rows: commanded_mm is rows x cables (any scalar,
+// converted to S row by row); session_starts the first row of every session,
+// increasing, the first 0 (none: one session from row 0). After each row's
+// update, row(i, state) sees the state.
+template <typename S, int MaxSegments, typename DerivedIn, typename Row>
+Status for_each_sequence_row(const HysteresisModel<S>& model, const RobotGeometry<S, MaxSegments>& geometry,
+                             const Eigen::MatrixBase<DerivedIn>& commanded_mm, const int* session_starts,
+                             int session_count, SessionStart start, Row row) {
   if (commanded_mm.cols() != model.cables) return Status::invalid_segment_count;
   HysteresisState<S> state;
-  CableVector<S, MaxSegments> row, effective;
+  CableVector<S, MaxSegments> lengths;
   int next_session = 0;
   for (Eigen::Index i = 0; i < commanded_mm.rows(); ++i) {
     const bool starts = i == 0 || (next_session < session_count && session_starts[next_session] == i);
-    if (starts) {
+    if (starts && start == SessionStart::power_up) reset_unknown(state, model);
+    if (starts && start == SessionStart::homed) {
       if (const Status s = start_at_home(state, model, geometry); s != Status::ok) return s;
     }
     while (next_session < session_count && session_starts[next_session] <= i) ++next_session;
-    row = commanded_mm.row(i).transpose().template cast<S>();
-    update_hysteresis(state, model, row);
-    effective_lengths(state, model, effective);
-    effective_mm.row(i) = effective.transpose().template cast<typename DerivedOut::Scalar>();
+    lengths = commanded_mm.row(i).transpose().template cast<S>();
+    update_hysteresis(state, model, lengths);
+    row(i, state);
   }
   return Status::ok;
+}
+
+// The effective lengths of every row; effective_mm, sized rows x cables by
+// the caller, receives them.
+template <typename S, int MaxSegments, typename DerivedIn, typename DerivedOut>
+Status effective_lengths_over_sequence(const HysteresisModel<S>& model, const RobotGeometry<S, MaxSegments>& geometry,
+                                       const Eigen::MatrixBase<DerivedIn>& commanded_mm, const int* session_starts,
+                                       int session_count, Eigen::MatrixBase<DerivedOut>& effective_mm,
+                                       SessionStart start = SessionStart::homed) {
+  CableVector<S, MaxSegments> effective;
+  return for_each_sequence_row(model, geometry, commanded_mm, session_starts, session_count, start,
+                               [&](Eigen::Index i, const HysteresisState<S>& state) {
+                                 effective_lengths(state, model, effective);
+                                 effective_mm.row(i) =
+                                     effective.transpose().template cast<typename DerivedOut::Scalar>();
+                               });
+}
+
+// The history inputs of every row (history_inputs); history, sized rows x
+// cables by the caller, receives them.
+template <typename S, int MaxSegments, typename DerivedIn, typename DerivedOut>
+Status history_inputs_over_sequence(const HysteresisModel<S>& model, const RobotGeometry<S, MaxSegments>& geometry,
+                                    const Eigen::MatrixBase<DerivedIn>& commanded_mm, const int* session_starts,
+                                    int session_count, Eigen::MatrixBase<DerivedOut>& history,
+                                    SessionStart start = SessionStart::homed) {
+  S values[kMaxCables];
+  return for_each_sequence_row(model, geometry, commanded_mm, session_starts, session_count, start,
+                               [&](Eigen::Index i, const HysteresisState<S>& state) {
+                                 history_inputs(state, model, values);
+                                 for (int c = 0; c < model.cables; ++c) {
+                                   history(i, c) = static_cast<typename DerivedOut::Scalar>(values[c]);
+                                 }
+                               });
 }
 
 }  // namespace cdcr::model

@@ -11,6 +11,10 @@
 //   (cable_fit.hpp), [rho_1, pi_1, rho_2, pi_2, ...] in mm. The bend is the
 //   variable (IK's); the residuals are state measured from the cables, held
 //   like the payload.
+// * bend_vector_history, bend_vector_cable_fit_history: either of the two,
+//   then per segment where each of its cables last moved, [h_1_1 .. h_1_4,
+//   h_2_1, ...] in [-1, 1] (hysteresis.hpp, history_inputs): state of the
+//   cables' friction, which the hysteresis block's last operator keeps.
 
 #include <cmath>
 #include <cstdint>
@@ -24,6 +28,8 @@ enum class InputEncoding : std::uint8_t {
   joint_angles = 1,
   bend_vector = 2,
   bend_vector_cable_fit = 3,
+  bend_vector_history = 4,
+  bend_vector_cable_fit_history = 5,
 };
 
 constexpr const char* to_string(InputEncoding encoding) {
@@ -31,23 +37,42 @@ constexpr const char* to_string(InputEncoding encoding) {
     case InputEncoding::joint_angles: return "joint-angles";
     case InputEncoding::bend_vector: return "bend-vector";
     case InputEncoding::bend_vector_cable_fit: return "bend-vector+cable-fit";
+    case InputEncoding::bend_vector_history: return "bend-vector+history";
+    case InputEncoding::bend_vector_cable_fit_history: return "bend-vector+cable-fit+history";
   }
   return "unknown";
 }
 
 constexpr bool is_known(InputEncoding encoding) {
   return encoding == InputEncoding::joint_angles || encoding == InputEncoding::bend_vector ||
-         encoding == InputEncoding::bend_vector_cable_fit;
+         encoding == InputEncoding::bend_vector_cable_fit || encoding == InputEncoding::bend_vector_history ||
+         encoding == InputEncoding::bend_vector_cable_fit_history;
 }
 
 constexpr bool takes_cable_residuals(InputEncoding encoding) {
-  return encoding == InputEncoding::bend_vector_cable_fit;
+  return encoding == InputEncoding::bend_vector_cable_fit || encoding == InputEncoding::bend_vector_cable_fit_history;
+}
+
+constexpr bool takes_history(InputEncoding encoding) {
+  return encoding == InputEncoding::bend_vector_history || encoding == InputEncoding::bend_vector_cable_fit_history;
+}
+
+// The encoding that adds (or drops) the history inputs, the rest the same;
+// joint angles take none.
+constexpr InputEncoding with_history(InputEncoding encoding, bool history) {
+  if (encoding == InputEncoding::joint_angles) return encoding;
+  if (takes_cable_residuals(encoding)) {
+    return history ? InputEncoding::bend_vector_cable_fit_history : InputEncoding::bend_vector_cable_fit;
+  }
+  return history ? InputEncoding::bend_vector_history : InputEncoding::bend_vector;
 }
 
 // Inputs the encoding gives a robot of `segments` segments (before any
 // extra input).
 constexpr int encoded_input_count(InputEncoding encoding, int segments) {
-  return (takes_cable_residuals(encoding) ? 2 + kCableResidualsPerSegment : 2) * segments;
+  return (2 + (takes_cable_residuals(encoding) ? kCableResidualsPerSegment : 0) +
+          (takes_history(encoding) ? kHistoryInputsPerSegment : 0)) *
+         segments;
 }
 
 // The bend's part of x (its first 2n values) from the stacked bend vector.

@@ -24,6 +24,10 @@ constexpr int max_model_inputs(int segments) { return 2 * segments + kMaxExtraIn
 // Inputs per segment of what its cables say beyond the bend: the cable
 // fit's common mode and pair imbalance (cable_fit.hpp).
 inline constexpr int kCableResidualsPerSegment = 2;
+// Inputs per segment of the cables' history: where each of its four cables
+// last moved (hysteresis.hpp, history_inputs). A model that takes them must
+// fit the same count too (one segment: 2 + 2 + 4 inputs; two: 16).
+inline constexpr int kHistoryInputsPerSegment = 4;
 inline constexpr int kMaxInputs = max_model_inputs(kMaxSegments);
 
 // Cables of the largest robot, four per segment.
