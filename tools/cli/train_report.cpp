@@ -87,6 +87,7 @@ Json hysteresis_json(const TrainRun& run) {
                   {"without_log_likelihood", h.searched ? Json(h.without_log_likelihood) : Json(nullptr)},
                   {"candidates", history_candidates},
                   {"extra_parameters", h.extra_parameters},
+                  {"penalty", h.penalty},
                   {"search_rows", h.search_rows},
                   {"reason", h.reason}};
   j["noise_variance_floor"] = s.noise_variance_floor > 0.0 ? Json(s.noise_variance_floor) : Json(nullptr);

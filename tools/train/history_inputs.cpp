@@ -1,6 +1,7 @@
 #include "history_inputs.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 #include <stdexcept>
 
@@ -99,8 +100,9 @@ HistoryChoice choose_history_inputs(const dataset::Dataset& data, const std::vec
         warm.length_scales.tail(extra);
     warm.length_scales = scales;
   }
-  // A candidate must beat the model without it by more than its parameters.
-  double to_beat = c.without_log_likelihood + c.extra_parameters;
+  // A candidate must beat the model without it by more than its penalty.
+  c.penalty = 0.5 * std::log(static_cast<double>(c.search_rows)) * c.extra_parameters;
+  double to_beat = c.without_log_likelihood + c.penalty;
   double best_log_likelihood = -std::numeric_limits<double>::infinity();
   for (const double width : kHistoryWidthsMm) {
     const model::HysteresisModel<double> candidate = with_history_operator(hysteresis, width, geometry);
@@ -119,11 +121,11 @@ HistoryChoice choose_history_inputs(const dataset::Dataset& data, const std::vec
   }
   const double gain = best_log_likelihood - c.without_log_likelihood;
   c.reason = c.chosen ? fmt::format("where each cable last moved (width {} mm) raises the log likelihood by {:.1f} "
-                                    "for {} parameters",
-                                    c.width_mm, gain, c.extra_parameters)
-                      : fmt::format("where each cable last moved raises the log likelihood by {:.1f} at best, not "
-                                    "more than its {} parameters",
-                                    gain, c.extra_parameters);
+                                    "for {} parameters ({:.1f} needed)",
+                                    c.width_mm, gain, c.extra_parameters, c.penalty)
+                      : fmt::format("where each cable last moved raises the log likelihood by {:.1f} at best, less "
+                                    "than the {:.1f} its {} parameters need",
+                                    gain, c.penalty, c.extra_parameters);
   return c;
 }
 
