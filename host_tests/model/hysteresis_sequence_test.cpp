@@ -29,17 +29,25 @@ HysteresisModel<float> two_operator_model(const RobotGeometry<float>& geometry) 
   return h;
 }
 
+// `rows` rows of a walk from home: every cable steps up to 0.8 mm either way.
+Eigen::MatrixXd random_walk_from_home(const RobotGeometry<float>& geometry, int rows, unsigned seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> step(-0.8, 0.8);
+  CableVector<float> approach, home;
+  homing_waypoints(geometry, approach, home);
+  Eigen::MatrixXd commanded(rows, home.size());
+  for (int i = 0; i < rows; ++i) {
+    for (int c = 0; c < home.size(); ++c) {
+      commanded(i, c) = home[c] + (i == 0 ? 0.0 : commanded(i - 1, c) - home[c]) + step(rng);
+    }
+  }
+  return commanded;
+}
+
 TEST(HysteresisSequence, EachSessionStartsAtHomeAndCarriesItsStateFromRowToRow) {
   const RobotGeometry<float> geometry = RobotGeometry<float>::uniform(2, 120.0f, 67.0f);
   const HysteresisModel<float> h = two_operator_model(geometry);
-  std::mt19937 rng(3);
-  std::uniform_real_distribution<double> step(-0.8, 0.8);
-  Eigen::MatrixXd commanded(30, 8);
-  CableVector<float> approach, home;
-  homing_waypoints(geometry, approach, home);
-  for (int i = 0; i < commanded.rows(); ++i) {
-    for (int c = 0; c < 8; ++c) commanded(i, c) = home[c] + (i == 0 ? 0.0 : commanded(i - 1, c) - home[c]) + step(rng);
-  }
+  const Eigen::MatrixXd commanded = random_walk_from_home(geometry, 30, 3);
   const std::vector<int> sessions = {0, 12, 20};
   Eigen::MatrixXf effective(30, 8);
   ASSERT_EQ(effective_lengths_over_sequence(h, geometry, commanded, sessions.data(), 3, effective), Status::ok);
@@ -76,17 +84,12 @@ TEST(HysteresisSequence, EachSessionStartsAtHomeAndCarriesItsStateFromRowToRow) 
 TEST(HysteresisSequence, HistoryInputsFollowTheSameState) {
   const RobotGeometry<float> geometry = RobotGeometry<float>::uniform(2, 120.0f, 67.0f);
   const HysteresisModel<float> h = two_operator_model(geometry);
-  std::mt19937 rng(5);
-  std::uniform_real_distribution<double> step(-0.8, 0.8);
-  Eigen::MatrixXd commanded(25, 8);
-  CableVector<float> approach, home;
-  homing_waypoints(geometry, approach, home);
-  for (int i = 0; i < commanded.rows(); ++i) {
-    for (int c = 0; c < 8; ++c) commanded(i, c) = home[c] + (i == 0 ? 0.0 : commanded(i - 1, c) - home[c]) + step(rng);
-  }
+  const Eigen::MatrixXd commanded = random_walk_from_home(geometry, 25, 5);
   const std::vector<int> sessions = {0, 10};
-  Eigen::MatrixXf history(25, 8);
-  ASSERT_EQ(history_inputs_over_sequence(h, geometry, commanded, sessions.data(), 2, history), Status::ok);
+  Eigen::MatrixXf effective(25, 8), history(25, 8);
+  ASSERT_EQ(effective_lengths_over_sequence(h, geometry, commanded, sessions.data(), 2, effective,
+                                            SessionStart::homed, &history),
+            Status::ok);
   HysteresisState<float> state;
   bool moved_both_ways = false;
   for (int i = 0; i < commanded.rows(); ++i) {

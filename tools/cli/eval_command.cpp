@@ -71,36 +71,27 @@ void write_rows(const std::string& path, const training::TrainingSet& set,
   exporting::write_binary_file(path, text.data(), text.size());
 }
 
-// The effective cable lengths of the rows, a motion sequence, as the board
-// computes them: the image's hysteresis block in float32, each session
-// starting at home, the state carried from row to row.
-Eigen::MatrixXd effective_cables(const model::ImageView& image, const model::HysteresisModel<float>& hysteresis,
-                                 const Eigen::MatrixXd& cables_mm, const std::vector<int>& session_starts) {
-  model::RobotGeometry<float> geometry;
-  model::geometry_from_image(image, geometry);
-  Eigen::MatrixXf effective(cables_mm.rows(), cables_mm.cols());
-  if (const model::Status s = model::effective_lengths_over_sequence(
-          hysteresis, geometry, cables_mm, session_starts.data(), static_cast<int>(session_starts.size()), effective);
-      s != model::Status::ok) {
-    throw std::invalid_argument(std::string("hysteresis: ") + model::to_string(s));
-  }
-  return effective.cast<double>();
-}
+// What the board's hysteresis state gives the rows, a motion sequence: the
+// image's block in float32, each session starting at home, the state carried
+// from row to row.
+struct BoardSequence {
+  Eigen::MatrixXd effective_mm;
+  Eigen::MatrixXd history;  // where each cable last moved; empty unless the image takes it
+};
 
-// Where each cable last moved at every row, as the board keeps it, for an
-// image with the history inputs (empty for others).
-Eigen::MatrixXd history_of(const model::ImageView& image, const model::HysteresisModel<float>& hysteresis,
-                           const Eigen::MatrixXd& cables_mm, const std::vector<int>& session_starts) {
-  if (!model::takes_history(image.encoding)) return {};
+BoardSequence board_sequence(const model::ImageView& image, const model::HysteresisModel<float>& hysteresis,
+                             const Eigen::MatrixXd& cables_mm, const std::vector<int>& session_starts) {
   model::RobotGeometry<float> geometry;
   model::geometry_from_image(image, geometry);
-  Eigen::MatrixXf history(cables_mm.rows(), cables_mm.cols());
-  if (const model::Status s = model::history_inputs_over_sequence(
-          hysteresis, geometry, cables_mm, session_starts.data(), static_cast<int>(session_starts.size()), history);
+  Eigen::MatrixXf effective(cables_mm.rows(), cables_mm.cols()), history(cables_mm.rows(), cables_mm.cols());
+  const bool with_history = model::takes_history(image.encoding);
+  if (const model::Status s = model::effective_lengths_over_sequence(
+          hysteresis, geometry, cables_mm, session_starts.data(), static_cast<int>(session_starts.size()), effective,
+          model::SessionStart::homed, with_history ? &history : nullptr);
       s != model::Status::ok) {
     throw std::invalid_argument(std::string("hysteresis: ") + model::to_string(s));
   }
-  return history.cast<double>();
+  return {effective.cast<double>(), with_history ? Eigen::MatrixXd(history.cast<double>()) : Eigen::MatrixXd()};
 }
 
 // What the image and the rows hold, checked against each other before any
@@ -170,12 +161,11 @@ EvalResults evaluate(const EvalCommandOptions& o, const EvalInputs& in) {
     r.set = training::make_training_set(in.data, in.geometry, model::with_history(view.encoding, false),
                                         in.payload_input);
     // The nominal (initial) error stays that of the commanded lengths.
-    const Eigen::MatrixXd cables_mm = in.with_hysteresis
-                                          ? effective_cables(view, in.hysteresis, r.set.cables_mm, in.data.session_starts)
-                                          : r.set.cables_mm;
-    const Eigen::MatrixXd history =
-        in.with_hysteresis ? history_of(view, in.hysteresis, r.set.cables_mm, in.data.session_starts)
-                           : Eigen::MatrixXd();
+    const BoardSequence sequence =
+        in.with_hysteresis ? board_sequence(view, in.hysteresis, r.set.cables_mm, in.data.session_starts)
+                           : BoardSequence{r.set.cables_mm, Eigen::MatrixXd()};
+    const Eigen::MatrixXd& cables_mm = sequence.effective_mm;
+    const Eigen::MatrixXd& history = sequence.history;
     r.compensated = training::firmware_poses(view, cables_mm, training::FirmwareAccumulator::float64,
                                              r.set.payload_kg, history);
     r.estimates = training::firmware_estimates(view, cables_mm, r.set.payload_kg, history);

@@ -70,14 +70,10 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
   Eigen::MatrixXf effective_mm(data.cables_mm.rows(), data.cables_mm.cols());
   Eigen::MatrixXf history(data.cables_mm.rows(), data.cables_mm.cols());
   if (hysteresis.active()) {
-    const int sessions = static_cast<int>(data.session_starts.size());
-    model::Status s = model::effective_lengths_over_sequence(hysteresis.hysteresis_model(), runtime.geometry(),
-                                                             data.cables_mm, data.session_starts.data(), sessions,
-                                                             effective_mm);
-    if (s == model::Status::ok && runtime.correction().takes_history()) {
-      s = model::history_inputs_over_sequence(hysteresis.hysteresis_model(), runtime.geometry(), data.cables_mm,
-                                              data.session_starts.data(), sessions, history);
-    }
+    const model::Status s = model::effective_lengths_over_sequence(
+        hysteresis.hysteresis_model(), runtime.geometry(), data.cables_mm, data.session_starts.data(),
+        static_cast<int>(data.session_starts.size()), effective_mm, model::SessionStart::homed,
+        runtime.correction().takes_history() ? &history : nullptr);
     if (s != model::Status::ok) throw InputError(cables_path + ": hysteresis: " + model::to_string(s));
   }
   std::FILE* out = std::fopen(out_path.c_str(), "w");

@@ -8,6 +8,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <utility>
 
 #include "cdcr/model/hysteresis_sequence.hpp"
 #include "cdcr/model/limits.hpp"
@@ -18,7 +19,8 @@ namespace cdcr::training {
 
 Eigen::MatrixXd effective_cables(const Eigen::MatrixXd& commanded_mm, const std::vector<int>& session_starts,
                                  const model::HysteresisModel<double>& hysteresis,
-                                 const model::RobotGeometry<double>& geometry, model::SessionStart start) {
+                                 const model::RobotGeometry<double>& geometry, model::SessionStart start,
+                                 Eigen::MatrixXd* history) {
   if (hysteresis.empty()) return commanded_mm;
   const auto rows = static_cast<int>(commanded_mm.rows());
   if (hysteresis.cables != commanded_mm.cols()) {
@@ -36,9 +38,10 @@ Eigen::MatrixXd effective_cables(const Eigen::MatrixXd& commanded_mm, const std:
   }
   // The same sequence code the replay and the evaluation run in float32.
   Eigen::MatrixXd effective(commanded_mm.rows(), commanded_mm.cols());
+  if (history != nullptr) history->resize(commanded_mm.rows(), commanded_mm.cols());
   const model::Status status = model::effective_lengths_over_sequence(
       hysteresis, geometry, commanded_mm, session_starts.data(), static_cast<int>(session_starts.size()), effective,
-      start);
+      start, history);
   if (status != model::Status::ok) throw std::invalid_argument(std::string("homing move: ") + model::to_string(status));
   return effective;
 }
@@ -47,19 +50,18 @@ TrainingSet make_sequence_training_set(const dataset::Dataset& data, const model
                                        const model::RobotGeometry<double>& geometry, model::InputEncoding encoding,
                                        bool with_payload) {
   if (!data.has_time) throw std::invalid_argument("a hysteresis model needs a motion sequence (a t_s column)");
+  const bool with_history = model::takes_history(encoding);
+  if (with_history && hysteresis.empty()) {
+    throw std::invalid_argument("the history inputs need a hysteresis model to keep them");
+  }
   dataset::Dataset effective = data;
-  const model::SessionStart start = data.sessions_homed ? model::SessionStart::homed : model::SessionStart::power_up;
-  effective.cables_mm = effective_cables(data.cables_mm, data.session_starts, hysteresis, geometry, start);
+  Eigen::MatrixXd history;
+  effective.cables_mm = effective_cables(data.cables_mm, data.session_starts, hysteresis, geometry,
+                                         session_start(data), with_history ? &history : nullptr);
   TrainingSet set = make_training_set(effective, geometry, model::with_history(encoding, false), with_payload);
   set.commanded_mm = data.cables_mm;
-  if (!model::takes_history(encoding)) return set;
-  if (hysteresis.empty()) throw std::invalid_argument("the history inputs need a hysteresis model to keep them");
-  // The same sequence code as the effective lengths'.
-  set.history_inputs.resize(data.cables_mm.rows(), data.cables_mm.cols());
-  const model::Status status = model::history_inputs_over_sequence(
-      hysteresis, geometry, data.cables_mm, data.session_starts.data(), static_cast<int>(data.session_starts.size()),
-      set.history_inputs, start);
-  if (status != model::Status::ok) throw std::invalid_argument(std::string("homing move: ") + model::to_string(status));
+  if (!with_history) return set;
+  set.history_inputs = std::move(history);
   return with_encoding(set, encoding);
 }
 
@@ -180,8 +182,7 @@ class Likelihood {
  private:
   TrainingSet set_for(const model::HysteresisModel<double>& m) const {
     dataset::Dataset d = rows_data_;
-    d.cables_mm = effective_cables(data_.cables_mm, data_.session_starts, m, geometry_,
-                                   data_.sessions_homed ? model::SessionStart::homed : model::SessionStart::power_up)(
+    d.cables_mm = effective_cables(data_.cables_mm, data_.session_starts, m, geometry_, session_start(data_))(
         rows_, Eigen::all);
     return make_training_set(d, geometry_, encoding_, with_payload_);
   }

@@ -35,13 +35,20 @@ namespace cdcr::training {
 // The effective cable lengths of every row of a sequence: each session
 // starts at home after the homing move (model::start_at_home), or at
 // power-up with the state unknown, then the state follows the commanded
-// rows one by one. Throws std::invalid_argument
-// for session starts that do not begin at row 0 or do not increase. An empty
-// model returns the commanded lengths.
+// rows one by one; with `history` (not null), where each cable last moved
+// too (model::history_inputs), from the same run. Throws
+// std::invalid_argument for session starts that do not begin at row 0 or do
+// not increase. An empty model returns the commanded lengths.
 Eigen::MatrixXd effective_cables(const Eigen::MatrixXd& commanded_mm, const std::vector<int>& session_starts,
                                  const model::HysteresisModel<double>& hysteresis,
                                  const model::RobotGeometry<double>& geometry,
-                                 model::SessionStart start = model::SessionStart::homed);
+                                 model::SessionStart start = model::SessionStart::homed,
+                                 Eigen::MatrixXd* history = nullptr);
+
+// How the data's sessions start: after the homing move, or at power-up.
+inline model::SessionStart session_start(const dataset::Dataset& data) {
+  return data.sessions_homed ? model::SessionStart::homed : model::SessionStart::power_up;
+}
 
 // The training set of a sequence with the hysteresis applied: bends, nominal
 // poses and error twists from the effective lengths of every row (the state

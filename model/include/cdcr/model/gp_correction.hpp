@@ -201,7 +201,7 @@ class GpCorrection {
   std::uint32_t smallest_gradient_slice_units() const { return gradient_granule_ * gradient_point_units_; }
 
   // z = (x - input_mean) / (input_scale * length_scale) for x = encode(bend)
-  // followed by the held inputs (the cable residuals, the payload): the
+  // followed by the held inputs (the cable residuals, the history, the payload): the
   // coordinates the points are stored in (input_dims() values).
   void kernel_coordinates(const JointVector<S, MaxSegments>& bend, S* z) const {
     Input x(bend_dims_);

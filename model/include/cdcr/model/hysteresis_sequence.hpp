@@ -46,35 +46,26 @@ Status for_each_sequence_row(const HysteresisModel<S>& model, const RobotGeometr
   return Status::ok;
 }
 
-// The effective lengths of every row; effective_mm, sized rows x cables by
-// the caller, receives them.
-template <typename S, int MaxSegments, typename DerivedIn, typename DerivedOut>
+// The effective lengths of every row, and with `history` (not null) the
+// history inputs (history_inputs) from the same run; effective_mm and
+// *history, sized rows x cables by the caller, receive them.
+template <typename S, int MaxSegments, typename DerivedIn, typename DerivedOut, typename DerivedHistory = DerivedOut>
 Status effective_lengths_over_sequence(const HysteresisModel<S>& model, const RobotGeometry<S, MaxSegments>& geometry,
                                        const Eigen::MatrixBase<DerivedIn>& commanded_mm, const int* session_starts,
                                        int session_count, Eigen::MatrixBase<DerivedOut>& effective_mm,
-                                       SessionStart start = SessionStart::homed) {
+                                       SessionStart start = SessionStart::homed,
+                                       Eigen::MatrixBase<DerivedHistory>* history = nullptr) {
   CableVector<S, MaxSegments> effective;
+  S values[kMaxCables];
   return for_each_sequence_row(model, geometry, commanded_mm, session_starts, session_count, start,
                                [&](Eigen::Index i, const HysteresisState<S>& state) {
                                  effective_lengths(state, model, effective);
                                  effective_mm.row(i) =
                                      effective.transpose().template cast<typename DerivedOut::Scalar>();
-                               });
-}
-
-// The history inputs of every row (history_inputs); history, sized rows x
-// cables by the caller, receives them.
-template <typename S, int MaxSegments, typename DerivedIn, typename DerivedOut>
-Status history_inputs_over_sequence(const HysteresisModel<S>& model, const RobotGeometry<S, MaxSegments>& geometry,
-                                    const Eigen::MatrixBase<DerivedIn>& commanded_mm, const int* session_starts,
-                                    int session_count, Eigen::MatrixBase<DerivedOut>& history,
-                                    SessionStart start = SessionStart::homed) {
-  S values[kMaxCables];
-  return for_each_sequence_row(model, geometry, commanded_mm, session_starts, session_count, start,
-                               [&](Eigen::Index i, const HysteresisState<S>& state) {
+                                 if (history == nullptr) return;
                                  history_inputs(state, model, values);
                                  for (int c = 0; c < model.cables; ++c) {
-                                   history(i, c) = static_cast<typename DerivedOut::Scalar>(values[c]);
+                                   (*history)(i, c) = static_cast<typename DerivedHistory::Scalar>(values[c]);
                                  }
                                });
 }
