@@ -190,7 +190,8 @@ void IkRequest::conclude(bool reached, const Joints& joints) {
 }
 
 // A solution for a target that refuses extrapolation: outside the fitted
-// input range it is refused at once; with a variance block its variance is
+// input range it is refused at once where the range flags (images before
+// 2.6, or without a variance block); with a variance block its variance is
 // computed over the next cycles' IK slices (continue_solution_check).
 // Returns false when there is nothing to check (DEGRADED: no model to
 // extrapolate; RUN without a variance block and within range) and the
@@ -199,7 +200,7 @@ bool IkRequest::begin_solution_check(const Joints& joints) {
   if (!model_.compensated || !model_.uncertainty.bound()) return false;
   Scalar coordinates[Correction::kMaxInputs];
   model_.correction.kernel_coordinates(model::bend_from_joints(commanded_joints(model_, joints)), coordinates);
-  if (model_.uncertainty.outside_range(coordinates)) {
+  if (model_.uncertainty.range_flags() && model_.uncertainty.outside_range(coordinates)) {
     retry_or_refuse(joints);
     return true;
   }

@@ -90,7 +90,8 @@ FaultDetail Runtime::active_fault_detail() const {
 }
 
 bool Runtime::extrapolating() const {
-  return has_pose_ && (latest_pose_.outside_range || (has_uncertainty() && latest_uncertainty().extrapolating));
+  const bool range_flags = latest_pose_.outside_range && model_.uncertainty.range_flags();
+  return has_pose_ && (range_flags || (has_uncertainty() && latest_uncertainty().extrapolating));
 }
 
 void Runtime::run_cycle(const hal::TimerTick& tick, CycleInputs* inputs) {

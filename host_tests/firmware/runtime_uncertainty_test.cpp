@@ -4,12 +4,15 @@
 // in the pose frame and STATUS.
 
 #include <algorithm>
+#include <cstring>
 #include <map>
+#include <tuple>
 #include <vector>
 
 #include <gtest/gtest.h>
 
 #include "cdcr/firmware/ik_settings.hpp"
+#include "cdcr/model/crc32.hpp"
 #include "runtime_test_fixture.hpp"
 #include "train/predictive_variance.hpp"
 #include "../support/variance_block.hpp"
@@ -216,11 +219,24 @@ std::vector<protocol::IkOutcome> outcomes_in(const std::vector<hal::CanFrame>& f
 
 // The fitted range a narrow box around the held pose's inputs: a target
 // whose solution bends further is outside it. Without a variance block the
-// range alone decides; with one, the range decides before the variance runs.
-class RefusalOutsideTheRange : public RuntimeUncertaintyTest, public ::testing::WithParamInterface<int> {};
+// range alone decides; with one in an image before 2.6, the range decides
+// before the variance runs; from 2.6 the variance alone decides, and the
+// range does not refuse. Parameters: the variance rank, the image's minor
+// version.
+class RefusalOutsideTheRange : public RuntimeUncertaintyTest,
+                               public ::testing::WithParamInterface<std::tuple<int, int>> {};
+
+// The image with its minor version set and its CRC made good again.
+std::vector<std::uint8_t> with_minor_version(std::vector<std::uint8_t> image, std::uint16_t minor) {
+  std::memcpy(image.data() + 6, &minor, sizeof minor);
+  const std::uint32_t crc = model::crc32(image.data(), image.size() - model::kImageTrailerSize);
+  std::memcpy(image.data() + image.size() - model::kImageTrailerSize, &crc, sizeof crc);
+  return image;
+}
 
 TEST_P(RefusalOutsideTheRange, ATargetThatRefusesExtrapolationIsRefusedOutsideTheFittedRange) {
-  const int rank = GetParam();
+  const auto [rank, minor] = GetParam();
+  const bool range_flags = rank == 0 || minor < model::kImageVersionMinorHeldOutThreshold;
   training::TrainedModel m = test_support::small_correction_model(200);
   test_support::add_variance_block(m, rank);
   if (rank > 0) m.variance.extrapolation_variance = 1.0;  // the variance alone never flags
@@ -233,7 +249,8 @@ TEST_P(RefusalOutsideTheRange, ATargetThatRefusesExtrapolationIsRefusedOutsideTh
     m.input_min = bend.cast<double>().array() - 0.02;
     m.input_max = bend.cast<double>().array() + 0.02;
   }
-  const std::vector<std::uint8_t> image = exporting::write_image(m);
+  const std::vector<std::uint8_t> image =
+      with_minor_version(exporting::write_image(m), static_cast<std::uint16_t>(minor));
   for (const bool refuse : {true, false}) {
     SCOPED_TRACE(refuse ? "refusing" : "accepting");
     boot(image);
@@ -251,7 +268,7 @@ TEST_P(RefusalOutsideTheRange, ATargetThatRefusesExtrapolationIsRefusedOutsideTh
     int setpoint_frames = 0;
     const std::vector<protocol::IkOutcome> outcomes = outcomes_in(host_frames(), &setpoint_frames);
     ASSERT_FALSE(outcomes.empty());
-    if (refuse) {
+    if (refuse && range_flags) {
       EXPECT_EQ(outcomes.back(), protocol::IkOutcome::refused_extrapolating);
       // Refused when found, without the variance's cycles.
       EXPECT_EQ(runtime->last_ik_report().cycles, cycles_spent_solving);
@@ -266,7 +283,10 @@ TEST_P(RefusalOutsideTheRange, ATargetThatRefusesExtrapolationIsRefusedOutsideTh
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(VarianceRanks, RefusalOutsideTheRange, ::testing::Values(0, 16));
+INSTANTIATE_TEST_SUITE_P(VarianceRanks, RefusalOutsideTheRange,
+                         ::testing::Values(std::make_tuple(0, int(model::kImageVersionMinor)),
+                                           std::make_tuple(16, int(model::kImageVersionMinorHeldOutThreshold - 1)),
+                                           std::make_tuple(16, int(model::kImageVersionMinorHeldOutThreshold))));
 
 // Within the fitted range, the variance decides, over a few cycles of IK's
 // share: with a threshold above any share the solution goes out (later

@@ -28,8 +28,10 @@ repeatability: the same split, and
   - with --cdcr: the project's model, `cdcr train` on the first 80 % as the
     sequence it is, with and without `--no-history`, each `cdcr eval`uated
     on the last 20 %: the compensated mean position error, whether the
-    history inputs were kept, r95's coverage and the rows flagged as
-    extrapolating.
+    history inputs were kept, r95's coverage, the rows flagged as
+    extrapolating and those outside the fitted rows' range (which flag only
+    in images before 2.6), and the same test rows from power-up (the first
+    rows with the cables' state unknown; any sequence model with hysteresis).
 One segment of four cables (l1_1..l1_4) only. Needs numpy and scikit-learn.
 """
 
@@ -75,7 +77,7 @@ def cdcr_json(cdcr, *arguments):
 
 def cdcr_model(cdcr, source, train_rows, test_rows, with_time, length_mm, radius_mm, options=()):
     """cdcr train on train_rows, cdcr eval on test_rows: the compensated error, the encoding, the cable fit's counts,
-    r95's coverage."""
+    r95's coverage, the flags; with a hysteresis model, also the test rows evaluated from power-up."""
     with tempfile.TemporaryDirectory() as work:
         train, test, image = (os.path.join(work, name) for name in ("train.csv", "test.csv", "model.img"))
         write_rows(train, source, train_rows, with_time)
@@ -83,13 +85,20 @@ def cdcr_model(cdcr, source, train_rows, test_rows, with_time, length_mm, radius
         trained = cdcr_json(cdcr, "train", "--data", train, "--out", image, "--holdout", "0", "--segments", "1",
                             "--length", str(length_mm), "--radius", str(radius_mm), *options)
         evaluated = cdcr_json(cdcr, "eval", "--model", image, "--data", test)
+        # The test rows as a session the board starts at power-up, the cables' state unknown.
+        used_hysteresis = with_time and (trained.get("hysteresis") or {}).get("used")
+        power_up = cdcr_json(cdcr, "eval", "--model", image, "--data", test, "--from-power-up") \
+            if used_hysteresis else None
     out = {"compensated_mm": evaluated["compensated"]["position_mm"], "encoding": trained["encoding"],
            "model": trained["model"]["reason"], "cable_inputs": trained["cable_inputs"],
-           "extrapolating": evaluated["extrapolating"]}
+           "extrapolating": evaluated["extrapolating"], "outside_range": evaluated["outside_range"],
+           "uncertainty": trained.get("uncertainty")}
     if with_time and trained.get("hysteresis"):
         out["history"] = trained["hysteresis"].get("history", {}).get("reason")
     if evaluated.get("coverage"):
         out["r95_coverage"] = evaluated["coverage"]
+    if power_up:
+        out["from_power_up"] = {"extrapolating": power_up["extrapolating"], "power_up": power_up["power_up"]}
     return out
 
 

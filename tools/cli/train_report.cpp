@@ -237,6 +237,36 @@ std::string compliance_text(const TrainRun& run) {
   return t;
 }
 
+// The radii's calibration and the extrapolation threshold the image
+// carries, and the radii's coverage of the held-out samples.
+Json uncertainty_json(const training::ExportResult& r) {
+  const training::VarianceFactor& v = r.model.variance;
+  if (v.rank() == 0) return nullptr;
+  const training::CoverageCheck& c = r.validation_coverage;
+  return {{"variance_points", v.rank()},
+          {"calibration_rows", r.radius_calibration.rows},
+          {"position_scale", v.position_scale},
+          {"orientation_scale", v.orientation_scale},
+          {"extrapolation_share", v.extrapolation_variance},
+          {"validation_coverage", c.samples > 0 ? Json{{"r95_mm", c.position_coverage}, {"r95_deg", c.orientation_coverage}}
+                                                : Json(nullptr)}};
+}
+
+std::string uncertainty_text(const training::ExportResult& r) {
+  const training::VarianceFactor& v = r.model.variance;
+  if (v.rank() == 0) return "";
+  std::string t = fmt::format(
+      "  r95 from {} variance points, calibrated on {} rows each held out: position x{:.3g}, orientation x{:.3g}\n"
+      "  extrapolating above a latent share of {:.3g} (from the held-out rows' 99th percentile)\n",
+      v.rank(), r.radius_calibration.rows, v.position_scale, v.orientation_scale, v.extrapolation_variance);
+  const training::CoverageCheck& c = r.validation_coverage;
+  if (c.samples > 0) {
+    t += fmt::format("  r95 covers {:.1f} % of the held-out positions, {:.1f} % of the orientations (goal 95 %)\n",
+                     100.0 * c.position_coverage, 100.0 * c.orientation_coverage);
+  }
+  return t;
+}
+
 }  // namespace
 
 Json cable_inputs_json(const TrainRun& run) {
@@ -333,6 +363,7 @@ std::string train_report_json(const TrainRun& run) {
   }
   j["float32_fidelity"] = fidelity;
   j["float32_fidelity_target_met"] = r.fidelity_met();
+  j["uncertainty"] = uncertainty_json(r);
   if (run.data_has_time) j["hysteresis"] = hysteresis_json(run);
   // Only payload data have the key: every other report stays as it was.
   if (run.payload_input && !run.data_has_time) j["compliance"] = compliance_json(run);
@@ -387,6 +418,7 @@ std::string train_report_text(const TrainRun& run) {
                    m.signal_variance[0], m.noise_variance[0]);
   t += fmt::format("  log marginal likelihood {:.6g} after {} evaluations\n", r.report.log_marginal_likelihood,
                    r.report.likelihood_evaluations);
+  t += uncertainty_text(r);
   t += hysteresis_text(run);
   t += compliance_text(run);
   if (r.validation.samples > 0) {

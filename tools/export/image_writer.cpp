@@ -122,10 +122,13 @@ void check_parses(ImageBuffer& image, std::uint32_t size) {
   }
 }
 
-// The cable-fit encoding is 2.4's, the history's 2.5; the blocks' minor
-// versions are older, so it is put after them.
-void put_encoding_version(ImageBuffer& image, model::InputEncoding encoding) {
-  if (model::takes_history(encoding)) {
+// The cable-fit encoding is 2.4's, the history's 2.5, the variance block's
+// threshold alone flagging extrapolation 2.6; the blocks' minor versions are
+// older, so it is put after them.
+void put_newest_version(ImageBuffer& image, model::InputEncoding encoding, int variance_rank) {
+  if (variance_rank > 0) {
+    image.put_field(model::image_field::version_minor, model::kImageVersionMinorHeldOutThreshold);
+  } else if (model::takes_history(encoding)) {
     image.put_field(model::image_field::version_minor, model::kImageVersionMinorHistory);
   } else if (model::takes_cable_residuals(encoding)) {
     image.put_field(model::image_field::version_minor, model::kImageVersionMinorCableFit);
@@ -179,8 +182,8 @@ ModelDims checked_dims(const training::TrainedModel& model) {
   return ModelDims{n, d, segments, extra, rank, rows_fitted};
 }
 
-// The header of a 2.1 image; put_hysteresis() and put_compliance() raise
-// the minor version for their blocks.
+// The header of a 2.1 image; put_hysteresis(), put_compliance() and
+// put_newest_version() raise the minor version for what the image holds.
 void put_header(ImageBuffer& image, const training::TrainedModel& model, const ModelDims& dims,
                 const model::ImageLayout& layout) {
   namespace field = model::image_field;
@@ -317,11 +320,9 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   put_parameters(image, layout.parameters_offset, model, dims);
   put_points(image, layout, model, dims);
   put_variance(image, layout.variance_offset, model.variance, dims.input_dims);
-  // Without a hysteresis or compliance model the image is a 2.1 image,
-  // byte for byte.
   put_hysteresis(image, layout.hysteresis_offset, model.hysteresis);
   put_compliance(image, layout.compliance_offset, model.compliance);
-  put_encoding_version(image, model.encoding);
+  put_newest_version(image, model.encoding, dims.variance_rank);
   put_metadata(image, layout.metadata_offset, model, dims.rows_fitted);
   put_checksum(image, layout.total_size);
   check_parses(image, layout.total_size);
@@ -363,7 +364,9 @@ std::vector<std::uint8_t> with_blocks(const std::vector<std::uint8_t>& image,
   out.put_field(model::image_field::metadata_offset, layout.metadata_offset);
   put_hysteresis(out, layout.hysteresis_offset, hysteresis);
   put_compliance(out, layout.compliance_offset, compliance);
-  put_encoding_version(out, view.encoding);
+  // The variance block's threshold keeps the meaning it was written with.
+  put_newest_version(out, view.encoding,
+                     view.version_minor >= model::kImageVersionMinorHeldOutThreshold ? int(view.variance_rank) : 0);
   put_checksum(out, layout.total_size);
   check_parses(out, layout.total_size);
   return out.take();

@@ -12,18 +12,6 @@ namespace cdcr::training {
 
 namespace {
 
-// A query extrapolates where the model is less sure of its correction than
-// of a measurement (latent variance above the noise it learned) and than
-// anywhere in its own data (twice the 99th percentile of the variance
-// factor's share over the fitted rows: with few variance points the factor
-// overstates the variance where the data are dense, and must not flag them).
-double extrapolation_threshold(const TrainedModel& m, const Eigen::MatrixXd& fitted_inputs) {
-  Eigen::VectorXd share = latent_share(m.variance, kernel_coordinates(m, fitted_inputs));
-  std::sort(share.data(), share.data() + share.size());
-  const double p99 = share[static_cast<Eigen::Index>(0.99 * static_cast<double>(share.size() - 1))];
-  return std::min(1.0, std::max(m.noise_variance[0] / m.signal_variance[0], 2.0 * p99));
-}
-
 model::ImageMetrics metrics_of(const Evaluation& validation, const Fidelity& fidelity) {
   model::ImageMetrics m{};
   m.initial_position_mm = static_cast<float>(validation.initial.position_mm);
@@ -83,7 +71,8 @@ ExportResult train_and_export(const TrainingSet& train_set, const TrainingSet& v
     const RadiusCalibration calibration = calibrate_radii(m, rows, 0.95, 1000, options.search.seed);
     m.variance.position_scale = calibration.position_scale;
     m.variance.orientation_scale = calibration.orientation_scale;
-    m.variance.extrapolation_variance = extrapolation_threshold(m, rows.inputs);
+    m.variance.extrapolation_variance = extrapolation_threshold(m, rows.inputs, 4000, options.search.seed);
+    r.radius_calibration = calibration;
   };
   add_variance(searched, train_set);
   if (validation_set.size() > 0) {

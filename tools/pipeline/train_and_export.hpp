@@ -15,6 +15,7 @@
 #include "train/evaluation.hpp"
 #include "train/history_inputs.hpp"
 #include "train/hysteresis_identification.hpp"
+#include "train/predictive_variance.hpp"
 #include "train/trainer.hpp"
 #include "train/training_set.hpp"
 
@@ -37,6 +38,9 @@ struct ExportResult {
   // The radii of the model fitted on the training rows, on the held-out
   // samples (samples 0 when none are held out or the image has no variance).
   CoverageCheck validation_coverage;
+  // The radii's calibration of the exported model (rows 0 without a
+  // variance factor).
+  RadiusCalibration radius_calibration;
   // The exported image's float32 path against its double-precision model,
   // on the held-out samples (on the fitted rows when none are held out).
   // float32 path vs double trainer, one entry per FirmwareAccumulator.

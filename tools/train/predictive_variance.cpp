@@ -104,6 +104,45 @@ Eigen::VectorXd exact_latent_share(const TrainedModel& model, const Eigen::Matri
   return (Eigen::VectorXd::Ones(z.rows()) - v.colwise().squaredNorm().transpose()).cwiseMax(0.0);
 }
 
+Eigen::VectorXd held_out_latent_share(const TrainedModel& model, const Eigen::MatrixXd& rows) {
+  const VarianceFactor& factor = model.variance;
+  const double ratio = signal_to_noise(model);
+  const Eigen::MatrixXd z = kernel_coordinates(model, rows);
+  const Eigen::MatrixXd a =
+      factor.inducing_factor.triangularView<Eigen::Lower>().solve(unit_kernel(factor.points, z));
+  const Eigen::MatrixXd b = factor.posterior_factor.triangularView<Eigen::Lower>().solve(a);
+  Eigen::VectorXd share(z.rows());
+  for (Eigen::Index i = 0; i < z.rows(); ++i) {
+    const double q = b.col(i).squaredNorm();
+    // C - (s/n) a_i a_i^T >= I, so 1 - (s/n) q > 0 in exact arithmetic; it
+    // nears 0 only for a row the factor knows from itself alone, whose
+    // share without it is the prior's.
+    const double left = 1.0 - ratio * q;
+    const double recovered = left > 1e-12 ? q / left : a.col(i).squaredNorm();
+    share[i] = std::clamp(1.0 - a.col(i).squaredNorm() + recovered, 0.0, 1.0);
+  }
+  return share;
+}
+
+double extrapolation_threshold(const TrainedModel& model, const Eigen::MatrixXd& fitted_inputs, int max_rows,
+                               std::uint64_t seed) {
+  std::vector<Eigen::Index> rows(static_cast<std::size_t>(fitted_inputs.rows()));
+  std::iota(rows.begin(), rows.end(), Eigen::Index{0});
+  if (fitted_inputs.rows() > max_rows) {
+    std::mt19937_64 rng(seed);
+    std::shuffle(rows.begin(), rows.end(), rng);
+    rows.resize(static_cast<std::size_t>(max_rows));
+  }
+  Eigen::VectorXd share = held_out_latent_share(model, fitted_inputs(rows, Eigen::all));
+  std::sort(share.data(), share.data() + share.size());
+  const double p99 = share[static_cast<Eigen::Index>(0.99 * static_cast<double>(share.size() - 1))];
+  // Where the data leave much of the prior unknown (few variance points for
+  // many inputs), twice would be the prior itself: then halfway from the
+  // percentile to the prior. The image needs a positive threshold; a share
+  // of 1e-6 is the float path's rounding, far below any data's.
+  return std::clamp(std::min(2.0 * p99, 0.5 * (1.0 + p99)), 1e-6, 1.0);
+}
+
 RadiusCalibration calibrate_radii(const TrainedModel& model, const TrainingSet& set, double coverage, int max_rows,
                                   std::uint64_t seed) {
   const double ratio = signal_to_noise(model);
@@ -128,9 +167,11 @@ RadiusCalibration calibrate_radii(const TrainedModel& model, const TrainingSet& 
   // The radii are those the board computes, from the image's factor where
   // the model has one: the scales then correct the factor's approximation
   // too (with few variance points its variance is larger than the exact
-  // GP's where the data are dense).
+  // GP's where the data are dense). The row is left out of the factor as of
+  // the residual, so that a factor with a point at every row does not
+  // shrink the radius there.
   const bool with_factor = model.variance.rank() > 0;
-  const Eigen::VectorXd share = with_factor ? latent_share(model.variance, z) : Eigen::VectorXd();
+  const Eigen::VectorXd share = with_factor ? held_out_latent_share(model, sample.inputs) : Eigen::VectorXd();
   std::vector<double> position_ratio, orientation_ratio;
   for (Eigen::Index i = 0; i < z.rows(); ++i) {
     // Leave-one-out: residual alpha_i / [K^-1]_ii, variance 1 / [K^-1]_ii

@@ -38,11 +38,30 @@ Eigen::VectorXd latent_share(const VarianceFactor& factor, const Eigen::MatrixXd
 Eigen::VectorXd exact_latent_share(const TrainedModel& model, const Eigen::MatrixXd& fitted_inputs,
                                    const Eigen::MatrixXd& z);
 
+// The factor's latent share at each of `rows` (raw inputs, rows the factor
+// was fitted on) with that row left out of the factor (the same variance
+// points): what the board computes at a new input like it. The factor is
+// C = I + (s/n) A A^T; without row i it is C - (s/n) a_i a_i^T, and by
+// Sherman-Morrison a_i^T (C - (s/n) a_i a_i^T)^-1 a_i = q_i / (1 - (s/n) q_i),
+// q_i = |L_c^-1 a_i|^2.
+Eigen::VectorXd held_out_latent_share(const TrainedModel& model, const Eigen::MatrixXd& rows);
+
+// The share above which the board flags a query as extrapolating: twice
+// the 99th percentile of the held-out shares of the fitted rows (at most
+// max_rows of them, drawn at random), or halfway from it to the prior (1)
+// if that is lower, so that inputs like those the data visited stay
+// unflagged wherever they lie, and a query beyond the data, where the share
+// grows with the distance in the kernel's metric, is flagged.
+double extrapolation_threshold(const TrainedModel& model, const Eigen::MatrixXd& fitted_inputs, int max_rows = 4000,
+                               std::uint64_t seed = 1);
+
 // The scales that make the radii hold `coverage` of the rows: the exact
 // GP's leave-one-out residuals of the error twist on `set` (at most
 // max_rows of its rows, drawn at random), mapped to the tip as the board
-// maps the variance, against the radii the board computes there (from the
-// model's variance factor; without one, from the leave-one-out variances).
+// maps the variance, against the radii the board computes there with the
+// row left out (from the model's variance factor, held_out_latent_share();
+// without one, from the leave-one-out variances): split conformal
+// calibration with every row held out once.
 // The position radius needs it most: the motion-capture orientation noise
 // enters v and omega together (v = p x omega), and the outputs' independent
 // GPs cannot see that its effect on the tip cancels.

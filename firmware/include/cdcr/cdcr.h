@@ -154,7 +154,7 @@ typedef struct cdcr_pose {
   int segment_count;
   int compensated;     /* 1 in RUN (GP-corrected), 0 in DEGRADED (nominal) */
   uint32_t count;      /* poses computed so far: changes when this one is new */
-  int extrapolating;   /* 1: the model extrapolates at this pose (input range or variance) */
+  int extrapolating;   /* 1: the model extrapolates at this pose (its variance; before image 2.6 also its input range) */
   /* The radii around a recent compensated pose (a few cycles old) that hold
    * the measured pose with 95 % probability; 0 until the first is computed,
    * and without a variance block in the image. */

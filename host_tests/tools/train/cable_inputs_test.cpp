@@ -117,7 +117,9 @@ TEST(CableInputs, EvidenceKeepsTheResidualsWhereTheTipMovesWithThem) {
   model::ImageView view{};
   ASSERT_EQ(model::parse_image(with_residuals.image.data(), with_residuals.image.size(), view), model::ImageStatus::ok);
   EXPECT_EQ(view.encoding, model::InputEncoding::bend_vector_cable_fit);
-  EXPECT_EQ(view.version_minor, model::kImageVersionMinorCableFit);
+  // 2.4 for the encoding, 2.6 for the variance block's flag.
+  EXPECT_EQ(view.version_minor, model::kImageVersionMinorHeldOutThreshold);
+  EXPECT_GT(view.variance_rank, 0u);
   EXPECT_EQ(view.input_dims, 4);
   EXPECT_EQ(view.extra_inputs, 0);
 

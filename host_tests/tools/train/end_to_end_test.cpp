@@ -633,6 +633,20 @@ TEST(TrainEndToEnd, ASimulatedSequenceTrainsWithItsHysteresis) {
   EXPECT_LT(with_hysteresis, 0.4 * joints_only) << h.dump();
   EXPECT_DOUBLE_EQ(with_hysteresis, report.at("validation").at("compensated").at("position_mm").get<double>());
   EXPECT_TRUE(report.at("float32_fidelity_target_met").get<bool>());
+
+  // The radii, calibrated on held-out rows, hold on the other session, and
+  // the flag stays quiet on rows like the training rows, though the
+  // effective lengths' spread puts some of them outside the fitted rows'
+  // box (which flagged them before image 2.6).
+  const nlohmann::json& coverage = report.at("uncertainty").at("validation_coverage");
+  EXPECT_GE(coverage.at("r95_mm").get<double>(), 0.90) << report.at("uncertainty").dump();
+  EXPECT_LE(coverage.at("r95_mm").get<double>(), 0.98) << report.at("uncertainty").dump();
+  EXPECT_GE(coverage.at("r95_deg").get<double>(), 0.90) << report.at("uncertainty").dump();
+  EXPECT_LE(coverage.at("r95_deg").get<double>(), 0.98) << report.at("uncertainty").dump();
+  const nlohmann::json eval = cdcr_json("eval --model " + image + " --data " + test + " --json");
+  ASSERT_EQ(eval.at("n").get<int>(), 100);
+  EXPECT_LE(eval.at("extrapolating").get<int>(), 5) << eval.dump();
+  EXPECT_LT(eval.at("extrapolating").get<int>(), eval.at("outside_range").get<int>()) << eval.dump();
 }
 
 // Fewer training rows than identification needs: the joints-only model,

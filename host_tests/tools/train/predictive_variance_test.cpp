@@ -4,6 +4,7 @@
 // the 95 % radius against Monte Carlo samples; the board's float path
 // (model::GpUncertainty on a written and parsed image) against the
 // trainer's double evaluation; and what the parser refuses in the block.
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
@@ -154,7 +155,7 @@ TEST(PredictiveVariance, TheBoardsFloatPathMatchesTheTrainer) {
   const std::vector<std::uint8_t> image = image_with_variance(m);
   model::ImageView view{};
   ASSERT_EQ(model::parse_image(image.data(), image.size(), view), model::ImageStatus::ok);
-  EXPECT_EQ(view.version_minor, 1);
+  EXPECT_EQ(view.version_minor, model::kImageVersionMinorHeldOutThreshold);
   ASSERT_EQ(view.variance_rank, 24u);
   model::GpCorrection<float, double> correction;
   model::GpUncertainty<float> board;
@@ -204,7 +205,8 @@ TEST(PredictiveVariance, TheBoardsFloatPathMatchesTheTrainer) {
     bool outside = false;
     for (int d = 0; d < 4; ++d) outside = outside || x(i, d) < m.input_min[d] || x(i, d) > m.input_max[d];
     EXPECT_EQ(u.outside_range, outside) << "query " << i;
-    EXPECT_EQ(u.extrapolating, outside || u.latent_share > 0.3f) << "query " << i;
+    // From 2.6 the share alone flags; the range is reported.
+    EXPECT_EQ(u.extrapolating, u.latent_share > 0.3f) << "query " << i;
     if (!outside && u.latent_share > 0.3f) ++flagged_by_variance;
   }
   static_cast<void>(flagged_by_variance);
@@ -268,6 +270,109 @@ TEST(PredictiveVariance, ModelsWithOwnKernelsPerOutputGetNoFactor) {
   TrainedModel m = make_model(30, 13);
   m.noise_variance[4] = 0.05;
   EXPECT_THROW(fit_variance_factor(m, m.inputs, kernel_coordinates(m, m.inputs)), std::invalid_argument);
+}
+
+// The same image as a 2.5 image: the fitted rows' range flags as it did
+// when that image was written, beside the share.
+TEST(PredictiveVariance, ImagesBefore26FlagOutsideTheRangeToo) {
+  TrainedModel m = make_model(120, 8);
+  m.variance = fit_variance_factor(m, m.inputs, variance_points(m, m.inputs, 24, 2));
+  const float threshold = 0.8f;
+  m.variance.extrapolation_variance = threshold;
+  const std::vector<std::uint8_t> image = image_with_variance(m);
+  const std::uint16_t minor = model::kImageVersionMinorHeldOutThreshold - 1;
+  const std::vector<std::uint8_t> older = resealed(image, 6, &minor, sizeof minor);
+  model::ImageView view{};
+  model::ImageView older_view{};
+  ASSERT_EQ(model::parse_image(image.data(), image.size(), view), model::ImageStatus::ok);
+  ASSERT_EQ(model::parse_image(older.data(), older.size(), older_view), model::ImageStatus::ok);
+  model::GpUncertainty<float> board;
+  model::GpUncertainty<float> older_board;
+  ASSERT_EQ(board.bind(view), model::Status::ok);
+  ASSERT_EQ(older_board.bind(older_view), model::Status::ok);
+  EXPECT_FALSE(board.range_flags());
+  EXPECT_TRUE(older_board.range_flags());
+
+  const Eigen::MatrixXd z = kernel_coordinates(m, queries(60, 0.35, 9));
+  int outside_within_share = 0;
+  for (int i = 0; i < z.rows(); ++i) {
+    float zf[4];
+    for (int d = 0; d < 4; ++d) zf[d] = static_cast<float>(z(i, d));
+    const Eigen::Vector3f tip(0.0f, 0.0f, 300.0f);
+    const model::PoseUncertainty<float> u = board.evaluate(zf, tip);
+    const model::PoseUncertainty<float> old = older_board.evaluate(zf, tip);
+    EXPECT_EQ(old.latent_share, u.latent_share);
+    EXPECT_EQ(old.outside_range, u.outside_range);
+    EXPECT_EQ(old.extrapolating, u.outside_range || u.latent_share > threshold) << "query " << i;
+    EXPECT_EQ(u.extrapolating, u.latent_share > threshold) << "query " << i;
+    if (u.outside_range && !u.extrapolating) ++outside_within_share;
+  }
+  EXPECT_GT(outside_within_share, 0) << "no query tells the rules apart";
+}
+
+// Against references outside the Sherman-Morrison update: with a point at
+// every row, the factor is the exact GP and the share with a row left out
+// is the dense formula on the other rows; with fewer points, it is the
+// factor fitted again without the row.
+TEST(PredictiveVariance, TheHeldOutShareIsTheFactorWithoutTheRow) {
+  TrainedModel m = make_model(40, 21);
+  const Eigen::MatrixXd z = kernel_coordinates(m, m.inputs);
+  m.variance = fit_variance_factor(m, m.inputs, z);
+  const Eigen::VectorXd held_out = held_out_latent_share(m, m.inputs);
+  const Eigen::VectorXd in_sample = latent_share(m.variance, z);
+  for (int i = 0; i < m.training_points(); ++i) {
+    TrainedModel without = m;
+    without.inputs.resize(m.training_points() - 1, 4);
+    for (int j = 0, k = 0; j < m.training_points(); ++j) {
+      if (j != i) without.inputs.row(k++) = m.inputs.row(j);
+    }
+    EXPECT_NEAR(held_out[i], dense_share(without, m.inputs.row(i).transpose()), 1e-6) << "row " << i;
+    EXPECT_GT(held_out[i], in_sample[i]) << "row " << i;
+  }
+
+  TrainedModel sparse = make_model(60, 22);
+  const Eigen::MatrixXd points = variance_points(sparse, sparse.inputs, 12, 3);
+  sparse.variance = fit_variance_factor(sparse, sparse.inputs, points);
+  const Eigen::VectorXd sparse_held_out = held_out_latent_share(sparse, sparse.inputs);
+  for (int i = 0; i < sparse.training_points(); i += 7) {
+    Eigen::MatrixXd rows(sparse.training_points() - 1, 4);
+    for (int j = 0, k = 0; j < sparse.training_points(); ++j) {
+      if (j != i) rows.row(k++) = sparse.inputs.row(j);
+    }
+    const VarianceFactor refitted = fit_variance_factor(sparse, rows, points);
+    const Eigen::VectorXd share = latent_share(refitted, kernel_coordinates(sparse, sparse.inputs.row(i)));
+    EXPECT_NEAR(sparse_held_out[i], share[0], 1e-8) << "row " << i;
+  }
+}
+
+// Twice the 99th percentile of the held-out shares: above every fitted
+// row's, below the prior far from the data; halfway to the prior where
+// twice would reach it.
+TEST(PredictiveVariance, TheThresholdSitsAboveTheHeldOutShares) {
+  TrainedModel m = make_model(200, 23);
+  m.length_scales *= 4.0;  // smooth: the data leave little unknown
+  m.variance = fit_variance_factor(m, m.inputs, variance_points(m, m.inputs, 32, 4));
+  const Eigen::VectorXd held_out = held_out_latent_share(m, m.inputs);
+  const double threshold = extrapolation_threshold(m, m.inputs);
+  std::vector<double> sorted(held_out.data(), held_out.data() + held_out.size());
+  std::sort(sorted.begin(), sorted.end());
+  const double p99 = sorted[static_cast<std::size_t>(0.99 * 199)];
+  ASSERT_LT(p99, 0.2);
+  EXPECT_DOUBLE_EQ(threshold, 2.0 * p99);
+  const Eigen::MatrixXd far = Eigen::MatrixXd::Constant(1, 4, 3.0);
+  EXPECT_GT(latent_share(m.variance, kernel_coordinates(m, far))[0], threshold);
+
+  // Two variance points for rows spread over about two length scales: much
+  // of the prior stays unknown at the rows.
+  TrainedModel vague = make_model(200, 24);
+  vague.length_scales *= 2.0;
+  vague.variance = fit_variance_factor(vague, vague.inputs, variance_points(vague, vague.inputs, 2, 4));
+  Eigen::VectorXd vague_share = held_out_latent_share(vague, vague.inputs);
+  std::sort(vague_share.data(), vague_share.data() + vague_share.size());
+  const double vague_p99 = vague_share[static_cast<Eigen::Index>(0.99 * 199)];
+  ASSERT_GT(vague_p99, 1.0 / 3.0);
+  ASSERT_LT(vague_p99, 0.9);
+  EXPECT_DOUBLE_EQ(extrapolation_threshold(vague, vague.inputs), 0.5 * (1.0 + vague_p99));
 }
 
 }  // namespace

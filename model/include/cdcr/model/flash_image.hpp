@@ -43,6 +43,12 @@ inline constexpr std::uint16_t kImageVersionMinorCableFit = 4;
 // 2.5: the history input encodings (where each cable last moved, from the
 // hysteresis block's last operator). Written only for a model that takes them.
 inline constexpr std::uint16_t kImageVersionMinorHistory = 5;
+// 2.6: the variance block's extrapolation_variance alone flags a query as
+// extrapolating (a threshold on the latent share, calibrated on held-out
+// rows); the fitted rows' range is still reported but no longer flags. In
+// older images, and without a variance block, the range flags as before.
+// Written for every image with a variance block.
+inline constexpr std::uint16_t kImageVersionMinorHeldOutThreshold = 6;
 inline constexpr std::uint16_t kImageOldestVersionMajor = 1;  // still read: deployed boards carry v1 images
 inline constexpr std::uint32_t kImageHeaderSize = 64;
 inline constexpr std::uint32_t kImageBlockAlignment = 8;

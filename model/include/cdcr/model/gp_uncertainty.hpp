@@ -42,7 +42,7 @@ struct PoseUncertainty {
   S r95_deg = S(0);
   S latent_share = S(0);       // latent variance / signal variance, 0 (known) to 1 (prior)
   bool outside_range = false;  // some input beyond the range of the rows the model was fitted on
-  bool extrapolating = false;  // outside_range, or latent_share above the image's threshold
+  bool extrapolating = false;  // latent_share above the image's threshold, or (before 2.6) outside_range
 };
 
 // The radius of the ball around 0 that holds 95 % of N(0, S), from
@@ -123,6 +123,11 @@ class GpUncertainty {
       }
     }
     rank_ = static_cast<int>(image.variance_rank);
+    // A box around the fitted rows is too tight where the inputs spread
+    // with the cables' state (the hysteresis' lag, the history): rows that
+    // repeat a visited command fall just outside it. From 2.6 the latent
+    // share, the data's density in the kernel's own metric, decides alone.
+    range_flags_ = rank_ == 0 || image.version_major < 2 || image.version_minor < kImageVersionMinorHeldOutThreshold;
     if (rank_ > 0) {
       points_ = image.variance_points;
       inducing_factor_ = image.variance_inducing_factor;
@@ -228,7 +233,7 @@ class GpUncertainty {
   PoseUncertainty<S> evaluation_result(const Evaluation& e) const {
     PoseUncertainty<S> result;
     result.outside_range = e.outside_range;
-    result.extrapolating = e.outside_range;
+    result.extrapolating = range_flags_ && e.outside_range;
     if (rank_ == 0) return result;
     const S share = S(1) - e.known + e.recovered;
     result.latent_share = share < S(0) ? S(0) : (share > S(1) ? S(1) : share);
@@ -241,6 +246,10 @@ class GpUncertainty {
     result.r95_deg *= orientation_scale_;
     return result;
   }
+
+  // Whether a query outside the fitted rows' range extrapolates by that
+  // alone (images before 2.6, or without a variance block).
+  bool range_flags() const { return range_flags_; }
 
   bool outside_range(const S* z) const {
     if (!has_range_) return false;
@@ -265,6 +274,7 @@ class GpUncertainty {
   int dims_ = 0;
   int rank_ = 0;
   bool has_range_ = false;
+  bool range_flags_ = true;
   S range_min_[MaxInputs] = {};
   S range_max_[MaxInputs] = {};
   const float* points_ = nullptr;

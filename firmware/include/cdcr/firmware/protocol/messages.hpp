@@ -211,8 +211,9 @@ namespace pose_uncertainty {
 inline constexpr SignalSpec kR95Position{"R95_POSITION", 0, 16, false, 0.001, 0, 0, 65.535, "mm"};
 inline constexpr SignalSpec kR95Orientation{"R95_ORIENTATION", 16, 16, false, 0.001, 0, 0, 65.535, "deg"};
 inline constexpr SignalSpec kLatentShare{"LATENT_SHARE", 32, 8, false, 0.005, 0, 0, 1, ""};
-// Bit 0: extrapolating (outside the fitted input range, or latent share
-// above the image's threshold); bit 1: outside the fitted input range.
+// Bit 0: extrapolating (latent share above the image's threshold; before
+// image 2.6 also outside the fitted input range); bit 1: outside the fitted
+// input range.
 inline constexpr SignalSpec kFlags{"FLAGS", 40, 8, false, 1, 0, 0, 255, ""};
 inline constexpr std::int64_t kFlagExtrapolating = 0x01;
 inline constexpr std::int64_t kFlagOutsideRange = 0x02;
@@ -231,8 +232,8 @@ inline constexpr SignalNote kSignalNotes[] = {
      "The model's latent variance at this pose as a share of its prior: near 0 inside the training data, 1 far from "
      "it."},
     {&kFlags,
-     "Bit 0: extrapolating (outside the fitted input range, or LATENT_SHARE above the image's threshold). Bit 1: "
-     "outside the fitted input range. The other bits are 0."},
+     "Bit 0: extrapolating (LATENT_SHARE above the image's threshold; with an image before 2.6 also outside the "
+     "fitted input range). Bit 1: outside the fitted input range. The other bits are 0."},
 };
 inline constexpr MessageNotes kNotes{
     &kMessage, "HOST",
