@@ -4,6 +4,7 @@
 
 #include "cdcr/model/chain.hpp"
 #include "cdcr/model/image_hysteresis.hpp"
+#include "cdcr/model/input_encoding.hpp"
 #include "cdcr/model/series.hpp"
 #include "cdcr/model/units.hpp"
 
@@ -30,6 +31,7 @@ void HysteresisTracker::bind(const RobotModel& model) {
   // (segment.hpp), a little less here so the kinematics' rounding allowance
   // is not needed.
   segments_ = model.geometry.segment_count;
+  within_limit_ = !model::takes_cable_residuals(model.image.encoding);
   for (int s = 0; s < segments_; ++s) {
     chord_limit_mm_[s] = Scalar(4) * model.geometry.segments[s].anchor_radius_mm *
                          std::sin(Scalar(0.5) * model.geometry.segments[s].theta_max_rad) * Scalar(0.999999);
@@ -46,6 +48,7 @@ const Cables& HysteresisTracker::track(const Cables& commanded_mm) {
   // The lag intervals only shrink: once known, the state stays known.
   if (!known_) known_ = state_.known();
   model::effective_lengths(state_, model_, effective_mm_, &uncertainty_mm_);
+  if (!within_limit_) return effective_mm_;
   for (int s = 0; s < segments_; ++s) {
     // The means of the two pairs stay.
     Scalar* e = effective_mm_.data() + 4 * s;

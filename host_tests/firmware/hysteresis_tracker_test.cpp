@@ -24,8 +24,10 @@ constexpr float kNarrowMm = 0.25f, kNarrowWeight = 0.25f;
 // Homing lags of our choosing (the check asks only |lag| <= width).
 constexpr float kWideHomingLagMm = 0.5f, kNarrowHomingLagMm = -0.25f;
 
-std::vector<std::uint8_t> image_with_play() {
-  training::TrainedModel trained = test_support::synthetic_trained_model({});
+std::vector<std::uint8_t> image_with_play(bool cable_residuals = false) {
+  test_support::SyntheticModelOptions options;
+  options.cable_residuals = cable_residuals;
+  training::TrainedModel trained = test_support::synthetic_trained_model(options);
   model::HysteresisModel<double>& h = trained.hysteresis;
   h.cables = kCables;
   h.operators = 2;
@@ -176,6 +178,39 @@ TEST(HysteresisTrackerWithoutPlay, AnUncompensatedModelLeavesTheLengthsAlone) {
   Cables setpoints = lengths;
   tracker.commanded_for(setpoints);
   EXPECT_EQ(setpoints, lengths);
+}
+
+// Cables beyond the bend limit: a joints-only model needs them pulled
+// within it (the runtime would refuse them), a model that takes the
+// cables' residuals reads them as the trainer did, unchanged.
+TEST(HysteresisTrackerLimit, OnlyAModelThatCannotReadBeyondTheLimitIsPulledWithinIt) {
+  for (const bool cable_residuals : {false, true}) {
+    SCOPED_TRACE(cable_residuals ? "cable-fit model" : "joints-only model");
+    const std::vector<std::uint8_t> image = image_with_play(cable_residuals);
+    RobotModel robot;
+    ASSERT_EQ(model::parse_image(image.data(), image.size(), robot.image), model::ImageStatus::ok);
+    ASSERT_EQ(model::geometry_from_image(robot.image, robot.geometry), model::Status::ok);
+    robot.compensated = true;
+    HysteresisTracker tracker;
+    tracker.bind(robot);
+    ASSERT_TRUE(tracker.active());
+    // Segment 1 bent twice as far as its chord allows, along l3 - l1; at
+    // power-up the lags' midpoints are 0, so the effective lengths are the
+    // commanded ones but for the pull.
+    const model::SegmentGeometry<float>& g = robot.geometry.segments[0];
+    const float limit = 4.0f * g.anchor_radius_mm * std::sin(0.5f * g.theta_max_rad);
+    Cables commanded = Cables::Constant(kCables, 100.0f);
+    commanded[0] = 100.0f - limit;
+    commanded[2] = 100.0f + limit;
+    const Cables effective = tracker.track(commanded);
+    if (cable_residuals) {
+      EXPECT_EQ(effective, commanded);
+    } else {
+      EXPECT_NEAR(effective[2] - effective[0], limit, 1e-3f * limit);
+      EXPECT_FLOAT_EQ(effective[0] + effective[2], 200.0f);
+      for (int c = 4; c < kCables; ++c) EXPECT_EQ(effective[c], commanded[c]);
+    }
+  }
 }
 
 }  // namespace

@@ -82,6 +82,10 @@ class HysteresisTracker {
   model::HysteresisState<Scalar> state_;
   int segments_ = 0;
   Scalar chord_limit_mm_[kMaxSegments] = {};  // per segment, the largest |(l3 - l1, l2 - l4)|
+  // A model that takes the cables' residuals reads effective lengths
+  // beyond the bend limit, as the trainer gave them; only others need them
+  // pulled within it.
+  bool within_limit_ = true;
   Cables effective_mm_;
   Cables uncertainty_mm_;
   // The covariance added at the pose of the variance in progress: position
