@@ -162,14 +162,20 @@ TEST_F(HysteresisTrackerTest, LengthsThatAreNotFiniteLeaveTheStateAlone) {
   EXPECT_EQ(tracker.uncertainty_mm(), before);
 }
 
+// The robot of `image` as the runtime binds it, and a tracker bound to it.
+void bind_robot(const std::vector<std::uint8_t>& image, bool compensated, RobotModel& robot,
+                HysteresisTracker& tracker) {
+  ASSERT_EQ(model::parse_image(image.data(), image.size(), robot.image), model::ImageStatus::ok);
+  ASSERT_EQ(model::geometry_from_image(robot.image, robot.geometry), model::Status::ok);
+  robot.compensated = compensated;
+  tracker.bind(robot);
+}
+
 TEST(HysteresisTrackerWithoutPlay, AnUncompensatedModelLeavesTheLengthsAlone) {
   const std::vector<std::uint8_t> image = image_with_play();
   RobotModel robot;
-  ASSERT_EQ(model::parse_image(image.data(), image.size(), robot.image), model::ImageStatus::ok);
-  ASSERT_EQ(model::geometry_from_image(robot.image, robot.geometry), model::Status::ok);
-  robot.compensated = false;
   HysteresisTracker tracker;
-  tracker.bind(robot);
+  ASSERT_NO_FATAL_FAILURE(bind_robot(image, false, robot, tracker));
   EXPECT_FALSE(tracker.active());
   EXPECT_TRUE(tracker.known());
   EXPECT_EQ(hysteresis_units(tracker), 0u);
@@ -188,11 +194,8 @@ TEST(HysteresisTrackerLimit, OnlyAModelThatCannotReadBeyondTheLimitIsPulledWithi
     SCOPED_TRACE(cable_residuals ? "cable-fit model" : "joints-only model");
     const std::vector<std::uint8_t> image = image_with_play(cable_residuals);
     RobotModel robot;
-    ASSERT_EQ(model::parse_image(image.data(), image.size(), robot.image), model::ImageStatus::ok);
-    ASSERT_EQ(model::geometry_from_image(robot.image, robot.geometry), model::Status::ok);
-    robot.compensated = true;
     HysteresisTracker tracker;
-    tracker.bind(robot);
+    ASSERT_NO_FATAL_FAILURE(bind_robot(image, true, robot, tracker));
     ASSERT_TRUE(tracker.active());
     // Segment 1 bent twice as far as its chord allows, along l3 - l1; at
     // power-up the lags' midpoints are 0, so the effective lengths are the

@@ -35,6 +35,31 @@ double signal_to_noise(const TrainedModel& model) {
   return model.signal_variance[0] / model.noise_variance[0];
 }
 
+// a = L_u^-1 r and b = L_c^-1 a at each column's query (z's rows): the
+// factor's two solves, column by column.
+struct FactorSolves {
+  Eigen::MatrixXd a, b;
+};
+FactorSolves factor_solves(const VarianceFactor& factor, const Eigen::MatrixXd& z) {
+  FactorSolves s;
+  s.a = factor.inducing_factor.triangularView<Eigen::Lower>().solve(unit_kernel(factor.points, z));
+  s.b = factor.posterior_factor.triangularView<Eigen::Lower>().solve(s.a);
+  return s;
+}
+
+// At most max_rows of rows 0..count-1, drawn at random (all of them, in
+// order, when there are no more).
+std::vector<int> sampled_rows(Eigen::Index count, int max_rows, std::uint64_t seed) {
+  std::vector<int> rows(static_cast<std::size_t>(count));
+  std::iota(rows.begin(), rows.end(), 0);
+  if (count > max_rows) {
+    std::mt19937_64 rng(seed);
+    std::shuffle(rows.begin(), rows.end(), rng);
+    rows.resize(static_cast<std::size_t>(max_rows));
+  }
+  return rows;
+}
+
 }  // namespace
 
 Eigen::MatrixXd kernel_coordinates(const TrainedModel& model, const Eigen::MatrixXd& inputs) {
@@ -83,11 +108,9 @@ VarianceFactor fit_variance_factor(const TrainedModel& model, const Eigen::Matri
 }
 
 Eigen::VectorXd latent_share(const VarianceFactor& factor, const Eigen::MatrixXd& z) {
-  const Eigen::MatrixXd a =
-      factor.inducing_factor.triangularView<Eigen::Lower>().solve(unit_kernel(factor.points, z));
-  const Eigen::MatrixXd b = factor.posterior_factor.triangularView<Eigen::Lower>().solve(a);
-  const Eigen::VectorXd share =
-      Eigen::VectorXd::Ones(z.rows()) - a.colwise().squaredNorm().transpose() + b.colwise().squaredNorm().transpose();
+  const FactorSolves s = factor_solves(factor, z);
+  const Eigen::VectorXd share = Eigen::VectorXd::Ones(z.rows()) - s.a.colwise().squaredNorm().transpose() +
+                                s.b.colwise().squaredNorm().transpose();
   return share.cwiseMax(0.0).cwiseMin(1.0);
 }
 
@@ -105,12 +128,9 @@ Eigen::VectorXd exact_latent_share(const TrainedModel& model, const Eigen::Matri
 }
 
 Eigen::VectorXd held_out_latent_share(const TrainedModel& model, const Eigen::MatrixXd& rows) {
-  const VarianceFactor& factor = model.variance;
   const double ratio = signal_to_noise(model);
   const Eigen::MatrixXd z = kernel_coordinates(model, rows);
-  const Eigen::MatrixXd a =
-      factor.inducing_factor.triangularView<Eigen::Lower>().solve(unit_kernel(factor.points, z));
-  const Eigen::MatrixXd b = factor.posterior_factor.triangularView<Eigen::Lower>().solve(a);
+  const auto [a, b] = factor_solves(model.variance, z);
   Eigen::VectorXd share(z.rows());
   for (Eigen::Index i = 0; i < z.rows(); ++i) {
     const double q = b.col(i).squaredNorm();
@@ -126,13 +146,7 @@ Eigen::VectorXd held_out_latent_share(const TrainedModel& model, const Eigen::Ma
 
 double extrapolation_threshold(const TrainedModel& model, const Eigen::MatrixXd& fitted_inputs, int max_rows,
                                std::uint64_t seed) {
-  std::vector<Eigen::Index> rows(static_cast<std::size_t>(fitted_inputs.rows()));
-  std::iota(rows.begin(), rows.end(), Eigen::Index{0});
-  if (fitted_inputs.rows() > max_rows) {
-    std::mt19937_64 rng(seed);
-    std::shuffle(rows.begin(), rows.end(), rng);
-    rows.resize(static_cast<std::size_t>(max_rows));
-  }
+  const std::vector<int> rows = sampled_rows(fitted_inputs.rows(), max_rows, seed);
   Eigen::VectorXd share = held_out_latent_share(model, fitted_inputs(rows, Eigen::all));
   std::sort(share.data(), share.data() + share.size());
   const double p99 = share[static_cast<Eigen::Index>(0.99 * static_cast<double>(share.size() - 1))];
@@ -146,14 +160,7 @@ double extrapolation_threshold(const TrainedModel& model, const Eigen::MatrixXd&
 RadiusCalibration calibrate_radii(const TrainedModel& model, const TrainingSet& set, double coverage, int max_rows,
                                   std::uint64_t seed) {
   const double ratio = signal_to_noise(model);
-  std::vector<int> rows(static_cast<std::size_t>(set.size()));
-  std::iota(rows.begin(), rows.end(), 0);
-  if (set.size() > max_rows) {
-    std::mt19937_64 rng(seed);
-    std::shuffle(rows.begin(), rows.end(), rng);
-    rows.resize(static_cast<std::size_t>(max_rows));
-  }
-  const TrainingSet sample = set.subset(rows);
+  const TrainingSet sample = set.subset(sampled_rows(set.size(), max_rows, seed));
   const Eigen::MatrixXd z = kernel_coordinates(model, sample.inputs);
   Eigen::MatrixXd k = unit_kernel(z, z);
   k.diagonal().array() += 1.0 / ratio;
