@@ -1,5 +1,5 @@
 #pragma once
-// What all four cables of a segment say, not only their two differences.
+// What all of a segment's cables say, not only their two differences.
 //
 // joints_from_cables (segment.hpp) reads the bend from l3 - l1 and l2 - l4
 // and ignores what the pairs' sums say. On a real robot they say a lot: a
@@ -17,12 +17,16 @@
 // is the linear one,
 //   m = mean(l),  v = ((l3 - l1)/2, (l2 - l4)/2),
 // so its bend is exactly today's (alpha = atan2(l2 - l4, l3 - l1), theta =
-// 2 asin(|v| / 2r)). What the fit leaves are the cable inputs the GP may take:
+// 2 asin(|v| / 2r)). Other layouts (three cables at 120 degrees, measured
+// angles) fit the same way with their own weights (geometry.hpp's
+// CableLayout). What the fit leaves are the cable inputs the GP may take:
 //   * the common mode, m - L s(theta): the cables' mean length against the
 //     arc's (negative when the backbone is compressed or all cables slack);
 //   * the pairs' imbalance, ((l1 + l3) - (l2 + l4)) / 2: one pair pulled
 //     against the other, the one thing four cables say that the fit's three
-//     parameters cannot (its residual is this value, +-1/2 per cable).
+//     parameters cannot (its residual is this value, +-1/2 per cable); with
+//     measured angles, n . l (CableLayout::imbalance_weights). Three cables
+//     leave nothing beyond (m, v): their imbalance is 0.
 // Cables that are exactly consistent give zeros (to rounding).
 //
 // The fit refuses nothing but impossible lengths (non-finite or not
@@ -32,6 +36,7 @@
 // the fit's: measured rows beyond it are data too.
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 
 #include "cdcr/model/geometry.hpp"
@@ -50,16 +55,27 @@ struct SegmentCableFit {
   bool beyond_reach = false;   // |l3 - l1, l2 - l4| > 4 r: theta set to pi
 };
 
-// The two residuals of a segment's cables at a bending angle theta.
-template <typename S>
-Vec2<S> segment_cable_residuals(const Vec4<S>& cables_mm, S backbone_length_mm, S theta_rad) {
-  const S mean = (cables_mm[0] + cables_mm[1] + cables_mm[2] + cables_mm[3]) / S(4);
-  return Vec2<S>(mean - backbone_length_mm * series::sinc(theta_rad / S(2)),
-                 ((cables_mm[0] + cables_mm[2]) - (cables_mm[1] + cables_mm[3])) / S(2));
+// n . l, the pairs (1, 3) and (2, 4) summed first as eq. (2)'s pairs are.
+template <typename S, typename Derived>
+S pair_imbalance(const CableLayout<S>& layout, const Eigen::MatrixBase<Derived>& cables_mm) {
+  if (layout.count != 4) return S(0);
+  const std::array<S, kMaxCablesPerSegment>& n = layout.imbalance_weights;
+  return (n[0] * cables_mm[0] + n[2] * cables_mm[2]) + (n[1] * cables_mm[1] + n[3] * cables_mm[3]);
 }
 
-template <typename S>
-Status fit_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry, SegmentCableFit<S>& fit) {
+// The two residuals of a segment's cables at a bending angle theta.
+template <typename S, typename Derived>
+Vec2<S> segment_cable_residuals(const Eigen::MatrixBase<Derived>& cables_mm, const SegmentGeometry<S>& geometry,
+                                S theta_rad) {
+  const CableLayout<S>& layout = geometry.cables;
+  const S mean = layout_sum(layout.mean_weights, cables_mm, layout.count);
+  return Vec2<S>(mean - geometry.backbone_length_mm * series::sinc(theta_rad / S(2)),
+                 pair_imbalance(layout, cables_mm));
+}
+
+template <typename S, typename Derived>
+Status fit_cables(const Eigen::MatrixBase<Derived>& cables_mm, const SegmentGeometry<S>& geometry,
+                  SegmentCableFit<S>& fit) {
   // The differences joints_from_cables reads, so consistent cables give the
   // same bits.
   const CableDifferences<S> d = cable_differences(cables_mm, geometry);
@@ -68,7 +84,7 @@ Status fit_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry, 
   result.beyond_reach = d.chord > d.reach;
   const S theta = S(2) * std::asin(std::min(d.chord / d.reach, S(1)));
   result.joints = SegmentJoints<S>{std::atan2(d.d24, d.d31), theta};
-  const Vec2<S> residuals = segment_cable_residuals(cables_mm, geometry.backbone_length_mm, theta);
+  const Vec2<S> residuals = segment_cable_residuals(cables_mm, geometry, theta);
   result.common_mode_mm = residuals[0];
   result.pair_imbalance_mm = residuals[1];
   fit = result;
@@ -79,14 +95,18 @@ Status fit_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry, 
 // inverse of fit_cables for theta < pi (a check of both, and how a
 // simulated robot's inconsistent cables are written down).
 template <typename S>
-Vec4<S> cables_from_fit(const SegmentCableFit<S>& fit, const SegmentGeometry<S>& geometry) {
+SegmentCables<S> cables_from_fit(const SegmentCableFit<S>& fit, const SegmentGeometry<S>& geometry) {
   const Vec2<S> b = bend_from_joints(fit.joints);
   const S s = series::sinc(fit.joints.theta_rad / S(2));
   const S mean = geometry.backbone_length_mm * s + fit.common_mode_mm;
   const S r = geometry.anchor_radius_mm * s;
-  const S half_imbalance = fit.pair_imbalance_mm / S(2);
-  return Vec4<S>(mean - r * b.x() + half_imbalance, mean + r * b.y() - half_imbalance,
-                 mean + r * b.x() + half_imbalance, mean - r * b.y() - half_imbalance);
+  const CableLayout<S>& layout = geometry.cables;
+  SegmentCables<S> cables(layout.count);
+  for (int j = 0; j < layout.count; ++j) {
+    cables[j] = mean - r * (b.x() * layout.anchor_x[j] + b.y() * layout.anchor_y[j]) +
+                fit.pair_imbalance_mm * layout.imbalance_weights[j];
+  }
+  return cables;
 }
 
 // A row is far from consistent with constant curvature when its fit leaves
@@ -115,13 +135,13 @@ template <typename S, int Max>
 Status fit_cables(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
                   JointVector<S, Max>& joints, CableResiduals<S, Max>& residuals, int* far_segments = nullptr) {
   if (const Status s = geometry.validate(); s != Status::ok) return s;
-  if (cables_mm.size() != 4 * geometry.segment_count) return Status::invalid_segment_count;
+  if (cables_mm.size() != geometry.cable_count()) return Status::invalid_segment_count;
   JointVector<S, Max> q(2 * geometry.segment_count);
   CableResiduals<S, Max> rho(2 * geometry.segment_count);
   int far = 0;
-  for (int i = 0; i < geometry.segment_count; ++i) {
+  for (int i = 0, first = 0; i < geometry.segment_count; first += geometry.segments[i].cables.count, ++i) {
     SegmentCableFit<S> fit;
-    const Vec4<S> segment_cables = cables_mm.template segment<4>(4 * i);
+    const auto segment_cables = cables_mm.segment(first, geometry.segments[i].cables.count);
     if (const Status s = fit_cables(segment_cables, geometry.segments[i], fit); s != Status::ok) return s;
     q[2 * i] = fit.joints.alpha_rad;
     q[2 * i + 1] = fit.joints.theta_rad;
@@ -141,9 +161,9 @@ template <typename S, int Max>
 void cable_residuals(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
                      const JointVector<S, Max>& joints, CableResiduals<S, Max>& residuals) {
   residuals.resize(2 * geometry.segment_count);
-  for (int i = 0; i < geometry.segment_count; ++i) {
+  for (int i = 0, first = 0; i < geometry.segment_count; first += geometry.segments[i].cables.count, ++i) {
     residuals.template segment<2>(2 * i) = segment_cable_residuals(
-        Vec4<S>(cables_mm.template segment<4>(4 * i)), geometry.segments[i].backbone_length_mm, joints[2 * i + 1]);
+        cables_mm.segment(first, geometry.segments[i].cables.count), geometry.segments[i], joints[2 * i + 1]);
   }
 }
 

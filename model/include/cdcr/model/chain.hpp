@@ -24,11 +24,11 @@ template <typename S, int Max>
 Status joints_from_cables(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,
                           JointVector<S, Max>& joints, S cable_resolution_mm = S(0)) {
   if (const Status s = geometry.validate(); s != Status::ok) return s;
-  if (cables_mm.size() != 4 * geometry.segment_count) return Status::invalid_segment_count;
+  if (cables_mm.size() != geometry.cable_count()) return Status::invalid_segment_count;
   JointVector<S, Max> result(2 * geometry.segment_count);
-  for (int i = 0; i < geometry.segment_count; ++i) {
+  for (int i = 0, first = 0; i < geometry.segment_count; first += geometry.segments[i].cables.count, ++i) {
     SegmentJoints<S> q;
-    const Vec4<S> segment_cables = cables_mm.template segment<4>(4 * i);
+    const auto segment_cables = cables_mm.segment(first, geometry.segments[i].cables.count);
     if (const Status s = joints_from_cables(segment_cables, geometry.segments[i], q, cable_resolution_mm);
         s != Status::ok) {
       return s;
@@ -54,14 +54,14 @@ template <typename S, int Max>
 Status cables_from_joints(const JointVector<S, Max>& joints, const RobotGeometry<S, Max>& geometry,
                           CableVector<S, Max>& cables_mm) {
   if (const Status s = check_joints(joints, geometry); s != Status::ok) return s;
-  CableVector<S, Max> result(4 * geometry.segment_count);
-  for (int i = 0; i < geometry.segment_count; ++i) {
-    Vec4<S> segment_cables;
+  CableVector<S, Max> result(geometry.cable_count());
+  for (int i = 0, first = 0; i < geometry.segment_count; first += geometry.segments[i].cables.count, ++i) {
+    SegmentCables<S> segment_cables;
     if (const Status s = cables_from_joints(segment_joints(joints, i), geometry.segments[i], segment_cables);
         s != Status::ok) {
       return s;
     }
-    result.template segment<4>(4 * i) = segment_cables;
+    result.segment(first, segment_cables.size()) = segment_cables;
   }
   cables_mm = result;
   return Status::ok;

@@ -292,17 +292,17 @@ Status homing_waypoints(const RobotGeometry<S, MaxSegments>& geometry, CableVect
                         CableVectorType& home_mm) {
   const int n = geometry.segment_count;
   if (n < 1 || n > MaxSegments) return Status::invalid_segment_count;
-  approach_mm.resize(4 * n);
-  home_mm.resize(4 * n);
-  for (int i = 0; i < n; ++i) {
-    Vec4<S> bent, straight;
+  approach_mm.resize(geometry.cable_count());
+  home_mm.resize(geometry.cable_count());
+  for (int i = 0, first = 0; i < n; first += geometry.segments[i].cables.count, ++i) {
+    SegmentCables<S> bent, straight;
     const Status bent_status = cables_from_joints(SegmentJoints<S>{S(kHomingAlphaRad), S(kHomingBendRad)},
                                                   geometry.segments[i], bent);
     if (bent_status != Status::ok) return bent_status;
     const Status straight_status = cables_from_joints(SegmentJoints<S>{S(0), S(0)}, geometry.segments[i], straight);
     if (straight_status != Status::ok) return straight_status;
-    approach_mm.template segment<4>(4 * i) = bent;
-    home_mm.template segment<4>(4 * i) = straight;
+    approach_mm.segment(first, bent.size()) = bent;
+    home_mm.segment(first, straight.size()) = straight;
   }
   return Status::ok;
 }

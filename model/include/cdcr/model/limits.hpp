@@ -30,8 +30,14 @@ inline constexpr int kCableResidualsPerSegment = 2;
 inline constexpr int kHistoryInputsPerSegment = 4;
 inline constexpr int kMaxInputs = max_model_inputs(kMaxSegments);
 
-// Cables of the largest robot, four per segment.
-inline constexpr int kMaxCables = 4 * kMaxSegments;
+// Cables of a segment: three (at 120 degrees, the fewest that read a bend
+// in any direction) or four (the paper's, at 90 degrees; the most a
+// CABLE_FEEDBACK frame carries).
+inline constexpr int kMinCablesPerSegment = 3;
+inline constexpr int kMaxCablesPerSegment = 4;
+
+// Cables of the largest robot.
+inline constexpr int kMaxCables = kMaxCablesPerSegment * kMaxSegments;
 
 // Play operators per cable a hysteresis model may hold (hysteresis.hpp).
 inline constexpr int kMaxHysteresisOperators = 4;

@@ -1,6 +1,7 @@
 #pragma once
-// One cable-driven segment (Section III-A): four cables -> (alpha, theta) ->
-// pose of the moving platform in the segment's base frame.
+// One cable-driven segment (Section III-A): its cables (the paper's four,
+// or three; geometry.hpp's CableLayout) -> (alpha, theta) -> pose of the
+// moving platform in the segment's base frame.
 //
 // Two coordinates describe the same bend:
 //   * the paper's joint variables (alpha, theta): bending-plane angle and
@@ -39,27 +40,46 @@ SegmentJoints<S> joints_from_bend(const Vec2<S>& b) {
   return SegmentJoints<S>{std::atan2(b.y(), b.x()), b.norm()};
 }
 
-// What eqs. (3)-(5) read of a segment's cables: the differences l3 - l1 and
-// l2 - l4, and their chord. `status` is not ok for impossible lengths (or
-// geometry); the differences are then not computed.
+// What the least-squares fit of eq. (2) reads of a segment's cables
+// (geometry.hpp's CableLayout): the mean m and the chord vector D, for the
+// paper's four cables (l3 - l1, l2 - l4), and D's length. `status` is not ok
+// for impossible lengths (or geometry, or a cable count other than the
+// layout's); nothing is computed then.
 template <typename S>
 struct CableDifferences {
   Status status = Status::ok;
-  S d31 = S(0), d24 = S(0), chord = S(0), reach = S(0);  // reach = 4 r, the largest chord
+  S mean = S(0);
+  S d31 = S(0), d24 = S(0), chord = S(0), reach = S(0);  // D = (d31, d24); reach = 4 r, the largest chord
 };
 
-template <typename S>
-CableDifferences<S> cable_differences(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry) {
+// sum_j w_j l_j over the layout's cables, in cable order (with the paper's
+// weights, 0, +-1 and 1/4, every product is exact and the sums are those of
+// eqs. (3)-(5)).
+template <typename S, typename Derived>
+S layout_sum(const std::array<S, kMaxCablesPerSegment>& weights, const Eigen::MatrixBase<Derived>& cables_mm,
+             int count) {
+  S sum = weights[0] * cables_mm[0];
+  for (int j = 1; j < count; ++j) sum += weights[j] * cables_mm[j];
+  return sum;
+}
+
+template <typename S, typename Derived>
+CableDifferences<S> cable_differences(const Eigen::MatrixBase<Derived>& cables_mm,
+                                      const SegmentGeometry<S>& geometry) {
   CableDifferences<S> d;
+  const CableLayout<S>& layout = geometry.cables;
   if (const Status s = geometry.validate(); s != Status::ok) {
     d.status = s;
+  } else if (cables_mm.size() != layout.count) {
+    d.status = Status::invalid_segment_count;
   } else if (!cables_mm.allFinite()) {
     d.status = Status::non_finite_input;
   } else if (!(cables_mm.minCoeff() > S(0))) {
     d.status = Status::cable_length_not_positive;
   } else {
-    d.d31 = cables_mm[2] - cables_mm[0];
-    d.d24 = cables_mm[1] - cables_mm[3];
+    d.mean = layout_sum(layout.mean_weights, cables_mm, layout.count);
+    d.d31 = layout_sum(layout.chord_x_weights, cables_mm, layout.count);
+    d.d24 = layout_sum(layout.chord_y_weights, cables_mm, layout.count);
     d.reach = S(4) * geometry.anchor_radius_mm;
     d.chord = std::hypot(d.d31, d.d24);
   }
@@ -67,13 +87,14 @@ CableDifferences<S> cable_differences(const Vec4<S>& cables_mm, const SegmentGeo
 }
 
 // Eqs. (2)-(5). alpha = atan2(l2 - l4, l3 - l1): eq. (4) as printed has the
-// opposite sign and loses the quadrant; this form reproduces Table 1.
+// opposite sign and loses the quadrant; this form reproduces Table 1. Any
+// layout: alpha = atan2(D_y, D_x), theta = 2 asin(|D| / 4r).
 // cable_resolution_mm: the step of the measured lengths (the drives report
 // in steps of the protocol's scale). A segment at its limit reads up to one
 // step of each cable difference beyond it; that is still the limit.
-template <typename S>
-Status joints_from_cables(const Vec4<S>& cables_mm, const SegmentGeometry<S>& geometry, SegmentJoints<S>& joints,
-                          S cable_resolution_mm = S(0)) {
+template <typename S, typename Derived>
+Status joints_from_cables(const Eigen::MatrixBase<Derived>& cables_mm, const SegmentGeometry<S>& geometry,
+                          SegmentJoints<S>& joints, S cable_resolution_mm = S(0)) {
   const CableDifferences<S> d = cable_differences(cables_mm, geometry);
   if (d.status != Status::ok) return d.status;
   const S reach = d.reach;
@@ -105,19 +126,33 @@ Status check_joints(const SegmentJoints<S>& joints, const SegmentGeometry<S>& ge
 }
 
 // Eq. (2): l_j = 2 (L/theta) sin(theta/2) - 2 r cos(alpha + (j-1) pi/2) sin(theta/2).
-// With s = sin(theta/2)/(theta/2) and b = (u, w) this is
+// With s = sin(theta/2)/(theta/2), b = (u, w) and the anchors' directions
+// e_j this is l_j = L s - r s (b . e_j): for the paper's four cables
 //   l = L s + r s * (-u, +w, +u, -w).
 template <typename S>
-Status cables_from_joints(const SegmentJoints<S>& joints, const SegmentGeometry<S>& geometry, Vec4<S>& cables_mm) {
+Status cables_from_joints(const SegmentJoints<S>& joints, const SegmentGeometry<S>& geometry,
+                          SegmentCables<S>& cables_mm) {
   if (const Status s = check_joints(joints, geometry); s != Status::ok) return s;
   const Vec2<S> b = bend_from_joints(joints);
   const S s = series::sinc(joints.theta_rad / S(2));
   const S mean = geometry.backbone_length_mm * s;
   const S r = geometry.anchor_radius_mm * s;
-  const Vec4<S> cables(mean - r * b.x(), mean + r * b.y(), mean + r * b.x(), mean - r * b.y());
+  const CableLayout<S>& layout = geometry.cables;
+  SegmentCables<S> cables(layout.count);
+  for (int j = 0; j < layout.count; ++j) cables[j] = mean - r * (b.x() * layout.anchor_x[j] + b.y() * layout.anchor_y[j]);
   if (!(cables.minCoeff() > S(0))) return Status::cable_length_not_positive;
   cables_mm = cables;
   return Status::ok;
+}
+
+// The same for a layout of four cables, into a fixed four-vector.
+template <typename S>
+Status cables_from_joints(const SegmentJoints<S>& joints, const SegmentGeometry<S>& geometry, Vec4<S>& cables_mm) {
+  if (geometry.cables.count != 4) return Status::invalid_segment_count;
+  SegmentCables<S> cables;
+  const Status s = cables_from_joints(joints, geometry, cables);
+  if (s == Status::ok) cables_mm = cables;
+  return s;
 }
 
 // Pose of the moving platform in the segment base frame, as the

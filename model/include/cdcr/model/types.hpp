@@ -23,9 +23,15 @@ template <typename S> using Twist = Eigen::Matrix<S, 6, 1>;
 template <typename S, int MaxSegments = kMaxSegments>
 using JointVector = Eigen::Matrix<S, Eigen::Dynamic, 1, Eigen::ColMajor, 2 * MaxSegments, 1>;
 
-// Cable lengths stacked as [l1_1, l1_2, l1_3, l1_4, l2_1, ...] in mm.
+// Cable lengths stacked segment by segment, [l1_1, l1_2, l1_3, l1_4, l2_1,
+// ...] in mm for the paper's four cables a segment (geometry.hpp's
+// RobotGeometry::first_cable() says where a segment's cables start).
 template <typename S, int MaxSegments = kMaxSegments>
-using CableVector = Eigen::Matrix<S, Eigen::Dynamic, 1, Eigen::ColMajor, 4 * MaxSegments, 1>;
+using CableVector = Eigen::Matrix<S, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxCablesPerSegment * MaxSegments, 1>;
+
+// One segment's cable lengths, 3 or 4 (mm).
+template <typename S>
+using SegmentCables = Eigen::Matrix<S, Eigen::Dynamic, 1, Eigen::ColMajor, kMaxCablesPerSegment, 1>;
 
 // d(twist)/d(joints): 6 rows, two columns per segment.
 template <typename S, int MaxSegments = kMaxSegments>
