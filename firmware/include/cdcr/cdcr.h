@@ -49,7 +49,7 @@ extern "C" {
 /* Bytes of cdcr_runtime: enough for every supported target (host, Cortex-M7,
  * Cortex-M4F), checked when the library is compiled;
  * cdcr_runtime_storage_size() says how much this build uses. */
-#define CDCR_RUNTIME_STORAGE_BYTES 12288u
+#define CDCR_RUNTIME_STORAGE_BYTES 16384u
 
 /* Opaque: the caller provides the storage, typically as a static variable. */
 typedef struct cdcr_runtime {
