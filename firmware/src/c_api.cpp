@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <new>
 
 #include "cdcr/callbacks/callback_hal.hpp"
@@ -29,10 +30,11 @@ double transmitted(const protocol::SignalSpec& signal, float value) { return pro
 class InputQueue final : public CycleInputs {
  public:
   bool has_room(int frames) const { return frames_ + frames <= kInputQueueDepth; }
-  void push_cables(int segment, const float* lengths_mm) {
+  // A segment of three cables: the fourth is not available, as on the bus.
+  void push_cables(int segment, const float* lengths_mm, int cables) {
     Input& input = push(Kind::cables, 1);
     input.segment = static_cast<std::uint8_t>(segment);
-    for (int k = 0; k < 4; ++k) input.values[k] = lengths_mm[k];
+    for (int k = 0; k < 4; ++k) input.values[k] = k < cables ? lengths_mm[k] : std::numeric_limits<float>::quiet_NaN();
   }
   void push_target(const cdcr_target& target) {
     const bool pose = target.mode == CDCR_TARGET_POSE;
@@ -51,7 +53,10 @@ class InputQueue final : public CycleInputs {
       const Input& input = inputs_[i];
       if (input.kind == Kind::cables) {
         Scalar lengths_mm[4];
-        for (int k = 0; k < 4; ++k) lengths_mm[k] = Scalar(protocol::cable_length_as_transmitted(input.values[k]));
+        for (int k = 0; k < 4; ++k) {
+          lengths_mm[k] = std::isnan(input.values[k]) ? input.values[k]
+                                                      : Scalar(protocol::cable_length_as_transmitted(input.values[k]));
+        }
         runtime.set_cable_lengths(input.segment, lengths_mm);
       } else if (input.kind == Kind::target) {
         runtime.set_target(target_request(input));
@@ -147,7 +152,11 @@ bool geometry_from_config(const cdcr_geometry& in, Geometry& out) {
     out = Geometry::prototype();
     return true;
   }
+  if (in.cables_per_segment != 0 && in.cables_per_segment != 3 && in.cables_per_segment != 4) return false;
   out = Geometry::uniform(in.segment_count, in.backbone_length_mm, in.anchor_radius_mm, in.theta_max_rad);
+  if (in.cables_per_segment == 3) {
+    for (int i = 0; i < out.segment_count; ++i) out.segments[i].cables = model::CableLayout<Scalar>::evenly_spaced(3);
+  }
   return out.validate() == model::Status::ok;
 }
 
@@ -189,16 +198,26 @@ cdcr_result cdcr_step(cdcr_runtime* runtime) {
   return CDCR_OK;
 }
 
-cdcr_result cdcr_set_segment_cable_lengths(cdcr_runtime* runtime, int segment, const float lengths_mm[4]) {
+cdcr_result cdcr_set_segment_cable_lengths(cdcr_runtime* runtime, int segment, const float* lengths_mm) {
   CRuntime* c = nullptr;
   if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
   if (lengths_mm == nullptr) return CDCR_ERROR_NULL_ARGUMENT;
   if (segment < 0 || segment >= c->runtime.geometry().segment_count) return CDCR_ERROR_INVALID_ARGUMENT;
-  for (int k = 0; k < 4; ++k) {
+  const int cables = c->runtime.geometry().segments[segment].cables.count;
+  for (int k = 0; k < cables; ++k) {
     if (!protocol::cable_length_encodable(lengths_mm[k])) return CDCR_ERROR_OUT_OF_RANGE;
   }
   if (!c->inputs.has_room(1)) return CDCR_ERROR_QUEUE_FULL;
-  c->inputs.push_cables(segment, lengths_mm);
+  c->inputs.push_cables(segment, lengths_mm, cables);
+  return CDCR_OK;
+}
+
+cdcr_result cdcr_get_segment_cables(const cdcr_runtime* runtime, int segment, int* cables) {
+  CRuntime* c = nullptr;
+  if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
+  if (cables == nullptr) return CDCR_ERROR_NULL_ARGUMENT;
+  if (segment < 0 || segment >= c->runtime.geometry().segment_count) return CDCR_ERROR_INVALID_ARGUMENT;
+  *cables = c->runtime.geometry().segments[segment].cables.count;
   return CDCR_OK;
 }
 
@@ -206,14 +225,15 @@ cdcr_result cdcr_set_cable_lengths(cdcr_runtime* runtime, const float* lengths_m
   CRuntime* c = nullptr;
   if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
   if (lengths_mm == nullptr) return CDCR_ERROR_NULL_ARGUMENT;
-  const int segments = c->runtime.geometry().segment_count;
-  if (count != size_t(4 * segments)) return CDCR_ERROR_INVALID_ARGUMENT;
+  const firmware::Geometry& geometry = c->runtime.geometry();
+  const int segments = geometry.segment_count;
+  if (count != size_t(geometry.cable_count())) return CDCR_ERROR_INVALID_ARGUMENT;
   // All or nothing: check every value and the room first.
   for (size_t i = 0; i < count; ++i) {
     if (!protocol::cable_length_encodable(lengths_mm[i])) return CDCR_ERROR_OUT_OF_RANGE;
   }
   if (!c->inputs.has_room(segments)) return CDCR_ERROR_QUEUE_FULL;
-  for (int s = 0; s < segments; ++s) cdcr_set_segment_cable_lengths(runtime, s, lengths_mm + 4 * s);
+  for (int s = 0; s < segments; ++s) cdcr_set_segment_cable_lengths(runtime, s, lengths_mm + geometry.first_cable(s));
   return CDCR_OK;
 }
 
@@ -292,7 +312,7 @@ cdcr_result cdcr_get_setpoints(const cdcr_runtime* runtime, cdcr_setpoints* setp
   const firmware::Runtime& rt = c->runtime;
   if (!rt.has_setpoints()) return CDCR_ERROR_NO_DATA;
   *setpoints = cdcr_setpoints{};
-  setpoints->cable_count = 4 * rt.geometry().segment_count;
+  setpoints->cable_count = rt.geometry().cable_count();
   for (int i = 0; i < setpoints->cable_count; ++i) setpoints->lengths_mm[i] = rt.setpoints_mm()[i];
   setpoints->count = rt.setpoints_published();
   return CDCR_OK;

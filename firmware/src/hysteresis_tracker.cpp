@@ -25,14 +25,14 @@ void add_outer(Scalar (&covariance)[6], const model::Vec3<Scalar>& v, Scalar var
 
 void HysteresisTracker::bind(const RobotModel& model) {
   active_ = model.compensated && model::hysteresis_from_image(model.image, model_) &&
-            model_.cables == 4 * model.geometry.segment_count;
+            model_.cables == model.geometry.cable_count();
   if (!active_) model_ = model::HysteresisModel<Scalar>{};
-  // l3 - l1 and l2 - l4 span a chord of at most 4 r sin(theta_max / 2)
-  // (segment.hpp), a little less here so the kinematics' rounding allowance
-  // is not needed.
-  segments_ = model.geometry.segment_count;
+  // The chord D (l3 - l1, l2 - l4 for the paper's cables) is at most
+  // 4 r sin(theta_max / 2) (segment.hpp), a little less here so the
+  // kinematics' rounding allowance is not needed.
+  geometry_ = model.geometry;
   within_limit_ = !model::takes_cable_residuals(model.image.encoding);
-  for (int s = 0; s < segments_; ++s) {
+  for (int s = 0; s < geometry_.segment_count; ++s) {
     chord_limit_mm_[s] = Scalar(4) * model.geometry.segments[s].anchor_radius_mm *
                          std::sin(Scalar(0.5) * model.geometry.segments[s].theta_max_rad) * Scalar(0.999999);
   }
@@ -49,19 +49,19 @@ const Cables& HysteresisTracker::track(const Cables& commanded_mm) {
   if (!known_) known_ = state_.known();
   model::effective_lengths(state_, model_, effective_mm_, &uncertainty_mm_);
   if (!within_limit_) return effective_mm_;
-  for (int s = 0; s < segments_; ++s) {
-    // The means of the two pairs stay.
-    Scalar* e = effective_mm_.data() + 4 * s;
+  for (int s = 0, first = 0; s < geometry_.segment_count; first += geometry_.segments[s].cables.count, ++s) {
+    // The chord D shrinks to the limit; what the fit leaves beyond D (the
+    // mean, the pairs' imbalance) stays: l_j = m - (D / 2) . e_j + rest.
+    const model::CableLayout<Scalar>& layout = geometry_.segments[s].cables;
+    Scalar* e = effective_mm_.data() + first;
+    const auto cables = effective_mm_.segment(first, layout.count);
+    const Scalar dx = model::layout_sum(layout.chord_x_weights, cables, layout.count);
+    const Scalar dy = model::layout_sum(layout.chord_y_weights, cables, layout.count);
+    const Scalar chord = std::hypot(dx, dy);
     const Scalar limit = chord_limit_mm_[s];
-    const Scalar chord = std::hypot(e[2] - e[0], e[1] - e[3]);
     if (!(chord > limit)) continue;
-    const Scalar scale = limit / chord;
-    const Scalar mean_13 = Scalar(0.5) * (e[0] + e[2]), half_31 = Scalar(0.5) * scale * (e[2] - e[0]);
-    const Scalar mean_24 = Scalar(0.5) * (e[1] + e[3]), half_24 = Scalar(0.5) * scale * (e[1] - e[3]);
-    e[0] = mean_13 - half_31;
-    e[2] = mean_13 + half_31;
-    e[1] = mean_24 + half_24;
-    e[3] = mean_24 - half_24;
+    const Scalar shrink = Scalar(0.5) * (Scalar(1) - limit / chord);
+    for (int j = 0; j < layout.count; ++j) e[j] += shrink * (dx * layout.anchor_x[j] + dy * layout.anchor_y[j]);
   }
   return effective_mm_;
 }
@@ -84,10 +84,11 @@ void HysteresisTracker::commanded_for(Cables& cables_mm) const {
   for (int c = 0; c < model_.cables; ++c) cables_mm[c] = model::commanded_for_effective(state_, model_, c, cables_mm[c]);
 }
 
-// The bend of segment i follows its cables as u = (l3 - l1) / (2 r s),
-// w = (l2 - l4) / (2 r s) with s = sinc(theta / 2) (segment.hpp), so each
-// bend coordinate's variance is that of a cable difference over (2 r s)^2,
-// the difference's the largest its bound u_a + u_b allows (the header says
+// The bend of segment i follows its cables as (u, w) = D / (2 r s) with
+// s = sinc(theta / 2) and D the layout's chord, sum_j W_j l_j (for the
+// paper's cables (l3 - l1, l2 - l4); segment.hpp), so each bend
+// coordinate's variance is that of a chord coordinate over (2 r s)^2, the
+// chord's the largest its bound sum_j |W_j| u_j allows (the header says
 // why); the spatial Jacobian in the bend moves the tip position p by
 // v + omega x p.
 void HysteresisTracker::begin_variance(const RobotModel& model, const PoseEstimate& estimate) {
@@ -99,12 +100,18 @@ void HysteresisTracker::begin_variance(const RobotModel& model, const PoseEstima
   model::Jacobian<Scalar, kMaxSegments> jacobian;
   model::tip_jacobian_bend(bend, geometry, tip, jacobian);
   for (int i = 0; i < 6; ++i) position_covariance_[i] = orientation_covariance_[i] = Scalar(0);
-  for (int s = 0; s < geometry.segment_count; ++s) {
+  for (int s = 0, first = 0; s < geometry.segment_count; first += geometry.segments[s].cables.count, ++s) {
     const Scalar lever = Scalar(2) * geometry.segments[s].anchor_radius_mm *
                          model::series::sinc(Scalar(0.5) * estimate.joints[2 * s + 1]);
-    const Scalar* u = uncertainty_mm_.data() + 4 * s;
-    const Scalar bend_variance[2] = {(u[0] + u[2]) * (u[0] + u[2]) / (lever * lever),
-                                     (u[1] + u[3]) * (u[1] + u[3]) / (lever * lever)};
+    const model::CableLayout<Scalar>& layout = geometry.segments[s].cables;
+    const Scalar* u = uncertainty_mm_.data() + first;
+    Scalar chord_bound[2] = {Scalar(0), Scalar(0)};
+    for (int j = 0; j < layout.count; ++j) {
+      chord_bound[0] += std::abs(layout.chord_x_weights[j]) * u[j];
+      chord_bound[1] += std::abs(layout.chord_y_weights[j]) * u[j];
+    }
+    const Scalar bend_variance[2] = {chord_bound[0] * chord_bound[0] / (lever * lever),
+                                     chord_bound[1] * chord_bound[1] / (lever * lever)};
     for (int k = 0; k < 2; ++k) {
       const model::Vec3<Scalar> v = jacobian.col(2 * s + k).head<3>();
       const model::Vec3<Scalar> omega = jacobian.col(2 * s + k).tail<3>();

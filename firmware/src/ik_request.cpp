@@ -275,8 +275,9 @@ bool IkRequest::set_setpoints(const Joints& joints) {
   // The joints are the effective lengths'; the drives are sent what makes them.
   if (hysteresis_ != nullptr) hysteresis_->commanded_for(cables);
   hal::CanFrame frames[kMaxSegments];
-  for (int s = 0; s < model_.geometry.segment_count; ++s) {
-    const protocol::CableSetpoint setpoint{s, {cables[4 * s], cables[4 * s + 1], cables[4 * s + 2], cables[4 * s + 3]}};
+  for (int s = 0, first = 0; s < model_.geometry.segment_count; first += model_.geometry.segments[s].cables.count, ++s) {
+    const auto setpoint = protocol::segment_cables_frame<protocol::CableSetpoint>(
+        s, cables, first, model_.geometry.segments[s].cables.count);
     if (!protocol::encode(setpoint, frames[s])) return false;
   }
   for (int s = 0; s < model_.geometry.segment_count; ++s) setpoint_frames_[s] = frames[s];

@@ -53,7 +53,7 @@ RuntimeState Runtime::init() {
   } else {
     payload_kg_ = model_.correction.payload_kg();
   }
-  latest_cables_mm_.setZero(4 * model_.geometry.segment_count);
+  latest_cables_mm_.setZero(model_.geometry.cable_count());
   ik_.configure();
   hysteresis_.bind(model_);
   scheduler_.configure({model_.compensated, model_.uncertainty.has_variance(),
@@ -149,9 +149,15 @@ void Runtime::handle_frame(const hal::CanFrame& frame) {
 // A segment's cables are used for a pose until they are stale (the same
 // limit as input_stale()), so segments reporting in different cycles still
 // make a set, and every cycle in RUN has a pose.
+// A segment of three cables reads the first three lengths.
 bool Runtime::set_cable_lengths(int segment, const Scalar (&lengths_mm)[4]) {
   if (segment < 0 || segment >= model_.geometry.segment_count) return false;
-  for (int k = 0; k < 4; ++k) latest_cables_mm_[4 * segment + k] = lengths_mm[k];
+  const int cables = model_.geometry.segments[segment].cables.count;
+  for (int k = 0; k < cables; ++k) {
+    if (std::isnan(lengths_mm[k])) return false;
+  }
+  const int first = model_.geometry.first_cable(segment);
+  for (int k = 0; k < cables; ++k) latest_cables_mm_[first + k] = lengths_mm[k];
   segment_updated_cycle_[segment] = cycle_;
   segment_seen_[segment] = true;
   fresh_cables_ = true;

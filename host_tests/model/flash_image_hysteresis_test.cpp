@@ -61,7 +61,7 @@ TEST_F(FlashImageHysteresis, AGoodBlockParsesIntoTheViewAndAModel) {
 
   HysteresisModel<float> from_image;
   ASSERT_TRUE(hysteresis_from_image(view, from_image));
-  EXPECT_EQ(check_hysteresis(from_image, 2), HysteresisCheck::ok);
+  EXPECT_EQ(check_hysteresis(from_image, 8), HysteresisCheck::ok);
   for (int c = 0; c < 8; ++c) {
     for (int k = 0; k < 2; ++k) {
       EXPECT_EQ(from_image.widths_mm[c][k], static_cast<float>(model.hysteresis.widths_mm[c][k]));

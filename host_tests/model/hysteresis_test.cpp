@@ -446,7 +446,7 @@ TEST(Hysteresis, HomingLeavesEachLagAtTheStopOfItsCablesDirectionHome) {
   CableVector<double, kMaxSegments> approach, home;
   ASSERT_EQ(homing_waypoints(g, approach, home), Status::ok);
   compute_homing_lags(m, approach, home);
-  EXPECT_EQ(check_hysteresis(m, 4), HysteresisCheck::ok);
+  EXPECT_EQ(check_hysteresis(m, 16), HysteresisCheck::ok);
   // On the way home (alpha = 45 deg, theta 0.1 -> 0) eq. (2) makes cable j
   // lengthen when cos(45 deg + (j - 1) 90 deg) > 0: cables 1 and 4 lengthen
   // (lag +r), cables 2 and 3 shorten (lag -r), in every segment.
@@ -502,51 +502,51 @@ TEST(Hysteresis, CheckRefusesModelsItCannotUse) {
     for (int c = 0; c < 8; ++c) m.homing_lag_mm[c][1] = -0.8;
     return m;
   };
-  EXPECT_EQ(check_hysteresis(good(), 2), HysteresisCheck::ok);
+  EXPECT_EQ(check_hysteresis(good(), 8), HysteresisCheck::ok);
   const double nan = std::numeric_limits<double>::quiet_NaN();
   const double inf = std::numeric_limits<double>::infinity();
 
-  EXPECT_EQ(check_hysteresis(good(), 3), HysteresisCheck::bad_counts);
+  EXPECT_EQ(check_hysteresis(good(), 12), HysteresisCheck::bad_counts);
   {
     HysteresisModel<double> m = good();
     m.operators = 0;
-    EXPECT_EQ(check_hysteresis(m, 2), HysteresisCheck::bad_counts);
+    EXPECT_EQ(check_hysteresis(m, 8), HysteresisCheck::bad_counts);
     m.operators = kMaxHysteresisOperators + 1;
-    EXPECT_EQ(check_hysteresis(m, 2), HysteresisCheck::bad_counts);
+    EXPECT_EQ(check_hysteresis(m, 8), HysteresisCheck::bad_counts);
   }
   {
     HysteresisModel<double> m = good();
     m.cables = kMaxCables + 4;
-    EXPECT_EQ(check_hysteresis(m, kMaxSegments + 1), HysteresisCheck::bad_counts);
+    EXPECT_EQ(check_hysteresis(m, 4 * (kMaxSegments + 1)), HysteresisCheck::bad_counts);
   }
   for (const double width : {nan, inf, -0.1, kMaxHysteresisWidthMm * 1.01}) {
     HysteresisModel<double> m = good();
     m.widths_mm[5][1] = width;
-    EXPECT_EQ(check_hysteresis(m, 2), HysteresisCheck::bad_width) << width;
+    EXPECT_EQ(check_hysteresis(m, 8), HysteresisCheck::bad_width) << width;
   }
   {
     HysteresisModel<double> m = good();
     m.widths_mm[5][1] = kMaxHysteresisWidthMm;
-    EXPECT_EQ(check_hysteresis(m, 2), HysteresisCheck::ok);
+    EXPECT_EQ(check_hysteresis(m, 8), HysteresisCheck::ok);
     m.widths_mm[5][0] = 0.0;
     m.homing_lag_mm[5][0] = 0.0;
-    EXPECT_EQ(check_hysteresis(m, 2), HysteresisCheck::ok);
+    EXPECT_EQ(check_hysteresis(m, 8), HysteresisCheck::ok);
   }
   for (const double weight : {nan, inf, -0.01, 0.51}) {
     HysteresisModel<double> m = good();
     m.weights[7][0] = weight;
-    EXPECT_EQ(check_hysteresis(m, 2), HysteresisCheck::bad_weight) << weight;
+    EXPECT_EQ(check_hysteresis(m, 8), HysteresisCheck::bad_weight) << weight;
   }
   for (const double lag : {nan, -0.81, 0.8000001}) {
     HysteresisModel<double> m = good();
     m.homing_lag_mm[3][1] = lag;
-    EXPECT_EQ(check_hysteresis(m, 2), HysteresisCheck::bad_homing_lag) << lag;
+    EXPECT_EQ(check_hysteresis(m, 8), HysteresisCheck::bad_homing_lag) << lag;
   }
   // Float weights that sum to 1 only up to their rounding are accepted.
   HysteresisModel<float> mf = make_model<float>(4, {0.1, 0.1, 0.1}, {0.1f, 0.2f, 0.7f});
   float sum = 0.0f;
   for (int k = 0; k < 3; ++k) sum += mf.weights[0][k];
-  EXPECT_EQ(check_hysteresis(mf, 1), HysteresisCheck::ok) << "sum " << sum;
+  EXPECT_EQ(check_hysteresis(mf, 4), HysteresisCheck::ok) << "sum " << sum;
 }
 
 }  // namespace

@@ -21,7 +21,7 @@ model::RobotGeometry<double> geometry_for(const dataset::Dataset& data, const Ge
     throw InputError(fmt::format("--segments is {} but the dataset has {} segments", *options.segment_count,
                                  data.segment_count));
   }
-  return make_geometry(options, data.segment_count);
+  return make_geometry(options, data.segment_count, data.segment_cables);
 }
 
 }  // namespace cdcr::cli

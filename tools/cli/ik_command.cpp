@@ -65,24 +65,26 @@ model::JointVector<double> read_initial_joints(const std::optional<std::vector<d
   return joints;
 }
 
-std::string format_text(const model::IkResult<double>& result, double orientation_error_deg) {
+std::string format_text(const model::IkResult<double>& result, double orientation_error_deg,
+                        const model::RobotGeometry<double>& geometry) {
   std::string text = fmt::format(
       "converged: {}\niterations: {}\nposition error: {:.6g} mm\norientation error: {:.6g} deg\n\n",
       result.converged() ? "yes" : "no", result.iterations, result.position_error_mm, orientation_error_deg);
   text += format_joints_table(result.joints);
   text += "\n";
-  text += format_cables_table(result.cables_mm);
+  text += format_cables_table(result.cables_mm, geometry);
   return text;
 }
 
-std::string format_json(const model::IkResult<double>& result, double orientation_error_deg) {
+std::string format_json(const model::IkResult<double>& result, double orientation_error_deg,
+                        const model::RobotGeometry<double>& geometry) {
   Json json;
   json["converged"] = result.converged();
   json["iterations"] = result.iterations;
   json["position_error_mm"] = result.position_error_mm;
   json["orientation_error_deg"] = orientation_error_deg;
   json["joints"] = joints_to_json(result.joints);
-  json["cables"] = cables_to_json(result.cables_mm);
+  json["cables"] = cables_to_json(result.cables_mm, geometry);
   return json.dump() + "\n";
 }
 
@@ -153,7 +155,8 @@ CommandOutput run_ik(const IkCommandOptions& options) {
 
   const double orientation_error_deg = result.orientation_error_rad * model::kDegreesPerRadian;
   CommandOutput output;
-  output.text = options.json ? format_json(result, orientation_error_deg) : format_text(result, orientation_error_deg);
+  output.text = options.json ? format_json(result, orientation_error_deg, geometry)
+                              : format_text(result, orientation_error_deg, geometry);
   if (!result.converged()) output.failure = describe_miss(result, target.orientation_given, orientation_error_deg);
   return output;
 }

@@ -299,6 +299,12 @@ void describe_unfailed(ImageCheck& check, const Findings& findings, const ImageR
                          r.compliance->ratios.size()));
       }
       return;
+    case ImageCheckId::cables:
+      pass(r.cables ? fmt::format("{} segments: 3 or 4 cables each, angles finite, anchors that read a bend, the inputs "
+                                  "and hysteresis cables they imply",
+                                  r.cables->size())
+                    : std::string("no cables block: four cables at 90 degrees a segment"));
+      return;
     case ImageCheckId::fitted_rows:
       if (r.fitted_rows && *r.fitted_rows == h.training_points) {
         pass(fmt::format("{} rows, the training points", *r.fitted_rows));
@@ -366,6 +372,8 @@ model::ImageDims declared_dims(const ImageHeaderFields& h) {
   dims.extra_inputs = v1 ? 0 : h.extra_inputs;
   dims.hysteresis_floats = model::image_hysteresis_floats(h.hysteresis_cables, h.hysteresis_operators);
   dims.compliance_floats = model::image_compliance_floats(h.compliance_segments);
+  dims.cables_floats =
+      model::image_has_cables_block(h.version_major, h.version_minor) ? model::image_cables_floats(h.segment_count) : 0;
   return dims;
 }
 
@@ -390,11 +398,32 @@ void read_blocks(ImageReport& r, const std::uint8_t* bytes, std::size_t size) {
     return (bytes_of_block + model::kImageBlockAlignment - 1) / model::kImageBlockAlignment *
            model::kImageBlockAlignment;
   };
-  // The compliance block (v2.3) lies just before the metadata.
+  // The cables block (v2.7) lies just before the metadata.
+  const std::uint64_t cables_bytes = model::image_block_bytes(model::ImageBlockId::cables, dims);
+  const std::uint64_t cables_span = span(cables_bytes);
+  const std::uint64_t cables_at = cables_bytes > 0 && h.metadata_offset >= cables_span
+                                      ? h.metadata_offset - cables_span
+                                      : h.metadata_offset;
+  if (cables_at != h.metadata_offset) {
+    const bool readable = inside(size, cables_at, cables_bytes);
+    r.blocks.insert(r.blocks.end() - 1, {"cables", cables_at, cables_bytes, readable});
+    if (readable) {
+      const std::vector<float> values = read_floats(bytes, cables_at, cables_bytes / 4);
+      std::vector<ImageSegmentCables> segments(h.segment_count);
+      for (std::size_t i = 0; i < segments.size(); ++i) {
+        const float* segment = values.data() + i * model::image_cables_field::per_segment;
+        segments[i].count = segment[model::image_cables_field::count];
+        std::copy(segment + model::image_cables_field::angles, segment + model::image_cables_field::per_segment,
+                  segments[i].angles_rad.begin());
+      }
+      r.cables = std::move(segments);
+    }
+  }
+  // The compliance block (v2.3) lies before it.
   const std::uint64_t compliance_bytes = model::image_block_bytes(model::ImageBlockId::compliance, dims);
   const std::uint64_t compliance_span = span(compliance_bytes);
-  if (compliance_bytes > 0 && h.metadata_offset >= compliance_span) {
-    const std::uint64_t at = h.metadata_offset - compliance_span;
+  if (compliance_bytes > 0 && cables_at >= compliance_span) {
+    const std::uint64_t at = cables_at - compliance_span;
     const bool readable = inside(size, at, compliance_bytes);
     r.blocks.insert(r.blocks.end() - 1, {"compliance", at, compliance_bytes, readable});
     if (readable) {
@@ -411,9 +440,8 @@ void read_blocks(ImageReport& r, const std::uint8_t* bytes, std::size_t size) {
   // The hysteresis block (v2.2) lies before them.
   const std::uint64_t hysteresis_bytes = model::image_block_bytes(model::ImageBlockId::hysteresis, dims);
   const std::uint64_t hysteresis_span = span(hysteresis_bytes);
-  const std::uint64_t hysteresis_end = compliance_bytes > 0 && h.metadata_offset >= compliance_span
-                                           ? h.metadata_offset - compliance_span
-                                           : h.metadata_offset;
+  const std::uint64_t hysteresis_end =
+      compliance_bytes > 0 && cables_at >= compliance_span ? cables_at - compliance_span : cables_at;
   if (hysteresis_bytes > 0 && hysteresis_end >= hysteresis_span) {
     const std::uint64_t at = hysteresis_end - hysteresis_span;
     const bool readable = inside(size, at, hysteresis_bytes);

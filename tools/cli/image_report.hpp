@@ -84,6 +84,12 @@ struct ImageHysteresis {
   std::vector<float> widths_mm, weights, homing_lags_mm;
 };
 
+// The cables block (v2.7): a segment's cables and their anchor angles.
+struct ImageSegmentCables {
+  float count = 0;
+  std::array<float, 4> angles_rad{};
+};
+
 // The compliance block (v2.3).
 struct ImageCompliance {
   std::array<float, 3> weighted_gravity{};  // rad per kg mm, base frame
@@ -119,6 +125,7 @@ struct ImageReport {
   std::optional<float> max_abs_alpha;
   std::optional<ImageHysteresis> hysteresis;  // a v2.2 image's block, when it lies inside the file
   std::optional<ImageCompliance> compliance;  // a v2.3 image's block, when it lies inside the file
+  std::optional<std::vector<ImageSegmentCables>> cables;  // a v2.7 image's block, when it lies inside the file
   std::optional<ImageMetadata> metadata;
   // Data rows the model was fitted on: the metadata's for v2, the training
   // points for v1 (whose images carry exactly the rows they were fitted on).

@@ -151,6 +151,18 @@ void add_geometry_and_parameters_text(std::string& t, const ImageReport& r) {
     }
     if (r.geometry->size() > kMaxListedRows) t += fmt::format("  ({} more not listed)\n", r.geometry->size() - kMaxListedRows);
   }
+  if (r.cables) {
+    // Without the block, every segment has the paper's four at 0, -90, -180 and -270 degrees.
+    t += "cables (anchor angles in the segment's base frame, deg)\n";
+    for (std::size_t s = 0; s < r.cables->size() && s < kMaxListedRows; ++s) {
+      const ImageSegmentCables& c = (*r.cables)[s];
+      std::string angles;
+      for (int j = 0; j < 4 && j < c.count; ++j) {
+        angles += fmt::format("{}{:.2f}", j > 0 ? ", " : "", c.angles_rad[j] * 57.29577951308232);
+      }
+      t += fmt::format("  {:<9}{} cables at {}\n", s + 1, c.count, angles);
+    }
+  }
 
   if (r.parameters) {
     const ImageParameters& p = *r.parameters;
@@ -260,6 +272,9 @@ void add_metadata_and_checks_text(std::string& t, const ImageReport& r) {
     // Likewise without a compliance block before v2.3.
     const bool no_compliance = !r.header || r.header->compliance_segments == 0;
     if (c.id == model::ImageCheckId::compliance && no_compliance && c.result != CheckResult::failed) continue;
+    // And without a cables block before v2.7.
+    const bool no_cables = !r.header || !model::image_has_cables_block(r.header->version_major, r.header->version_minor);
+    if (c.id == model::ImageCheckId::cables && no_cables && c.result != CheckResult::failed) continue;
     std::string line = fmt::format("  {:<12}{:<13}{}", c.name, result_text(c.result), c.detail);
     while (line.back() == ' ') line.pop_back();
     t += line + "\n";
@@ -367,6 +382,17 @@ void add_model_json(Json& j, const ImageReport& r) {
     j["geometry"] = segments;
   } else {
     j["geometry"] = nullptr;
+  }
+  if (r.cables) {
+    Json segments = Json::array();
+    for (const ImageSegmentCables& c : *r.cables) {
+      Json angles = Json::array();
+      for (int j = 0; j < 4 && j < c.count; ++j) angles.push_back(float_json(c.angles_rad[j]));
+      segments.push_back({{"count", float_json(c.count)}, {"angles_rad", angles}});
+    }
+    j["cables"] = segments;
+  } else {
+    j["cables"] = nullptr;
   }
 
   if (r.parameters) {

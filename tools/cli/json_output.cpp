@@ -10,11 +10,13 @@ Json joints_to_json(const model::JointVector<double>& joints) {
   return segments;
 }
 
-Json cables_to_json(const model::CableVector<double>& cables_mm) {
+Json cables_to_json(const model::CableVector<double>& cables_mm, const model::RobotGeometry<double>& geometry) {
   Json segments = Json::array();
-  for (Eigen::Index i = 0; i < cables_mm.size() / 4; ++i) {
-    segments.push_back(
-        Json::array({cables_mm[4 * i], cables_mm[4 * i + 1], cables_mm[4 * i + 2], cables_mm[4 * i + 3]}));
+  for (int i = 0; i < geometry.segment_count; ++i) {
+    Json segment = Json::array();
+    const int first = geometry.first_cable(i);
+    for (int j = 0; j < geometry.segments[i].cables.count; ++j) segment.push_back(cables_mm[first + j]);
+    segments.push_back(segment);
   }
   return segments;
 }

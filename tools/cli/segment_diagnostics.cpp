@@ -9,16 +9,21 @@
 namespace cdcr::cli {
 namespace {
 
-// The cable whose value is the first to break the rule, numbered 1..4.
+// The cable whose value is the first to break the rule, numbered from 1.
 template <typename Predicate>
-int first_cable(const model::Vec4<double>& cables_mm, Predicate predicate) {
-  for (int j = 0; j < 4; ++j) {
+int first_cable(const model::SegmentCables<double>& cables_mm, Predicate predicate) {
+  for (int j = 0; j < cables_mm.size(); ++j) {
     if (predicate(cables_mm[j])) return j + 1;
   }
   return 1;
 }
 
-std::string describe_difference(const model::Vec4<double>& cables_mm, double reach_mm) {
+std::string describe_difference(const model::SegmentCables<double>& cables_mm,
+                                const model::SegmentGeometry<double>& geometry, double reach_mm) {
+  if (geometry.cables != model::CableLayout<double>{}) {
+    const model::CableDifferences<double> d = model::cable_differences(cables_mm, geometry);
+    return fmt::format("the chord of the cables' fit, {:g} mm > {:g} mm", d.chord, reach_mm);
+  }
   const double d31 = std::abs(cables_mm[2] - cables_mm[0]);
   const double d42 = std::abs(cables_mm[3] - cables_mm[1]);
   if (d31 > reach_mm) return fmt::format("|l3-l1| = {:g} mm > {:g} mm", d31, reach_mm);
@@ -32,7 +37,8 @@ std::string with_source(std::string_view source, const std::string& message) {
 
 }  // namespace
 
-std::string describe_segment_cables(model::Status status, int segment_number, const model::Vec4<double>& cables_mm,
+std::string describe_segment_cables(model::Status status, int segment_number,
+                                    const model::SegmentCables<double>& cables_mm,
                                     const model::SegmentGeometry<double>& geometry) {
   using model::Status;
   const double reach_mm = 4.0 * geometry.anchor_radius_mm;
@@ -48,9 +54,9 @@ std::string describe_segment_cables(model::Status status, int segment_number, co
     }
     case Status::cable_difference_out_of_range:
       return fmt::format("segment {}: cable length difference exceeds 4 x anchor radius ({})", segment_number,
-                         describe_difference(cables_mm, reach_mm));
+                         describe_difference(cables_mm, geometry, reach_mm));
     case Status::theta_beyond_limit: {
-      const double chord_mm = std::hypot(cables_mm[2] - cables_mm[0], cables_mm[1] - cables_mm[3]);
+      const double chord_mm = model::cable_differences(cables_mm, geometry).chord;
       const double theta_rad = 2.0 * std::asin(chord_mm / reach_mm);
       return fmt::format("segment {}: bending angle theta = {:.4f} rad exceeds theta_max = {:.6g} rad",
                          segment_number, theta_rad, geometry.theta_max_rad);
@@ -81,11 +87,13 @@ model::JointVector<double> joints_from_cables_checked(const model::CableVector<d
   model::JointVector<double> joints;
   const model::Status status = model::joints_from_cables(cables_mm, geometry, joints);
   if (status == model::Status::ok) return joints;
-  if (status == model::Status::invalid_segment_count || cables_mm.size() != 4 * geometry.segment_count) {
-    throw InputError(fmt::format("{} cable lengths do not match {} segments", cables_mm.size(), geometry.segment_count));
+  if (status == model::Status::invalid_segment_count || cables_mm.size() != geometry.cable_count()) {
+    throw InputError(fmt::format("{} cable lengths do not match {} segments of {} cables", cables_mm.size(),
+                                 geometry.segment_count, geometry.cable_count()));
   }
   for (int i = 0; i < geometry.segment_count; ++i) {
-    const model::Vec4<double> segment_cables = cables_mm.segment<4>(4 * i);
+    const model::SegmentCables<double> segment_cables =
+        cables_mm.segment(geometry.first_cable(i), geometry.segments[i].cables.count);
     model::SegmentJoints<double> segment_joints;
     const model::Status segment_status = model::joints_from_cables(segment_cables, geometry.segments[i], segment_joints);
     if (segment_status != model::Status::ok) {
@@ -121,7 +129,8 @@ model::CableVector<double> cables_from_joints_checked(const model::JointVector<d
   const model::Status status = model::cables_from_joints(joints, geometry, cables_mm);
   if (status == model::Status::ok) return cables_mm;
   for (int i = 0; i < geometry.segment_count; ++i) {
-    model::Vec4<double> segment_cables = model::Vec4<double>::Zero();
+    model::SegmentCables<double> segment_cables =
+        model::SegmentCables<double>::Zero(geometry.segments[i].cables.count);
     const model::Status segment_status =
         model::cables_from_joints(model::segment_joints(joints, i), geometry.segments[i], segment_cables);
     if (segment_status != model::Status::ok) {

@@ -12,7 +12,8 @@
 namespace cdcr::cli {
 
 // Segments are numbered from 1 in every message, as on the robot.
-std::string describe_segment_cables(model::Status status, int segment_number, const model::Vec4<double>& cables_mm,
+std::string describe_segment_cables(model::Status status, int segment_number,
+                                    const model::SegmentCables<double>& cables_mm,
                                     const model::SegmentGeometry<double>& geometry);
 
 std::string describe_segment_joints(model::Status status, int segment_number,

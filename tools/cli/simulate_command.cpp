@@ -117,13 +117,14 @@ sim::SimulatorConfig make_config(const SimulateCommandOptions& options, const mo
   return config;
 }
 
-dataset::Dataset to_dataset(const std::vector<sim::CollectedSample>& samples, int segment_count, bool payload,
-                            bool sequence) {
+dataset::Dataset to_dataset(const std::vector<sim::CollectedSample>& samples,
+                            const model::RobotGeometry<double>& geometry, bool payload, bool sequence) {
   dataset::Dataset data;
-  data.segment_count = segment_count;
+  data.segment_count = geometry.segment_count;
+  for (int i = 0; i < geometry.segment_count; ++i) data.segment_cables.push_back(geometry.segments[i].cables.count);
   data.has_poses = true;
   data.has_payload = payload;
-  data.cables_mm.resize(static_cast<Eigen::Index>(samples.size()), 4 * segment_count);
+  data.cables_mm.resize(static_cast<Eigen::Index>(samples.size()), geometry.cable_count());
   if (payload) data.payload_kg.resize(static_cast<Eigen::Index>(samples.size()));
   data.poses.reserve(samples.size());
   for (std::size_t i = 0; i < samples.size(); ++i) {
@@ -256,7 +257,7 @@ CommandOutput run_simulate(const SimulateCommandOptions& options) {
   if (options.out_path) {
     try {
       const dataset::Dataset data =
-          to_dataset(samples, geometry.segment_count, config.payload.enabled, summary.sequence);
+          to_dataset(samples, geometry, config.payload.enabled, summary.sequence);
       dataset::write_dataset_csv(*options.out_path, data, dataset_comment(geometry, config, summary));
     } catch (const dataset::DatasetError& error) {
       throw InputError(error.what());

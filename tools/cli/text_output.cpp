@@ -17,14 +17,19 @@ std::string format_joints_table(const model::JointVector<double>& joints) {
   return fmt::to_string(out);
 }
 
-std::string format_cables_table(const model::CableVector<double>& cables_mm) {
+std::string format_cables_table(const model::CableVector<double>& cables_mm,
+                                const model::RobotGeometry<double>& geometry) {
   fmt::memory_buffer out;
   auto it = std::back_inserter(out);
   fmt::format_to(it, "cable lengths (mm)\n");
   fmt::format_to(it, "  {:>7}  {:>12}  {:>12}  {:>12}  {:>12}\n", "segment", "l1", "l2", "l3", "l4");
-  for (Eigen::Index i = 0; i < cables_mm.size() / 4; ++i) {
-    fmt::format_to(it, "  {:>7}  {:>12.6f}  {:>12.6f}  {:>12.6f}  {:>12.6f}\n", i + 1, cables_mm[4 * i],
-                   cables_mm[4 * i + 1], cables_mm[4 * i + 2], cables_mm[4 * i + 3]);
+  for (int i = 0; i < geometry.segment_count; ++i) {
+    fmt::format_to(it, "  {:>7}", i + 1);
+    const int first = geometry.first_cable(i);
+    for (int j = 0; j < geometry.segments[i].cables.count; ++j) fmt::format_to(it, "  {:>12.6f}", cables_mm[first + j]);
+    // A segment of three cables has no l4.
+    if (geometry.segments[i].cables.count == 3) fmt::format_to(it, "  {:>12}", "-");
+    fmt::format_to(it, "\n");
   }
   return fmt::to_string(out);
 }

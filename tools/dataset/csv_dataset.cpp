@@ -1,5 +1,6 @@
 #include "dataset/csv_dataset.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -46,12 +47,14 @@ double parse_number(std::string_view field, int line, const std::string& column)
 struct Header {
   int line = 0;
   int segment_count = 0;
+  std::vector<int> segment_cables;
+  std::vector<std::string> cable_names;
   bool has_time = false;
   bool has_payload = false;
   bool has_poses = false;
 
   int first_cable_column() const { return has_time ? 1 : 0; }
-  int cable_columns() const { return 4 * segment_count; }
+  int cable_columns() const { return static_cast<int>(cable_names.size()); }
   int payload_column() const { return first_cable_column() + cable_columns(); }
   int columns() const {
     return first_cable_column() + cable_columns() + (has_payload ? 1 : 0) + (has_poses ? kPoseColumnCount : 0);
@@ -59,7 +62,7 @@ struct Header {
   std::string column_name(int index) const {
     if (has_time && index == 0) return kTimeColumn;
     const int cable = index - first_cable_column();
-    if (cable < cable_columns()) return cable_column_name(cable / 4, cable % 4);
+    if (cable < cable_columns()) return cable_names[static_cast<std::size_t>(cable)];
     if (has_payload && index == payload_column()) return kPayloadColumn;
     return kPoseColumns[index - payload_column() - (has_payload ? 1 : 0)];
   }
@@ -86,34 +89,64 @@ Header parse_header(std::string_view line, int line_number, PoseColumns poses) {
          fields[first_cable + cables][0] == 'l') {
     ++cables;
   }
-  // The payload column has one place: right after the cable columns.
+  // The payload column has one place: right after the cable columns (not
+  // between them).
+  const auto cable_column_after = [&](int i) {
+    return std::any_of(fields.begin() + i + 1, fields.end(),
+                       [](std::string_view f) { return !f.empty() && f[0] == 'l'; });
+  };
   for (int i = 0; i < static_cast<int>(fields.size()); ++i) {
-    if (fields[i] == kPayloadColumn && (i != first_cable + cables || cables == 0 || cables % 4 != 0)) {
+    if (fields[i] == kPayloadColumn && (i != first_cable + cables || cables == 0 || cable_column_after(i))) {
       throw DatasetError(line_number, "header column " + std::to_string(i + 1) + " is '" + kPayloadColumn +
                                           "', which belongs right after the cable columns and before x,y,z,...");
     }
   }
-  if (cables == 0 || cables % 4 != 0) {
+  if (cables == 0) {
     throw DatasetError(line_number, std::string("header must start with ") + (has_time ? "t_s, then " : "") +
-                                        "cable columns l1_1,l1_2,l1_3,l1_4,... (a multiple of 4), found " +
-                                        std::to_string(cables));
+                                        "cable columns l1_1,l1_2,l1_3[,l1_4],l2_1,... (three or four a segment)");
   }
   Header h;
   h.line = line_number;
   h.has_time = has_time;
-  h.segment_count = cables / 4;
-  if (h.segment_count > model::kMaxSegments) {
-    throw DatasetError(line_number, std::to_string(cables) + " cable columns make " + std::to_string(h.segment_count) +
-                                        " segments, more than the " + std::to_string(model::kMaxSegments) +
-                                        " supported");
-  }
-  for (int i = 0; i < cables; ++i) {
-    const std::string expected = cable_column_name(i / 4, i % 4);
-    if (fields[first_cable + i] != expected) {
-      throw DatasetError(line_number, "header column " + std::to_string(first_cable + i + 1) + " is " +
-                                          quoted(fields[first_cable + i]) + ", expected '" + expected + "'");
+  // Segment by segment: li_1, li_2, ... then l(i+1)_1; each segment has the
+  // cables a segment may have (three or four).
+  const auto segment_complete = [&](int column) {
+    const int count = h.segment_cables.back();
+    if (count < model::kMinCablesPerSegment || count > model::kMaxCablesPerSegment) {
+      throw DatasetError(line_number, "header column " + std::to_string(column) + ": segment " +
+                                          std::to_string(h.segment_cables.size()) + " has " + std::to_string(count) +
+                                          " cable columns; a segment has " +
+                                          std::to_string(model::kMinCablesPerSegment) + " or " +
+                                          std::to_string(model::kMaxCablesPerSegment));
     }
+  };
+  for (int i = 0; i < cables; ++i) {
+    const std::string_view name = fields[first_cable + i];
+    const int segment = static_cast<int>(h.segment_cables.size());
+    const bool next_cable = segment > 0 && h.segment_cables.back() < model::kMaxCablesPerSegment &&
+                            name == cable_column_name(segment - 1, h.segment_cables.back());
+    if (next_cable) {
+      h.segment_cables.back() += 1;
+    } else if (name == cable_column_name(segment, 0)) {
+      if (segment > 0) segment_complete(first_cable + i + 1);
+      if (segment == model::kMaxSegments) {
+        throw DatasetError(line_number, "header column " + std::to_string(first_cable + i + 1) + " is " +
+                                            quoted(name) + ": more than the " + std::to_string(model::kMaxSegments) +
+                                            " segments supported");
+      }
+      h.segment_cables.push_back(1);
+    } else {
+      std::string expected = "'" + cable_column_name(segment, 0) + "'";
+      if (segment > 0 && h.segment_cables.back() < model::kMaxCablesPerSegment) {
+        expected = "'" + cable_column_name(segment - 1, h.segment_cables.back()) + "' or " + expected;
+      }
+      throw DatasetError(line_number, "header column " + std::to_string(first_cable + i + 1) + " is " +
+                                          quoted(name) + ", expected " + expected);
+    }
+    h.cable_names.emplace_back(name);
   }
+  segment_complete(first_cable + cables);
+  h.segment_count = static_cast<int>(h.segment_cables.size());
   h.has_payload = h.payload_column() < static_cast<int>(fields.size()) && fields[h.payload_column()] == kPayloadColumn;
   if (h.has_time && h.has_payload) {
     throw DatasetError(line_number, std::string("a time column (") + kTimeColumn + ") together with a payload column (" +
@@ -249,6 +282,7 @@ Dataset parse_dataset_csv(std::string_view text, PoseColumns poses) {
   }
   if (!have_header) throw DatasetError(0, "no header line (expected l1_1,l1_2,...): the file is empty or only comments");
   data.segment_count = header.segment_count;
+  data.segment_cables = header.segment_cables;
   data.has_time = header.has_time;
   data.has_payload = header.has_payload;
   data.has_poses = header.has_poses;
@@ -286,7 +320,8 @@ std::vector<int> session_starts_from_times(const Eigen::VectorXd& time_s) {
 
 std::string format_dataset_csv(const Dataset& data, const std::string& comment) {
   if (data.segment_count < 1 || data.segment_count > model::kMaxSegments ||
-      data.cables_mm.cols() != 4 * data.segment_count) {
+      (!data.segment_cables.empty() && data.segment_cables.size() != static_cast<std::size_t>(data.segment_count)) ||
+      data.cables_mm.cols() != data.cable_count()) {
     throw std::invalid_argument("dataset has " + std::to_string(data.cables_mm.cols()) + " cable columns for " +
                                 std::to_string(data.segment_count) + " segments");
   }
@@ -327,7 +362,9 @@ std::string format_dataset_csv(const Dataset& data, const std::string& comment) 
     for (std::string line; std::getline(lines, line);) out << "# " << line << '\n';
   }
   if (data.has_time) out << kTimeColumn << ',';
-  for (int i = 0; i < 4 * data.segment_count; ++i) out << (i ? "," : "") << cable_column_name(i / 4, i % 4);
+  for (int i = 0; i < data.segment_count; ++i) {
+    for (int j = 0; j < data.cables_of(i); ++j) out << (i + j > 0 ? "," : "") << cable_column_name(i, j);
+  }
   if (data.has_payload) out << ',' << kPayloadColumn;
   if (data.has_poses) {
     for (const char* c : kPoseColumns) out << ',' << c;

@@ -22,7 +22,10 @@ inline constexpr double kSessionGapSeconds = 30.0;
 
 struct Dataset {
   int segment_count = 0;
-  Eigen::MatrixXd cables_mm;                   // samples x 4n, columns l1_1, l1_2, ..., ln_4
+  // Each segment's cables, 3 or 4 (the header's columns); empty: the
+  // paper's four each.
+  std::vector<int> segment_cables;
+  Eigen::MatrixXd cables_mm;                   // samples x cables, columns l1_1, l1_2, ..., segment by segment
   Eigen::VectorXd payload_kg;                  // one per sample when has_payload: finite, not negative
   bool has_payload = false;
   std::vector<model::Pose<double>> poses;      // one per sample when has_poses
@@ -41,6 +44,14 @@ struct Dataset {
   std::uint64_t content_hash = 0;              // 64-bit FNV-1a of the file's bytes
 
   int sample_count() const { return static_cast<int>(cables_mm.rows()); }
+  int cables_of(int segment) const {
+    return segment_cables.empty() ? 4 : segment_cables[static_cast<std::size_t>(segment)];
+  }
+  int cable_count() const {
+    int count = 0;
+    for (int i = 0; i < segment_count; ++i) count += cables_of(i);
+    return count;
+  }
 };
 
 }  // namespace cdcr::dataset

@@ -284,6 +284,7 @@ MocapImport import_mocap(const Dataset& commanded, const MocapCapture& capture, 
   }
   if (kept_rows.empty()) throw DatasetError(0, "no frame has both bodies tracked");
   result.data.segment_count = commanded.segment_count;
+  result.data.segment_cables = commanded.segment_cables;
   result.data.has_poses = true;
   result.data.cables_mm = commanded.cables_mm(kept_rows, Eigen::all);
   result.data.has_payload = commanded.has_payload;

@@ -42,16 +42,36 @@ class ImageBuffer {
 };
 
 // The counts a trained hysteresis model must have for a robot of
-// `segments` segments; parse_image() judges its values.
-void check_hysteresis_counts(const model::HysteresisModel<double>& hysteresis, int segments) {
+// `cables` cables; parse_image() judges its values.
+void check_hysteresis_counts(const model::HysteresisModel<double>& hysteresis, int cables) {
   if (hysteresis.empty()) return;
-  if (hysteresis.cables != 4 * segments || hysteresis.cables > model::kMaxCables || hysteresis.operators < 1 ||
+  if (hysteresis.cables != cables || hysteresis.cables > model::kMaxCables || hysteresis.operators < 1 ||
       hysteresis.operators > model::kMaxHysteresisOperators) {
     throw std::invalid_argument("trained model's hysteresis has " + std::to_string(hysteresis.cables) +
                                 " cables and " + std::to_string(hysteresis.operators) +
-                                " operators per cable; a robot of " + std::to_string(segments) + " segments needs " +
-                                std::to_string(4 * segments) + " cables and 1 to " +
+                                " operators per cable; a robot of " + std::to_string(cables) + " cables needs " +
+                                std::to_string(cables) + " cables and 1 to " +
                                 std::to_string(model::kMaxHysteresisOperators) + " operators");
+  }
+}
+
+// The cables block (v2.7) of a robot whose segments are not all the
+// paper's four at 90 degrees; none for those.
+std::uint32_t cables_floats(const model::RobotGeometry<double>& geometry) {
+  return geometry.paper_cables() ? 0 : model::image_cables_floats(static_cast<std::uint32_t>(geometry.segment_count));
+}
+
+void put_cables(ImageBuffer& image, std::size_t block, const model::RobotGeometry<double>& geometry) {
+  if (cables_floats(geometry) == 0) return;
+  using namespace model::image_cables_field;
+  for (int i = 0; i < geometry.segment_count; ++i) {
+    const model::CableLayout<double>& layout = geometry.segments[i].cables;
+    const std::size_t at = block + 4 * static_cast<std::size_t>(i) * per_segment;
+    image.put_float(at + 4 * count, layout.count);
+    for (int j = 0; j < model::kMaxCablesPerSegment; ++j) {
+      image.put_float(at + 4 * (angles + j),
+                      j < layout.count ? std::atan2(layout.anchor_y[j], layout.anchor_x[j]) : 0.0);
+    }
   }
 }
 
@@ -123,10 +143,12 @@ void check_parses(ImageBuffer& image, std::uint32_t size) {
 }
 
 // The cable-fit encoding is 2.4's, the history's 2.5, the variance block's
-// threshold alone flagging extrapolation 2.6; the blocks' minor versions are
-// older, so it is put after them.
-void put_newest_version(ImageBuffer& image, model::InputEncoding encoding, int variance_rank) {
-  if (variance_rank > 0) {
+// threshold alone flagging extrapolation 2.6, the cables block 2.7; the
+// other blocks' minor versions are older, so it is put after them.
+void put_newest_version(ImageBuffer& image, model::InputEncoding encoding, int variance_rank, bool cables_block) {
+  if (cables_block) {
+    image.put_field(model::image_field::version_minor, model::kImageVersionMinorCables);
+  } else if (variance_rank > 0) {
     image.put_field(model::image_field::version_minor, model::kImageVersionMinorHeldOutThreshold);
   } else if (model::takes_history(encoding)) {
     image.put_field(model::image_field::version_minor, model::kImageVersionMinorHistory);
@@ -149,7 +171,7 @@ ModelDims checked_dims(const training::TrainedModel& model) {
   const int n = model.training_points();
   const int d = model.input_dims();
   const int segments = model.geometry.segment_count;
-  const int extra = d - model::encoded_input_count(model.encoding, segments);
+  const int extra = d - model::encoded_input_count(model.encoding, model.geometry);
   if (n < 1 || extra < 0 || extra > model::kMaxExtraInputs || model.alpha.rows() != n || model.alpha.cols() != model::kImageOutputs ||
       model.input_mean.size() != d || model.input_scale.size() != d || model.length_scales.size() != d) {
     throw std::invalid_argument("trained model has inconsistent dimensions");
@@ -177,7 +199,7 @@ ModelDims checked_dims(const training::TrainedModel& model) {
     throw std::invalid_argument("trained model's variance factor has inconsistent dimensions");
   }
   if (rank > 0xFFFF) throw std::invalid_argument("trained model's variance factor is too large for a flash image");
-  check_hysteresis_counts(model.hysteresis, segments);
+  check_hysteresis_counts(model.hysteresis, model.geometry.cable_count());
   check_compliance_counts(model.compliance, segments, extra);
   return ModelDims{n, d, segments, extra, rank, rows_fitted};
 }
@@ -313,7 +335,8 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
       model::image_layout(static_cast<std::uint32_t>(dims.points), static_cast<std::uint32_t>(dims.input_dims),
                           static_cast<std::uint32_t>(dims.segments), model::kImageVersionMajor,
                           static_cast<std::uint32_t>(dims.variance_rank), static_cast<std::uint32_t>(dims.extra_inputs),
-                          hysteresis_floats(model.hysteresis), compliance_floats(model.compliance));
+                          hysteresis_floats(model.hysteresis), compliance_floats(model.compliance),
+                          cables_floats(model.geometry));
   ImageBuffer image(layout.total_size);
   put_header(image, model, dims, layout);
   put_geometry(image, layout.geometry_offset, model.geometry);
@@ -322,7 +345,8 @@ std::vector<std::uint8_t> write_image(const training::TrainedModel& model) {
   put_variance(image, layout.variance_offset, model.variance, dims.input_dims);
   put_hysteresis(image, layout.hysteresis_offset, model.hysteresis);
   put_compliance(image, layout.compliance_offset, model.compliance);
-  put_newest_version(image, model.encoding, dims.variance_rank);
+  put_cables(image, layout.cables_offset, model.geometry);
+  put_newest_version(image, model.encoding, dims.variance_rank, cables_floats(model.geometry) > 0);
   put_metadata(image, layout.metadata_offset, model, dims.rows_fitted);
   put_checksum(image, layout.total_size);
   check_parses(image, layout.total_size);
@@ -344,10 +368,11 @@ std::vector<std::uint8_t> with_blocks(const std::vector<std::uint8_t>& image,
       status != model::ImageStatus::ok) {
     throw std::invalid_argument(std::string("image to add a block to: ") + model::to_string(status));
   }
-  if (view.version_major != model::kImageVersionMajor || view.hysteresis_cables != 0 || view.compliance_segments != 0) {
-    throw std::invalid_argument("only a v2 image without a hysteresis or compliance block can take one");
+  if (view.version_major != model::kImageVersionMajor || view.hysteresis_cables != 0 ||
+      view.compliance_segments != 0 || view.cables != nullptr) {
+    throw std::invalid_argument("only a v2 image without a hysteresis, compliance or cables block can take one");
   }
-  check_hysteresis_counts(hysteresis, view.segment_count);
+  check_hysteresis_counts(hysteresis, view.cable_count);
   check_compliance_counts(compliance, view.segment_count, view.extra_inputs);
   const auto layout_with = [&](std::uint32_t hysteresis_block, std::uint32_t compliance_block) {
     return model::image_layout(view.training_points, static_cast<std::uint32_t>(view.input_dims),
@@ -366,7 +391,8 @@ std::vector<std::uint8_t> with_blocks(const std::vector<std::uint8_t>& image,
   put_compliance(out, layout.compliance_offset, compliance);
   // The variance block's threshold keeps the meaning it was written with.
   put_newest_version(out, view.encoding,
-                     view.version_minor >= model::kImageVersionMinorHeldOutThreshold ? int(view.variance_rank) : 0);
+                     view.version_minor >= model::kImageVersionMinorHeldOutThreshold ? int(view.variance_rank) : 0,
+                     false);
   put_checksum(out, layout.total_size);
   check_parses(out, layout.total_size);
   return out.take();

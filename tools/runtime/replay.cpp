@@ -52,6 +52,10 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
     throw InputError(cables_path + ": " + std::to_string(data.segment_count) + " segments, the image has " +
                      std::to_string(runtime.geometry().segment_count));
   }
+  if (data.cable_count() != runtime.geometry().cable_count()) {
+    throw InputError(cables_path + ": " + std::to_string(data.cable_count()) + " cables, the image's robot has " +
+                     std::to_string(runtime.geometry().cable_count()));
+  }
   // A payload model takes each row's payload as if it had come in a PAYLOAD
   // frame with the row's cables; a model without the input ignores the column.
   const bool payload_input = runtime.correction().has_payload_input();

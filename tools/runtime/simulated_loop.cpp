@@ -70,7 +70,7 @@ struct SimulatedLoop {
 struct DrivenLoop {
   DrivenLoop(SimulatedLoop& loop, const model::CableVector<double>& start_cables, double rate_hz)
       : loop(loop),
-        drives(loop.platform.bus.node(1), start_cables, 50.0),
+        drives(loop.platform.bus.node(1), start_cables, 50.0, sim::cables_per_segment(loop.geometry)),
         effective_cables(loop.robot.move_cables(drives.cables_mm())),
         host(loop.platform.bus.node(2)),
         period_ns(static_cast<std::int64_t>(std::llround(1e9 / rate_hz))),
@@ -150,8 +150,8 @@ void run_homing_move(const model::RobotGeometry<double>& geometry, const sim::Si
   const long settle_cycles = std::max(1L, std::lround(0.1 * rate_hz));
   const auto send_setpoints = [&](const model::CableVector<double>& cables_mm) {
     for (int s = 0; s < geometry.segment_count; ++s) {
-      const protocol::CableSetpoint setpoint{
-          s, {cables_mm[4 * s], cables_mm[4 * s + 1], cables_mm[4 * s + 2], cables_mm[4 * s + 3]}};
+      const auto setpoint = protocol::segment_cables_frame<protocol::CableSetpoint>(
+          s, cables_mm, geometry.first_cable(s), geometry.segments[s].cables.count);
       cdcr::hal::CanFrame frame;
       if (!protocol::encode(setpoint, frame)) {
         throw std::runtime_error("the homing move: a cable length the CABLE_SETPOINT frame cannot carry");

@@ -1,6 +1,9 @@
 #include "sim/simulated_drives.hpp"
 
 #include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <utility>
 
 #include <cdcr/firmware/protocol.hpp>
 
@@ -9,8 +12,19 @@ namespace cdcr::sim {
 namespace protocol = firmware::protocol;
 
 SimulatedCableDrives::SimulatedCableDrives(hal::CanBus& bus, const Cables& initial_cables_mm,
-                                           double max_rate_mm_per_s)
-    : bus_(bus), cables_mm_(initial_cables_mm), setpoints_mm_(initial_cables_mm), max_rate_mm_per_s_(max_rate_mm_per_s) {
+                                           double max_rate_mm_per_s, std::vector<int> segment_cables)
+    : bus_(bus),
+      cables_mm_(initial_cables_mm),
+      setpoints_mm_(initial_cables_mm),
+      max_rate_mm_per_s_(max_rate_mm_per_s),
+      segment_cables_(std::move(segment_cables)) {
+  if (segment_cables_.empty()) segment_cables_.assign(static_cast<std::size_t>(cables_mm_.size() / 4), 4);
+  int first = 0;
+  for (const int count : segment_cables_) {
+    first_cable_.push_back(first);
+    first += count;
+  }
+  if (first != cables_mm_.size()) throw std::invalid_argument("the drives' cables and the segments' counts disagree");
   bus_.set_filters(&protocol::kCableSetpointFrames, 1);
 }
 
@@ -19,16 +33,20 @@ void SimulatedCableDrives::set_segment_silent(int segment, bool silent) {
 }
 
 void SimulatedCableDrives::step(double dt_s) {
-  const int segments = static_cast<int>(cables_mm_.size() / 4);
+  const int segments = static_cast<int>(segment_cables_.size());
   hal::CanFrame frame;
   while (bus_.receive(frame) == hal::CanStatus::ok) {
     if (!protocol::cable_setpoint::kMessage.carries(frame.id)) continue;
     protocol::CableSetpoint setpoint;
-    if (protocol::decode(frame, setpoint) != protocol::DecodeStatus::ok || setpoint.segment >= segments) {
+    if (protocol::decode(frame, setpoint) != protocol::DecodeStatus::ok || setpoint.segment >= segments ||
+        (segment_cables_[static_cast<std::size_t>(setpoint.segment)] == 4 && std::isnan(setpoint.lengths_mm[3]))) {
       rejected_frames_ += 1;
       continue;
     }
-    for (int k = 0; k < 4; ++k) setpoints_mm_[4 * setpoint.segment + k] = setpoint.lengths_mm[k];
+    const auto segment = static_cast<std::size_t>(setpoint.segment);
+    for (int k = 0; k < segment_cables_[segment]; ++k) {
+      setpoints_mm_[first_cable_[segment] + k] = setpoint.lengths_mm[k];
+    }
     setpoint_frames_ += 1;
   }
   const double max_step_mm = max_rate_mm_per_s_ * dt_s;
@@ -38,8 +56,9 @@ void SimulatedCableDrives::step(double dt_s) {
   if (silent_) return;
   for (int s = 0; s < segments; ++s) {
     if (segment_silent_[s]) continue;
-    const protocol::CableFeedback feedback{
-        s, {cables_mm_[4 * s], cables_mm_[4 * s + 1], cables_mm_[4 * s + 2], cables_mm_[4 * s + 3]}};
+    const auto segment = static_cast<std::size_t>(s);
+    const auto feedback = protocol::segment_cables_frame<protocol::CableFeedback>(
+        s, cables_mm_, first_cable_[segment], segment_cables_[segment]);
     if (protocol::encode(feedback, frame)) bus_.send(frame);
   }
 }

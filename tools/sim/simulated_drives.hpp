@@ -3,18 +3,32 @@
 // frames, move each cable toward its setpoint at a limited rate, and report
 // the achieved lengths every step, one feedback frame per segment.
 
+#include <vector>
+
 #include <cdcr/firmware/capacity.hpp>
 #include <cdcr/hal/can_bus.hpp>
+#include <cdcr/model/geometry.hpp>
 #include <cdcr/model/types.hpp>
 
 namespace cdcr::sim {
+
+// Each segment's cable count, as the drives take it.
+template <typename S, int Max>
+std::vector<int> cables_per_segment(const model::RobotGeometry<S, Max>& geometry) {
+  std::vector<int> counts;
+  for (int i = 0; i < geometry.segment_count; ++i) counts.push_back(geometry.segments[i].cables.count);
+  return counts;
+}
 
 class SimulatedCableDrives {
  public:
   using Cables = model::CableVector<double, firmware::kMaxSegments>;
 
-  // `bus` is the drives' own node; lengths start at initial_cables_mm.
-  SimulatedCableDrives(hal::CanBus& bus, const Cables& initial_cables_mm, double max_rate_mm_per_s);
+  // `bus` is the drives' own node; lengths start at initial_cables_mm, the
+  // cables of each segment in turn (segment_cables: how many each has;
+  // empty: four each).
+  SimulatedCableDrives(hal::CanBus& bus, const Cables& initial_cables_mm, double max_rate_mm_per_s,
+                       std::vector<int> segment_cables = {});
 
   // Takes every pending setpoint frame, moves the cables by dt_s, publishes.
   void step(double dt_s);
@@ -34,6 +48,8 @@ class SimulatedCableDrives {
   Cables cables_mm_;
   Cables setpoints_mm_;
   double max_rate_mm_per_s_;
+  std::vector<int> segment_cables_;
+  std::vector<int> first_cable_;
   bool silent_ = false;
   bool segment_silent_[firmware::kMaxSegments] = {};
   std::uint32_t setpoint_frames_ = 0;

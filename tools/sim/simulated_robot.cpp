@@ -20,9 +20,9 @@ using Pose = model::Pose<double>;
 constexpr int kMaxGravityIterations = 200;
 constexpr double kGravityToleranceRad = 1e-13;
 
-void check_cables(const model::CableVector<double>& cables_mm, int segment_count) {
-  if (cables_mm.size() != 4 * segment_count) {
-    throw std::invalid_argument("expected " + std::to_string(4 * segment_count) + " cable lengths, got " +
+void check_cables(const model::CableVector<double>& cables_mm, const model::RobotGeometry<double>& nominal) {
+  if (cables_mm.size() != nominal.cable_count()) {
+    throw std::invalid_argument("expected " + std::to_string(nominal.cable_count()) + " cable lengths, got " +
                                 std::to_string(cables_mm.size()));
   }
   if (!cables_mm.allFinite()) throw std::invalid_argument("cable lengths must be finite");
@@ -52,15 +52,17 @@ SimulatedRobot::SimulatedRobot(const model::RobotGeometry<double>& nominal, cons
     bend_retained_[i] = cables / stiffness_n_mm_per_rad_[i];
   }
   if (config_.hysteresis.enabled) {
-    friction_.emplace(4 * nominal.segment_count, config_.hysteresis, config_.seed, config_.session_seed());
+    friction_.emplace(nominal.cable_count(), config_.hysteresis, config_.seed, config_.session_seed());
   }
 }
 
-// Eqs. (4)-(5) with the segment's true anchor radius, written exactly as the
-// nominal model does so that a robot without errors reproduces it bit for bit.
-Vec2 SimulatedRobot::kinematic_bend(int segment, const model::Vec4<double>& cables_mm) const {
-  const double d31 = cables_mm[2] - cables_mm[0];
-  const double d24 = cables_mm[1] - cables_mm[3];
+// Eqs. (4)-(5) (the layout's chord, segment.hpp) with the segment's true
+// anchor radius, written exactly as the nominal model does so that a robot
+// without errors reproduces it bit for bit.
+Vec2 SimulatedRobot::kinematic_bend(int segment, const model::SegmentCables<double>& cables_mm) const {
+  const model::CableLayout<double>& layout = nominal_.segments[segment].cables;
+  const double d31 = model::layout_sum(layout.chord_x_weights, cables_mm, layout.count);
+  const double d24 = model::layout_sum(layout.chord_y_weights, cables_mm, layout.count);
   const double reach = 4.0 * radius_mm_[segment];
   const double chord = std::hypot(d31, d24);
   const double theta = 2.0 * std::asin(std::min(chord / reach, 1.0));
@@ -125,14 +127,14 @@ model::JointVector<double> SimulatedRobot::gravity_equilibrium(const model::Join
 model::JointVector<double> SimulatedRobot::achieved_bends(const model::CableVector<double>& cables_mm,
                                                           double payload_kg) const {
   const int n = nominal_.segment_count;
-  check_cables(cables_mm, n);
+  check_cables(cables_mm, nominal_);
   if (!(std::isfinite(payload_kg) && payload_kg >= 0.0)) {
     throw std::invalid_argument("payload must be finite and not negative (got " + std::to_string(payload_kg) + " kg)");
   }
 
   model::JointVector<double> bends(2 * n);
   for (int i = 0; i < n; ++i) {
-    Vec2 bend = kinematic_bend(i, cables_mm.segment<4>(4 * i));
+    Vec2 bend = kinematic_bend(i, cables_mm.segment(nominal_.first_cable(i), nominal_.segments[i].cables.count));
     if (config_.compliance.enabled) bend *= bend_retained_[i];
     bends.segment<2>(2 * i) = bend;
   }
@@ -149,7 +151,7 @@ Pose SimulatedRobot::true_pose(const model::CableVector<double>& cables_mm, doub
 }
 
 model::CableVector<double> SimulatedRobot::move_cables(const model::CableVector<double>& commanded_mm) {
-  check_cables(commanded_mm, nominal_.segment_count);
+  check_cables(commanded_mm, nominal_);
   if (!friction_) return commanded_mm;
   friction_->move_to(commanded_mm);
   return friction_->effective_mm();
@@ -157,7 +159,7 @@ model::CableVector<double> SimulatedRobot::move_cables(const model::CableVector<
 
 Measurement SimulatedRobot::measure(const model::CableVector<double>& cables_mm, double payload_kg) {
   // The same checks, in the same order, as achieved_bends, before the friction moves.
-  check_cables(cables_mm, nominal_.segment_count);
+  check_cables(cables_mm, nominal_);
   if (!(std::isfinite(payload_kg) && payload_kg >= 0.0)) {
     throw std::invalid_argument("payload must be finite and not negative (got " + std::to_string(payload_kg) + " kg)");
   }

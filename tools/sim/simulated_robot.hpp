@@ -96,7 +96,7 @@ class SimulatedRobot {
     model::Pose<double> end_disk;
   };
 
-  model::Vec2<double> kinematic_bend(int segment, const model::Vec4<double>& cables_mm) const;
+  model::Vec2<double> kinematic_bend(int segment, const model::SegmentCables<double>& cables_mm) const;
   model::Pose<double> segment_shape(int segment, const model::Vec2<double>& bend, double fraction) const;
   Shape shape(const model::JointVector<double>& bends) const;
   model::JointVector<double> gravity_equilibrium(const model::JointVector<double>& unloaded_bends,

@@ -31,13 +31,13 @@ CableInputChoice choose_cable_inputs(const TrainingSet& set, const TrainingOptio
   c.largest_residual_mm = set.cable_residuals.size() > 0 ? set.cable_residuals.cwiseAbs().maxCoeff() : 0.0;
   const int segments = static_cast<int>(set.bends.cols()) / 2;
   const int extra = static_cast<int>(set.inputs.cols()) - 2 * segments;
-  if (model::encoded_input_count(model::InputEncoding::bend_vector_cable_fit, segments) + extra > model::kMaxInputs) {
+  const int with_residuals_inputs = static_cast<int>(set.bends.cols() + set.cable_residuals.cols()) + extra;
+  if (with_residuals_inputs > model::kMaxInputs) {
     if (set.beyond_limit_rows > 0 || beyond_limit_elsewhere) {
       throw std::invalid_argument(fmt::format(
           "rows bend beyond the limit or the anchors' reach, and only the cable fit reads them, whose {} inputs "
           "exceed the board's {}",
-          model::encoded_input_count(model::InputEncoding::bend_vector_cable_fit, segments) + extra,
-          model::kMaxInputs));
+          with_residuals_inputs, model::kMaxInputs));
     }
     c.reason = fmt::format("not offered: {} segments' residuals exceed the board's {} inputs", segments,
                            model::kMaxInputs);

@@ -34,7 +34,7 @@ model::HysteresisModel<double> with_history_operator(const model::HysteresisMode
                                             model::kMaxHysteresisWidthMm));
   }
   model::HysteresisModel<double> m = hysteresis;
-  if (m.empty()) m.cables = 4 * geometry.segment_count;
+  if (m.empty()) m.cables = geometry.cable_count();
   const int k = m.operators;
   m.operators = k + 1;
   for (int c = 0; c < m.cables; ++c) {
@@ -65,7 +65,7 @@ HistoryChoice choose_history_inputs(const dataset::Dataset& data, const std::vec
     c.reason = fmt::format("not offered with the {} encoding", model::to_string(options.encoding));
     return c;
   }
-  if (model::encoded_input_count(with, segments) + extra > model::kMaxInputs) {
+  if (model::encoded_input_count(with, geometry) + extra > model::kMaxInputs) {
     c.reason = fmt::format("not offered: {} segments' history inputs exceed the board's {} inputs", segments,
                            model::kMaxInputs);
     return c;
@@ -82,7 +82,7 @@ HistoryChoice choose_history_inputs(const dataset::Dataset& data, const std::vec
   const TrainingSet without = make_sequence_training_set(data, hysteresis, geometry, options.encoding, with_payload)
                                   .subset(train_rows);
   c.search_rows = std::min(without.size(), std::max(2, options.sparse_search_rows));
-  c.extra_parameters = (options.search.isotropic ? 0 : model::kHistoryInputsPerSegment * segments) + 1;
+  c.extra_parameters = (options.search.isotropic ? 0 : geometry.cable_count()) + 1;
   const SearchResult without_search = search_on_rows(without, options, c.search_rows, nullptr);
   c.without_log_likelihood = without_search.log_marginal_likelihood;
   // Each candidate's search also starts where the model without the history
@@ -90,7 +90,7 @@ HistoryChoice choose_history_inputs(const dataset::Dataset& data, const std::vec
   // without it, and ends no lower unless the search fails).
   KernelHyperparameters warm = without_search.hyperparameters;
   const Eigen::Index without_dims = warm.length_scales.size();
-  const int history_dims = model::kHistoryInputsPerSegment * segments;
+  const int history_dims = geometry.cable_count();
   const bool warm_start = !options.search.isotropic && without_dims >= extra;
   if (warm_start) {
     Eigen::VectorXd scales(without_dims + history_dims);

@@ -77,25 +77,32 @@ const char* to_string(HysteresisSharing sharing) {
 
 namespace {
 
+// The segment cable `cable` of the robot's (segment by segment) belongs to.
+int segment_of(const model::RobotGeometry<double>& geometry, int cable) {
+  int segment = 0;
+  while (segment + 1 < geometry.segment_count && geometry.first_cable(segment + 1) <= cable) ++segment;
+  return segment;
+}
+
 // A candidate structure and its parameters: the widths of its groups (the
 // largest operator's, mm), then the K weights shared by every cable.
 struct Shape {
   HysteresisSharing sharing = HysteresisSharing::none;
   int operators = 0;
-  int segments = 0;
+  const model::RobotGeometry<double>* geometry = nullptr;  // whose cables (not for none)
 
   int groups() const {
     switch (sharing) {
       case HysteresisSharing::none: return 0;
       case HysteresisSharing::all_cables: return 1;
-      case HysteresisSharing::per_segment: return segments;
-      case HysteresisSharing::per_cable: return 4 * segments;
+      case HysteresisSharing::per_segment: return geometry->segment_count;
+      case HysteresisSharing::per_cable: return geometry->cable_count();
     }
     return 0;
   }
   int group_of(int cable) const {
     switch (sharing) {
-      case HysteresisSharing::per_segment: return cable / 4;
+      case HysteresisSharing::per_segment: return segment_of(*geometry, cable);
       case HysteresisSharing::per_cable: return cable;
       default: return 0;
     }
@@ -107,7 +114,7 @@ model::HysteresisModel<double> model_for(const Shape& shape, const Eigen::Vector
                                          const model::RobotGeometry<double>& geometry) {
   model::HysteresisModel<double> m;
   if (shape.sharing == HysteresisSharing::none) return m;
-  m.cables = 4 * shape.segments;
+  m.cables = geometry.cable_count();
   m.operators = shape.operators;
   const int groups = shape.groups();
   for (int c = 0; c < m.cables; ++c) {
@@ -147,6 +154,7 @@ class Likelihood {
              model::InputEncoding encoding, bool with_payload)
       : data_(data), rows_(rows), geometry_(geometry), encoding_(encoding), with_payload_(with_payload) {
     rows_data_.segment_count = data.segment_count;
+    rows_data_.segment_cables = data.segment_cables;
     rows_data_.has_poses = true;
     rows_data_.has_payload = data.has_payload;
     if (data.has_payload) rows_data_.payload_kg = data.payload_kg(rows);
@@ -255,9 +263,17 @@ std::vector<SearchDirection> search_directions(const Shape& shape) {
   std::vector<SearchDirection> directions;
   const auto unit = [&](int i) { return Eigen::VectorXd(Eigen::VectorXd::Unit(size, i)); };
   if (shape.sharing == HysteresisSharing::per_cable) {
-    for (int segment = 0; segment < shape.segments; ++segment) {
+    // Four cables make two opposite pairs, searched along their sum and
+    // their difference; three have no pairs, each cable on its own.
+    const model::RobotGeometry<double>& geometry = *shape.geometry;
+    for (int segment = 0; segment < geometry.segment_count; ++segment) {
+      const int first = geometry.first_cable(segment);
+      if (geometry.segments[segment].cables.count != 4) {
+        for (int c = 0; c < geometry.segments[segment].cables.count; ++c) directions.push_back({unit(first + c), 0.0});
+        continue;
+      }
       for (int pair = 0; pair < 2; ++pair) {
-        const int a = 4 * segment + pair, b = 4 * segment + pair + 2;
+        const int a = first + pair, b = first + pair + 2;
         directions.push_back({unit(a) + unit(b), 0.0});
         directions.push_back({unit(a) - unit(b), kSplitGain});
       }
@@ -338,7 +354,8 @@ class CandidateSearch {
         options_(options),
         result_(result),
         research_(hyperparameter_search),
-        segments_(geometry.segment_count) {
+        segments_(geometry.segment_count),
+        cables_(geometry.cable_count()) {
     research_.restarts = 0;
   }
 
@@ -352,7 +369,7 @@ class CandidateSearch {
   // the finer sharings then use.
   void add_shared(const KernelHyperparameters& joints_only_h) {
     const int before = likelihood_.evaluations();
-    const Shape shared{HysteresisSharing::all_cables, 1, segments_};
+    const Shape shared{HysteresisSharing::all_cables, 1, &geometry_};
     Eigen::VectorXd parameters(2);
     parameters << 0.0, 1.0;
     parameters = coordinate_search(shared, parameters, joints_only_h, likelihood_, geometry_, options_);
@@ -366,17 +383,17 @@ class CandidateSearch {
   // segment, then one per cable from the segments'.
   void add_per_segment_and_per_cable() {
     int before = likelihood_.evaluations();
-    const Shape per_segment{HysteresisSharing::per_segment, 1, segments_};
+    const Shape per_segment{HysteresisSharing::per_segment, 1, &geometry_};
     Eigen::VectorXd segment_parameters = Eigen::VectorXd::Constant(segments_ + 1, shared_width());
     segment_parameters[segments_] = shared_weight();
     segment_parameters = coordinate_search(per_segment, segment_parameters, h_, likelihood_, geometry_, options_);
     add_searched(per_segment, segment_parameters, before);
 
     before = likelihood_.evaluations();
-    const Shape per_cable{HysteresisSharing::per_cable, 1, segments_};
-    Eigen::VectorXd cable_parameters(4 * segments_ + 1);
-    for (int c = 0; c < 4 * segments_; ++c) cable_parameters[c] = segment_parameters[c / 4];
-    cable_parameters[4 * segments_] = segment_parameters[segments_];
+    const Shape per_cable{HysteresisSharing::per_cable, 1, &geometry_};
+    Eigen::VectorXd cable_parameters(cables_ + 1);
+    for (int c = 0; c < cables_; ++c) cable_parameters[c] = segment_parameters[segment_of(geometry_, c)];
+    cable_parameters[cables_] = segment_parameters[segments_];
     cable_parameters_ = coordinate_search(per_cable, cable_parameters, h_, likelihood_, geometry_, options_);
     add_searched(per_cable, cable_parameters_, before);
   }
@@ -390,7 +407,7 @@ class CandidateSearch {
     Eigen::VectorXd best_shape_parameters = shared_parameters_;
     for (int k = 2; k <= std::min(options_.operators_max, model::kMaxHysteresisOperators); ++k) {
       const int before = likelihood_.evaluations();
-      const Shape shape{HysteresisSharing::all_cables, k, segments_};
+      const Shape shape{HysteresisSharing::all_cables, k, &geometry_};
       Eigen::VectorXd parameters = Eigen::VectorXd::Constant(1 + k, shared_weight() / double(k));
       parameters[0] = shared_width();
       parameters = coordinate_search(shape, parameters, h_, likelihood_, geometry_, options_);
@@ -403,10 +420,10 @@ class CandidateSearch {
     const int best_operators = static_cast<int>(best_shape_parameters.size()) - 1;
     if (best_operators <= 1) return;
     const int before = likelihood_.evaluations();
-    const Shape shape{HysteresisSharing::per_cable, best_operators, segments_};
-    Eigen::VectorXd parameters(4 * segments_ + best_operators);
+    const Shape shape{HysteresisSharing::per_cable, best_operators, &geometry_};
+    Eigen::VectorXd parameters(cables_ + best_operators);
     const double scale = shared_width() > 0.0 ? best_shape_parameters[0] / shared_width() : 1.0;
-    for (int c = 0; c < 4 * segments_; ++c) {
+    for (int c = 0; c < cables_; ++c) {
       parameters[c] = std::min(model::kMaxHysteresisWidthMm, scale * cable_parameters_[c]);
     }
     parameters.tail(best_operators) = best_shape_parameters.tail(best_operators);
@@ -480,6 +497,7 @@ class CandidateSearch {
   HysteresisIdentification& result_;
   SearchOptions research_;
   int segments_;
+  int cables_;
   KernelHyperparameters h_;
   Eigen::VectorXd shared_parameters_;
   Eigen::VectorXd cable_parameters_;

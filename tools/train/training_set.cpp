@@ -56,12 +56,12 @@ Eigen::MatrixXd model_inputs(const Eigen::MatrixXd& bends, const Eigen::MatrixXd
                              const Eigen::MatrixXd& history_inputs, const Eigen::VectorXd& payload_kg,
                              model::InputEncoding encoding) {
   const bool with_residuals = model::takes_cable_residuals(encoding);
-  if (with_residuals && (cable_residuals.rows() != bends.rows() || cable_residuals.cols() != bends.cols())) {
+  if (with_residuals && (cable_residuals.rows() != bends.rows() || cable_residuals.cols() < bends.cols() / 2)) {
     throw std::invalid_argument("the cable-fit encoding needs the cables' residuals of every row");
   }
   const bool with_history = model::takes_history(encoding);
-  const Eigen::Index history_cols = with_history ? model::kHistoryInputsPerSegment * (bends.cols() / 2) : 0;
-  if (with_history && (history_inputs.rows() != bends.rows() || history_inputs.cols() != history_cols)) {
+  const Eigen::Index history_cols = with_history ? history_inputs.cols() : 0;
+  if (with_history && (history_inputs.rows() != bends.rows() || history_cols < 3 * (bends.cols() / 2))) {
     throw std::invalid_argument("a history encoding needs where every cable of every row last moved");
   }
   if (payload_kg.size() != 0 && payload_kg.size() != bends.rows()) {
@@ -88,6 +88,7 @@ TrainingSet with_float_cables(const TrainingSet& set, const model::RobotGeometry
                               model::InputEncoding encoding) {
   dataset::Dataset rows;
   rows.segment_count = geometry.segment_count;
+  for (int i = 0; i < geometry.segment_count; ++i) rows.segment_cables.push_back(geometry.segments[i].cables.count);
   rows.cables_mm = set.cables_mm.cast<float>().cast<double>();
   rows.poses = set.measured;
   rows.has_poses = true;
@@ -109,12 +110,19 @@ TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGe
     throw std::invalid_argument("dataset has " + std::to_string(data.segment_count) + " segments, geometry has " +
                                 std::to_string(geometry.segment_count));
   }
+  for (int i = 0; i < geometry.segment_count; ++i) {
+    if (data.cables_of(i) != geometry.segments[i].cables.count) {
+      throw std::invalid_argument("dataset's segment " + std::to_string(i + 1) + " has " +
+                                  std::to_string(data.cables_of(i)) + " cables, geometry's " +
+                                  std::to_string(geometry.segments[i].cables.count));
+    }
+  }
   const int n = data.sample_count();
   const int dims = 2 * geometry.segment_count;
   TrainingSet s;
   s.cables_mm = data.cables_mm;
   s.bends.resize(n, dims);
-  s.cable_residuals.resize(n, dims);
+  s.cable_residuals.resize(n, model::encoded_input_count(model::InputEncoding::bend_vector_cable_fit, geometry) - dims);
   s.error_twists.resize(n, 6);
   for (int i = 0; i < n; ++i) {
     const model::CableVector<double> cables = data.cables_mm.row(i).transpose();
@@ -129,7 +137,9 @@ TrainingSet make_training_set(const dataset::Dataset& data, const model::RobotGe
     }
     s.far_from_consistent_rows += far_segments > 0 ? 1 : 0;
     s.beyond_limit_rows += beyond_limit ? 1 : 0;
-    s.cable_residuals.row(i) = residuals.transpose();
+    double residual_inputs[model::kMaxCables];
+    const int residual_count = model::residual_inputs(residuals, geometry, residual_inputs);
+    s.cable_residuals.row(i) = Eigen::Map<const Eigen::RowVectorXd>(residual_inputs, residual_count);
     const model::JointVector<double> bend = model::bend_from_joints(joints);
     const model::Pose<double> nominal = model::forward_kinematics_bend(bend, geometry);
     s.bends.row(i) = bend.transpose();

@@ -18,14 +18,16 @@
 namespace cdcr::training {
 
 struct TrainingSet {
-  Eigen::MatrixXd cables_mm;     // samples x 4n, as commanded (a sequence with a hysteresis model: effective)
+  Eigen::MatrixXd cables_mm;     // samples x cables, as commanded (a sequence with a hysteresis model: effective)
   // A sequence with a hysteresis model: the commanded lengths (cables_mm
   // then holds the effective ones); empty otherwise.
   Eigen::MatrixXd commanded_mm;
   Eigen::MatrixXd bends;         // samples x 2n, stacked bend vectors
-  Eigen::MatrixXd cable_residuals;  // samples x 2n, the cable fit's [common mode, pair imbalance] per segment
-  // A sequence whose model keeps the cables' history: samples x 4n, where
-  // each cable last moved (model::history_inputs); empty otherwise.
+  // The cable fit's residuals as inputs (model::residual_inputs): per
+  // segment the common mode, and with four cables the pairs' imbalance.
+  Eigen::MatrixXd cable_residuals;
+  // A sequence whose model keeps the cables' history: samples x cables,
+  // where each cable last moved (model::history_inputs); empty otherwise.
   Eigen::MatrixXd history_inputs;
   Eigen::VectorXd payload_kg;    // samples, or empty: the data carried no payload column
   Eigen::MatrixXd inputs;        // samples x D, encoded (and the payload last, when there is one)

@@ -80,7 +80,7 @@ struct TrainedModel {
   // Inputs after the encoding's (the bend pairs, and the cable residuals for
   // the cable-fit encoding): 1 when the model takes the payload.
   int extra_inputs() const {
-    return input_dims() - model::encoded_input_count(encoding, geometry.segment_count);
+    return input_dims() - model::encoded_input_count(encoding, geometry);
   }
   bool has_payload_input() const { return extra_inputs() > 0; }
 

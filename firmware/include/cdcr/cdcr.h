@@ -13,7 +13,7 @@
  *   cdcr_init(&runtime, &config);
  *   for (;;) {
  *     board_wait_for_period();
- *     cdcr_set_cable_lengths(&runtime, lengths_mm, 16);   // 4 per segment
+ *     cdcr_set_cable_lengths(&runtime, lengths_mm, 16);   // every segment's cables, in order
  *     cdcr_step(&runtime);
  *     cdcr_get_pose(&runtime, &pose);
  *     if (cdcr_get_setpoints(&runtime, &setpoints) == CDCR_OK) ... // to the drives
@@ -116,13 +116,15 @@ typedef enum cdcr_target_mode {
 
 /* The robot's design geometry, the same for every segment. Used when there
  * is no valid image (DEGRADED); an image carries the geometry it was trained
- * on. All zero: the paper's prototype (4 segments, L = 120 mm, r = 67 mm,
- * theta_max = pi/2). */
+ * on (and its cables' anchor angles). All zero: the paper's prototype (4
+ * segments, L = 120 mm, r = 67 mm, theta_max = pi/2, four cables at 90
+ * degrees). */
 typedef struct cdcr_geometry {
   int segment_count; /* 1..CDCR_MAX_SEGMENTS */
   float backbone_length_mm;
   float anchor_radius_mm;
   float theta_max_rad;
+  int cables_per_segment; /* 0 or 4: four cables at 90 degrees; 3: three at 120 degrees, cable 1 on the x axis */
 } cdcr_geometry;
 
 typedef struct cdcr_config {
@@ -163,8 +165,8 @@ typedef struct cdcr_pose {
 } cdcr_pose;
 
 typedef struct cdcr_setpoints {
-  float lengths_mm[CDCR_MAX_CABLES]; /* l1_1..l1_4, l2_1, ...: what the drives should hold */
-  int cable_count;                   /* 4 per segment */
+  float lengths_mm[CDCR_MAX_CABLES]; /* l1_1, l1_2, ..., l2_1, ...: what the drives should hold */
+  int cable_count;                   /* every segment's cables (cdcr_get_segment_cables) */
   uint32_t count;                    /* setpoints published so far: changes when these are new */
 } cdcr_setpoints;
 
@@ -209,11 +211,17 @@ cdcr_result cdcr_init(cdcr_runtime *runtime, const cdcr_config *config);
  * cycle's budget, publishes. */
 cdcr_result cdcr_step(cdcr_runtime *runtime);
 
-/* The drives' cable lengths: all of them (count = 4 x segments), or one
- * segment's four. Take effect at the next cdcr_step(); a segment that is not
- * fed for more than 10 steps takes the runtime to FAULT. */
+/* The drives' cable lengths: all of them, segment by segment (count = the
+ * sum of the segments' cables, 4 x segments for the paper's robot), or one
+ * segment's (3 or 4 values: cdcr_get_segment_cables). Take effect at the
+ * next cdcr_step(); a segment that is not fed for more than 10 steps takes
+ * the runtime to FAULT. */
 cdcr_result cdcr_set_cable_lengths(cdcr_runtime *runtime, const float *lengths_mm, size_t count);
-cdcr_result cdcr_set_segment_cable_lengths(cdcr_runtime *runtime, int segment, const float lengths_mm[4]);
+cdcr_result cdcr_set_segment_cable_lengths(cdcr_runtime *runtime, int segment, const float *lengths_mm);
+
+/* How many cables drive a segment (3 or 4), from the image's geometry, or
+ * the fallback's without a valid image. */
+cdcr_result cdcr_get_segment_cables(const cdcr_runtime *runtime, int segment, int *cables);
 
 /* The tip payload in kg (0 to 50), for a model image with a payload input:
  * the pose and inverse kinematics use it from the next cdcr_step(); until

@@ -194,12 +194,17 @@ INSTANTIATE_TEST_SUITE_P(
                "line 1: missing header: the first line must name the columns (l1_1,l1_2,...), found data"},
         BadCsv{"no_header_after_comments", "# data\n\n120,120,120,120\n", 3,
                "line 3: missing header: the first line must name the columns (l1_1,l1_2,...), found data"},
-        BadCsv{"not_multiple_of_4", "l1_1,l1_2,l1_3\n1,2,3\n", 1,
-               "line 1: header must start with cable columns l1_1,l1_2,l1_3,l1_4,... (a multiple of 4), found 3"},
+        BadCsv{"two_cables", "l1_1,l1_2\n1,2\n", 1,
+               "line 1: header column 2: segment 1 has 2 cable columns; a segment has 3 or 4"},
+        BadCsv{"five_cables", "l1_1,l1_2,l1_3,l1_4,l1_5\n1,2,3,4,5\n", 1,
+               "line 1: header column 5 is 'l1_5', expected 'l2_1'"},
+        BadCsv{"two_cables_then_a_segment", "l1_1,l1_2,l2_1,l2_2,l2_3\n1,2,3,4,5\n", 1,
+               "line 1: header column 3: segment 1 has 2 cable columns; a segment has 3 or 4"},
         BadCsv{"no_cable_columns", "x,y,z,qw,qx,qy,qz\n", 1,
-               "line 1: header must start with cable columns l1_1,l1_2,l1_3,l1_4,... (a multiple of 4), found 0"},
+               "line 1: header must start with cable columns l1_1,l1_2,l1_3[,l1_4],l2_1,... (three or four a "
+               "segment)"},
         BadCsv{"wrong_cable_name", "l1_1,l1_2,l1_3,l2_4\n1,2,3,4\n", 1,
-               "line 1: header column 4 is 'l2_4', expected 'l1_4'"},
+               "line 1: header column 4 is 'l2_4', expected 'l1_4' or 'l2_1'"},
         BadCsv{"segments_out_of_order", "l1_1,l1_2,l1_3,l1_4,l3_1,l3_2,l3_3,l3_4\n", 1,
                "line 1: header column 5 is 'l3_1', expected 'l2_1'"},
         BadCsv{"too_many_segments",
@@ -209,7 +214,7 @@ INSTANTIATE_TEST_SUITE_P(
                    for (int c = 1; c <= 4; ++c) h += (h.empty() ? "" : ",") + ("l" + std::to_string(s) + "_" + std::to_string(c));
                  return h + "\n";
                }(),
-               1, "line 1: 36 cable columns make 9 segments, more than the 8 supported"},
+               1, "line 1: header column 33 is 'l9_1': more than the 8 segments supported"},
         BadCsv{"missing_pose_column", "l1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy\n", 1, "line 1: missing column 'qz'"},
         BadCsv{"wrong_pose_name", "l1_1,l1_2,l1_3,l1_4,x,y,z,qx,qy,qz,qw\n", 1,
                "line 1: header column 8 is 'qx', expected 'qw'"},
@@ -285,8 +290,8 @@ INSTANTIATE_TEST_SUITE_P(
         BadCsv{"twice", "t_s,t_s,l1_1,l1_2,l1_3,l1_4\n", 1,
                "line 1: header column 2 is 't_s', which belongs first, before the cable columns"},
         BadCsv{"alone", "t_s\n1\n", 1,
-               "line 1: header must start with t_s, then cable columns l1_1,l1_2,l1_3,l1_4,... (a multiple of 4), "
-               "found 0"}),
+               "line 1: header must start with t_s, then cable columns l1_1,l1_2,l1_3[,l1_4],l2_1,... (three or four "
+               "a segment)"}),
     cdcr::test_support::rejection_case_name);
 
 TEST(DatasetCsv, RequiredPoseColumns) {

@@ -43,7 +43,7 @@ TEST(HistoryOperator, IsAppendedWithWeightZeroAndItsHomingLag) {
     // The way home is 4.7 mm on this robot: each cable ends at a stop.
     EXPECT_DOUBLE_EQ(std::abs(m.homing_lag_mm[c][1]), 0.2);
   }
-  EXPECT_EQ(model::check_hysteresis(m, 2), model::HysteresisCheck::ok);
+  EXPECT_EQ(model::check_hysteresis(m, 8), model::HysteresisCheck::ok);
   // An empty model becomes the history operator alone.
   const model::HysteresisModel<double> alone = with_history_operator({}, 0.05, geometry);
   EXPECT_EQ(alone.cables, 8);

@@ -103,7 +103,7 @@ TEST(HysteresisIdentification, RecoversKnownPerCableWidths) {
     EXPECT_NEAR(id.model.weights[c][0], 1.0, 0.05) << "cable " << c;
     EXPECT_NEAR(id.model.max_lag_mm(c), truth.max_lag_mm(c), 0.05) << "cable " << c;
   }
-  EXPECT_EQ(model::check_hysteresis(id.model, geometry.segment_count), model::HysteresisCheck::ok);
+  EXPECT_EQ(model::check_hysteresis(id.model, geometry.cable_count()), model::HysteresisCheck::ok);
   // The candidates all ran, "none" first (and a shape of several operators
   // per cable when one beat a single operator with shared widths); the
   // likelihood preferred every hysteresis model to none.

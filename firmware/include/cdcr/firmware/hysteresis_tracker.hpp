@@ -80,8 +80,8 @@ class HysteresisTracker {
   bool known_ = true;
   model::HysteresisModel<Scalar> model_;
   model::HysteresisState<Scalar> state_;
-  int segments_ = 0;
-  Scalar chord_limit_mm_[kMaxSegments] = {};  // per segment, the largest |(l3 - l1, l2 - l4)|
+  Geometry geometry_{};
+  Scalar chord_limit_mm_[kMaxSegments] = {};  // per segment, the largest chord |D| (segment.hpp)
   // A model that takes the cables' residuals reads effective lengths
   // beyond the bend limit, as the trainer gave them; only others need them
   // pulled within it.

@@ -130,6 +130,26 @@ bool far_from_consistent(const SegmentCableFit<S>& fit) {
 template <typename S, int MaxSegments = kMaxSegments>
 using CableResiduals = JointVector<S, MaxSegments>;
 
+// The residuals as the GP takes them (input_encoding.hpp): per segment the
+// common mode, and with four cables (four_cables[i]) the pairs' imbalance;
+// three cables leave none. `out` receives the returned count of values.
+template <typename Derived, typename S>
+int residual_inputs(const Eigen::MatrixBase<Derived>& residuals, int segments, const bool* four_cables, S* out) {
+  int e = 0;
+  for (int i = 0; i < segments; ++i) {
+    out[e++] = residuals[2 * i];
+    if (four_cables[i]) out[e++] = residuals[2 * i + 1];
+  }
+  return e;
+}
+
+template <typename S, int Max>
+int residual_inputs(const CableResiduals<S, Max>& residuals, const RobotGeometry<S, Max>& geometry, S* out) {
+  bool four_cables[Max] = {};
+  for (int i = 0; i < geometry.segment_count; ++i) four_cables[i] = geometry.segments[i].cables.count == 4;
+  return residual_inputs(residuals, geometry.segment_count, four_cables, out);
+}
+
 // Every segment's fit. Writes the outputs only on success.
 template <typename S, int Max>
 Status fit_cables(const CableVector<S, Max>& cables_mm, const RobotGeometry<S, Max>& geometry,

@@ -23,6 +23,13 @@ Status geometry_from_image(const ImageView& image, RobotGeometry<S, Max>& geomet
   for (int i = 0; i < image.segment_count; ++i) {
     g.segments[i] = SegmentGeometry<S>{S(image.geometry[3 * i]), S(image.geometry[3 * i + 1]),
                                        S(image.geometry[3 * i + 2])};
+    if (image.cables != nullptr) {
+      // The angles as the image holds them (float), in S.
+      const float* angles = image.cables + i * image_cables_field::per_segment + image_cables_field::angles;
+      S psi[kMaxCablesPerSegment];
+      for (int j = 0; j < kMaxCablesPerSegment; ++j) psi[j] = S(angles[j]);
+      g.segments[i].cables = CableLayout<S>::at_angles(image_segment_cables(image, i), psi);
+    }
   }
   if (const Status s = g.validate(); s != Status::ok) return s;
   geometry = g;

@@ -49,6 +49,11 @@ inline constexpr std::uint16_t kImageVersionMinorHistory = 5;
 // older images, and without a variance block, the range flags as before.
 // Written for every image with a variance block.
 inline constexpr std::uint16_t kImageVersionMinorHeldOutThreshold = 6;
+// 2.7: the cables block, every segment's cable count and anchor angles
+// (geometry.hpp's CableLayout). Every 2.7 image has one; the exporter writes
+// 2.7 only for a robot whose segments are not all the paper's four cables at
+// 90 degrees, so a four-cable image stays byte for byte what it was.
+inline constexpr std::uint16_t kImageVersionMinorCables = 7;
 inline constexpr std::uint16_t kImageOldestVersionMajor = 1;  // still read: deployed boards carry v1 images
 inline constexpr std::uint32_t kImageHeaderSize = 64;
 inline constexpr std::uint32_t kImageBlockAlignment = 8;
@@ -158,6 +163,23 @@ constexpr std::uint32_t image_compliance_floats(std::uint32_t segments) {
   return segments == 0 ? 0 : image_compliance_field::ratios + segments + 2;
 }
 
+// The cables block (v2.7), float32, per segment: the cable count (3 or 4),
+// then kMaxCablesPerSegment anchor angles in rad, the unused ones zero.
+namespace image_cables_field {
+inline constexpr std::uint32_t count = 0;
+inline constexpr std::uint32_t angles = 1;
+inline constexpr std::uint32_t per_segment = 1 + kMaxCablesPerSegment;
+}  // namespace image_cables_field
+
+// Whether an image of this version carries the cables block.
+constexpr bool image_has_cables_block(std::uint16_t major, std::uint16_t minor) {
+  return major == 2 && minor >= kImageVersionMinorCables;
+}
+
+constexpr std::uint32_t image_cables_floats(std::uint32_t segments) {
+  return image_cables_field::per_segment * segments;
+}
+
 constexpr std::uint32_t packed_triangle_floats(std::uint32_t rank) { return rank * (rank + 1) / 2; }
 
 // In 64 bits: a damaged header's rank (up to 65535) must not wrap the count.
@@ -234,6 +256,12 @@ struct ImageView {
   const float* compliance_ratios;            // compliance_segments, finite, > 0
   const float* compliance_softening;         // 1, per rad, finite, keeps 1 + s |b| > 0 to a quarter turn
   const float* compliance_unloaded_mass;     // 1, kg, finite, >= 0
+  // Every segment's cables (v2.7; null without the block: the paper's four
+  // at 90 degrees), image_cables_field order; compensated_kinematics.hpp's
+  // geometry_from_image makes each a model::CableLayout. cable_count is
+  // the robot's cables either way.
+  const float* cables;
+  int cable_count;
   std::uint64_t dataset_hash;
   std::int64_t created_unix_s;
   std::uint32_t validation_samples;
@@ -256,6 +284,7 @@ struct ImageLayout {
   std::uint32_t variance_offset;  // 0 without a variance block
   std::uint32_t hysteresis_offset;  // 0 without a hysteresis block
   std::uint32_t compliance_offset;  // 0 without a compliance block
+  std::uint32_t cables_offset;      // 0 without a cables block
   std::uint32_t metadata_offset;
   std::uint32_t total_size;
 };
@@ -283,6 +312,7 @@ enum class ImageBlockId : std::uint8_t {
   variance,
   hysteresis,
   compliance,
+  cables,
   metadata,
   none,  // a header field that locates no block
 };
@@ -297,6 +327,7 @@ struct ImageDims {
   std::uint32_t extra_inputs = 0;
   std::uint32_t hysteresis_floats = 0;
   std::uint32_t compliance_floats = 0;
+  std::uint32_t cables_floats = 0;
 };
 
 // A block's bytes, in 64 bits: the dims of a damaged header can be anything.
@@ -310,6 +341,7 @@ constexpr std::uint64_t image_block_bytes(ImageBlockId block, const ImageDims& d
     case ImageBlockId::variance: return 4 * image_variance_floats(dims.variance_rank, dims.input_dims);
     case ImageBlockId::hysteresis: return 4 * std::uint64_t{dims.hysteresis_floats};
     case ImageBlockId::compliance: return 4 * std::uint64_t{dims.compliance_floats};
+    case ImageBlockId::cables: return 4 * std::uint64_t{dims.cables_floats};
     case ImageBlockId::metadata: return kImageMetadataSize;
     case ImageBlockId::none: break;
   }
@@ -335,6 +367,7 @@ inline constexpr ImageBlockFormat kImageBlocks[] = {
     {ImageBlockId::variance, "variance", 2, kImageVersionMinor, true, &ImageLayout::variance_offset},
     {ImageBlockId::hysteresis, "hysteresis", 2, kImageVersionMinorHysteresis, true, &ImageLayout::hysteresis_offset},
     {ImageBlockId::compliance, "compliance", 2, kImageVersionMinorCompliance, true, &ImageLayout::compliance_offset},
+    {ImageBlockId::cables, "cables", 2, kImageVersionMinorCables, true, &ImageLayout::cables_offset},
     {ImageBlockId::metadata, "metadata", 1, 0, false, &ImageLayout::metadata_offset},
 };
 
@@ -369,9 +402,10 @@ constexpr ImageLayout image_layout(const ImageDims& dims) {
 constexpr ImageLayout image_layout(std::uint32_t training_points, std::uint32_t input_dims,
                                    std::uint32_t segment_count, std::uint16_t version_major = kImageVersionMajor,
                                    std::uint32_t variance_rank = 0, std::uint32_t extra_inputs = 0,
-                                   std::uint32_t hysteresis_floats = 0, std::uint32_t compliance_floats = 0) {
+                                   std::uint32_t hysteresis_floats = 0, std::uint32_t compliance_floats = 0,
+                                   std::uint32_t cables_floats = 0) {
   return image_layout(ImageDims{training_points, input_dims, segment_count, version_major, variance_rank,
-                                extra_inputs, hysteresis_floats, compliance_floats});
+                                extra_inputs, hysteresis_floats, compliance_floats, cables_floats});
 }
 
 // A header field's type; the value is its size in bytes.
@@ -543,8 +577,9 @@ enum class ImageCheckId : std::uint8_t {
   variance,     // invalid_parameters, v2.1: what the variance block requires of the model
   hysteresis,   // invalid_parameters, v2.2: the hysteresis block's widths, weights and homing lags
   compliance,   // invalid_parameters, v2.3: the compliance block's values
+  cables,       // invalid_parameters, v2.7: the cables block's counts and angles, and the inputs they imply
 };
-inline constexpr int kImageCheckCount = static_cast<int>(ImageCheckId::compliance) + 1;
+inline constexpr int kImageCheckCount = static_cast<int>(ImageCheckId::cables) + 1;
 
 constexpr const char* to_string(ImageCheckId check) {
   switch (check) {
@@ -564,6 +599,7 @@ constexpr const char* to_string(ImageCheckId check) {
     case ImageCheckId::variance: return "variance";
     case ImageCheckId::hysteresis: return "hysteresis";
     case ImageCheckId::compliance: return "compliance";
+    case ImageCheckId::cables: return "cables";
   }
   return "unknown";
 }
@@ -904,8 +940,10 @@ struct DeclaredImage {
                      rank,
                      extra,
                      image_hysteresis_floats(hysteresis_cables, hysteresis_operators),
-                     image_compliance_floats(compliance_segments)};
+                     image_compliance_floats(compliance_segments),
+                     cables_block() ? image_cables_floats(segments) : 0};
   }
+  bool cables_block() const { return image_has_cables_block(major, minor); }
   // The field's value, or zero where this version does not name it.
   std::uint32_t value(const std::uint8_t* bytes, const ImageHeaderField& field) const {
     return image_field_named(field, layout_major, minor) ? image_field_value(bytes, field) : 0;
@@ -923,6 +961,7 @@ struct ImageBlocks {
   const float* variance = nullptr;
   const float* hysteresis = nullptr;
   const float* compliance = nullptr;
+  const float* cables = nullptr;
 };
 
 // The parameter arrays, back to back; null where the block is not readable.
@@ -1115,8 +1154,10 @@ bool check_dims(Run& run, const std::uint8_t* bytes, DeclaredImage& h) {
                     Expect::at_least) &&
          run.expect(h.segments >= 1, ImageCheckId::header, ImageStatus::bad_header, "segment_count", -1, h.segments,
                     1, Expect::at_least) &&
-         run.expect(h.input_dims == encoded_inputs(h) + h.extra, ImageCheckId::header, ImageStatus::bad_header,
-                    "input_dims", -1, h.input_dims, encoded_inputs(h) + h.extra, Expect::equal) &&
+         // With the cables block the inputs follow its counts (checked there).
+         (h.cables_block() ||
+          run.expect(h.input_dims == encoded_inputs(h) + h.extra, ImageCheckId::header, ImageStatus::bad_header,
+                     "input_dims", -1, h.input_dims, encoded_inputs(h) + h.extra, Expect::equal)) &&
          run.expect(outputs == kImageOutputs, ImageCheckId::header, ImageStatus::bad_header, "output_dims", -1,
                     outputs, kImageOutputs, Expect::equal);
 }
@@ -1135,8 +1176,11 @@ bool check_hysteresis_counts(Run& run, const std::uint8_t* bytes, DeclaredImage&
     return run.expect(!takes_history(h.encoding), ImageCheckId::header, ImageStatus::bad_header,
                       "history_without_hysteresis", -1, cables, 4 * h.segments, Expect::equal);
   }
-  return run.expect(cables == 4 * h.segments, ImageCheckId::header, ImageStatus::bad_header, "hysteresis_cables", -1,
-                    cables, 4 * h.segments, Expect::equal) &&
+  // With the cables block, its count (checked there); the paper's four a
+  // segment without.
+  return (h.cables_block() ||
+          run.expect(cables == 4 * h.segments, ImageCheckId::header, ImageStatus::bad_header, "hysteresis_cables", -1,
+                     cables, 4 * h.segments, Expect::equal)) &&
          run.expect(operators >= 1, ImageCheckId::header, ImageStatus::bad_header, "hysteresis_operators", -1,
                     operators, 1, Expect::at_least) &&
          run.expect(cables <= static_cast<std::uint32_t>(kMaxCables), ImageCheckId::capacity,
@@ -1201,7 +1245,7 @@ bool check_block_alignment(Run& run, const std::uint8_t* bytes, const DeclaredIm
 inline std::uint64_t declared_array_bytes(const DeclaredImage& h) {
   const ImageDims dims = h.dims();
   return (std::uint64_t{h.points} * (h.input_dims + kImageOutputs) + image_variance_floats(h.rank, h.input_dims) +
-          dims.hysteresis_floats + dims.compliance_floats) *
+          dims.hysteresis_floats + dims.compliance_floats + dims.cables_floats) *
          4;
 }
 
@@ -1266,6 +1310,7 @@ ImageBlocks locate_blocks(const std::uint8_t* bytes, std::size_t size, const Dec
                                                    : nullptr;
   b.compliance = dims.compliance_floats > 0 && fit ? block(ImageBlockId::compliance, implied.compliance_offset)
                                                    : nullptr;
+  b.cables = dims.cables_floats > 0 && fit ? block(ImageBlockId::cables, implied.cables_offset) : nullptr;
   return b;
 }
 
@@ -1433,9 +1478,67 @@ bool check_optional_blocks(Run& run, const ImageBlocks& b, const DeclaredImage& 
   return b.compliance == nullptr || check_compliance_block(run, b.compliance, h.compliance_segments);
 }
 
+// The cables block (v2.7): every segment's count 3 or 4, its angles finite
+// and the unused ones zero, anchors that read a bend (CableLayout::
+// validate), and the counts the header's inputs and hysteresis cables
+// follow from. `cable_count` is the robot's cables, the paper's four a
+// segment without the block. False where a stopping run must stop.
+template <typename Run>
+bool check_cables_block(Run& run, const float* block, const DeclaredImage& h, std::uint32_t& cable_count) {
+  using Expect = ImageExpectation;
+  using namespace image_cables_field;
+  cable_count = 4 * h.segments;
+  if (block == nullptr) {
+    if (Run::kEveryCheck) {
+      run.expect(true, ImageCheckId::cables, ImageStatus::invalid_parameters, "cables", -1, 0, 0, Expect::finite);
+    }
+    return true;
+  }
+  cable_count = 0;
+  std::uint32_t inputs = h.extra;
+  for (std::uint32_t i = 0; i < h.segments; ++i) {
+    const float* segment = block + i * per_segment;
+    const float count = segment[image_cables_field::count];
+    const auto index = static_cast<std::int32_t>(i);
+    if (!run.expect(count == 3.0f || count == 4.0f, ImageCheckId::cables, ImageStatus::invalid_parameters,
+                    "cable_count", index, count, kMaxCablesPerSegment, Expect::known)) {
+      return false;
+    }
+    const int cables = count == 3.0f ? 3 : 4;
+    for (int j = 0; j < kMaxCablesPerSegment; ++j) {
+      const float angle = segment[angles + j];
+      const auto at = static_cast<std::int32_t>(i * per_segment + angles + j);
+      if (!run.expect(std::isfinite(angle), ImageCheckId::cables, ImageStatus::invalid_parameters, "cable_angle", at,
+                      angle, 0, Expect::finite) ||
+          !run.expect(j < cables || angle == 0.0f, ImageCheckId::cables, ImageStatus::invalid_parameters,
+                      "cable_angle_unused", at, angle, 0, Expect::equal)) {
+        return false;
+      }
+    }
+    const CableLayout<float> layout = CableLayout<float>::at_angles(cables, segment + angles);
+    if (!run.expect(layout.validate() == Status::ok, ImageCheckId::cables, ImageStatus::invalid_parameters,
+                    "cable_anchor_spread", index, layout.spread(), CableLayout<float>::kLeastAnchorSpread,
+                    Expect::at_least)) {
+      return false;
+    }
+    cable_count += static_cast<std::uint32_t>(cables);
+    inputs += static_cast<std::uint32_t>(encoded_segment_inputs(h.encoding, cables));
+  }
+  if (!run.expect(h.input_dims == inputs, ImageCheckId::cables, ImageStatus::invalid_parameters, "input_dims", -1,
+                  h.input_dims, inputs, Expect::equal) ||
+      !run.expect(h.hysteresis_cables == 0 || h.hysteresis_cables == cable_count, ImageCheckId::cables,
+                  ImageStatus::invalid_parameters, "hysteresis_cables", -1, h.hysteresis_cables, cable_count,
+                  Expect::equal)) {
+    return false;
+  }
+  run.expect(true, ImageCheckId::cables, ImageStatus::invalid_parameters, Run::name("cables"), -1, 0, 0,
+             Expect::finite, image_cables_floats(h.segments));
+  return true;
+}
+
 // The view of an image that passed every check.
 inline ImageView make_view(const std::uint8_t* bytes, const DeclaredImage& h, const ImageBlocks& b,
-                           const ImageParameterArrays& p, std::uint32_t fitted) {
+                           const ImageParameterArrays& p, std::uint32_t fitted, std::uint32_t cable_count) {
   ImageView v{};
   v.version_major = h.major;
   v.version_minor = h.minor;
@@ -1482,6 +1585,8 @@ inline ImageView make_view(const std::uint8_t* bytes, const DeclaredImage& h, co
     v.compliance_softening = v.compliance_ratios + h.compliance_segments;
     v.compliance_unloaded_mass = v.compliance_softening + 1;
   }
+  v.cables = b.cables;
+  v.cable_count = static_cast<int>(cable_count);
   const std::uint8_t* metadata = b.metadata;
   v.dataset_hash = read_u64(metadata + image_metadata_field::dataset_hash);
   v.created_unix_s = static_cast<std::int64_t>(read_u64(metadata + image_metadata_field::created_unix_s));
@@ -1490,6 +1595,17 @@ inline ImageView make_view(const std::uint8_t* bytes, const DeclaredImage& h, co
   v.trainer = reinterpret_cast<const char*>(metadata + image_metadata_field::trainer);
   return v;
 }
+
+}  // namespace detail
+
+// Segment i's cables in a parsed image: the block's count, or the paper's
+// four without one.
+inline int image_segment_cables(const ImageView& image, int segment) {
+  if (image.cables == nullptr) return 4;
+  return image.cables[segment * image_cables_field::per_segment + image_cables_field::count] == 3.0f ? 3 : 4;
+}
+
+namespace detail {
 
 // Checks run from what is needed to read the rest (size, magic, version,
 // header) to the integrity check and then to the meaning of the payload, so
@@ -1515,13 +1631,15 @@ ImageStatus check_image(const std::uint8_t* bytes, std::size_t size, ImageView& 
   const ImageBlocks blocks = locate_blocks<Run>(bytes, size, h);
   const ImageParameterArrays parameters = parameter_arrays(blocks.parameters, h);
   std::uint32_t fitted = h.points;
+  std::uint32_t cable_count = 0;
   if (!check_finite(run, blocks, h, scan) || !check_positive(run, blocks, parameters, h) ||
       !check_ranges(run, parameters, h) || !check_fitted_rows(run, blocks.metadata, h, fitted) ||
-      !check_variance_block(run, blocks.variance, parameters, h) || !check_optional_blocks(run, blocks, h)) {
+      !check_variance_block(run, blocks.variance, parameters, h) || !check_optional_blocks(run, blocks, h) ||
+      !check_cables_block(run, blocks.cables, h, cable_count)) {
     return run.status;
   }
   if (run.status != ImageStatus::ok) return run.status;
-  view = make_view(bytes, h, blocks, parameters, fitted);
+  view = make_view(bytes, h, blocks, parameters, fitted, cable_count);
   return ImageStatus::ok;
 }
 }  // namespace detail

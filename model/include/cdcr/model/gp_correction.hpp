@@ -115,6 +115,18 @@ struct GpPointTerms {
   }
 };
 
+// One evaluation of GpCorrection in progress (begin_evaluation).
+template <typename S, typename Accumulator, int MaxInputs, int MaxSegments>
+struct GpEvaluation {
+  S z[MaxInputs] = {};
+  Accumulator sums[kImageOutputs] = {};
+  // sum_i alpha_ik r_i z_i, for the gradient.
+  S weighted[kImageOutputs][MaxInputs] = {};
+  JointVector<S, MaxSegments> bend;
+  std::uint32_t next_point = 0;
+  bool with_gradient = false;
+};
+
 }  // namespace detail
 
 template <typename S, typename Accumulator = double, int MaxSegments = kMaxSegments, typename Arch = arch::Selected>
@@ -135,8 +147,12 @@ class GpCorrection {
     training_points_ = image.training_points;
     input_dims_ = image.input_dims;
     bend_dims_ = 2 * image.segment_count;
-    residual_dims_ = model::takes_cable_residuals(image.encoding) ? kCableResidualsPerSegment * image.segment_count : 0;
-    history_dims_ = model::takes_history(image.encoding) ? kHistoryInputsPerSegment * image.segment_count : 0;
+    // Per segment its common mode, and with four cables its pairs'
+    // imbalance (input_encoding.hpp); a history input per cable.
+    segment_count_ = image.segment_count;
+    for (int i = 0; i < segment_count_; ++i) four_cables_[i] = image_segment_cables(image, i) == 4;
+    residual_dims_ = model::takes_cable_residuals(image.encoding) ? image.cable_count - 2 * segment_count_ : 0;
+    history_dims_ = model::takes_history(image.encoding) ? image.cable_count : 0;
     extra_inputs_ = image.extra_inputs;
     held_inputs_ = residual_dims_ + history_dims_ + extra_inputs_;
     if (bend_dims_ + held_inputs_ != input_dims_ || extra_inputs_ > kMaxExtraInputs || input_dims_ > kMaxInputs) {
@@ -179,8 +195,8 @@ class GpCorrection {
   // The residuals IK's evaluations use (zero until set); a model without
   // the inputs, or residuals of another robot, leave them as they are.
   void set_cable_residuals(const CableResiduals<S, MaxSegments>& residuals) {
-    if (residual_dims_ == 0 || residuals.size() != residual_dims_) return;
-    for (int e = 0; e < residual_dims_; ++e) held_[e] = residuals[e];
+    if (residual_dims_ == 0 || residuals.size() != kCableResidualsPerSegment * segment_count_) return;
+    residual_inputs(residuals, segment_count_, four_cables_, held_);
   }
   bool takes_history() const { return history_dims_ > 0; }
   int history_dims() const { return history_dims_; }
@@ -215,10 +231,12 @@ class GpCorrection {
   void kernel_coordinates(const JointVector<S, MaxSegments>& bend, const CableResiduals<S, MaxSegments>& residuals,
                           S* z) const {
     kernel_coordinates(bend, z);
-    if (residuals.size() != residual_dims_) return;
+    if (residual_dims_ == 0 || residuals.size() != kCableResidualsPerSegment * segment_count_) return;
+    S measured[kMaxInputs];
+    residual_inputs(residuals, segment_count_, four_cables_, measured);
     for (int e = 0; e < residual_dims_; ++e) {
       const int d = bend_dims_ + e;
-      z[d] = (residuals[e] - input_mean_[d]) * input_gain_[d];
+      z[d] = (measured[e] - input_mean_[d]) * input_gain_[d];
     }
   }
 
@@ -257,15 +275,7 @@ class GpCorrection {
   // The gradient pass goes over chunks of this many training points.
   static constexpr std::uint32_t kChunkPoints = 8 * kBlockPoints;
 
-  struct Evaluation {
-    S z[kMaxInputs] = {};
-    Accumulator sums[kImageOutputs] = {};
-    // sum_i alpha_ik r_i z_i, for the gradient.
-    S weighted[kImageOutputs][kMaxInputs] = {};
-    JointVector<S, MaxSegments> bend;
-    std::uint32_t next_point = 0;
-    bool with_gradient = false;
-  };
+  using Evaluation = detail::GpEvaluation<S, Accumulator, kMaxInputs, MaxSegments>;
 
   Status begin_evaluation(const JointVector<S, MaxSegments>& bend, Evaluation& evaluation,
                           bool with_gradient = false) const {
@@ -503,6 +513,8 @@ class GpCorrection {
   int bend_dims_ = 0;
   int residual_dims_ = 0;
   int history_dims_ = 0;
+  int segment_count_ = 0;
+  bool four_cables_[MaxSegments] = {};
   int extra_inputs_ = 0;
   int held_inputs_ = 0;
   std::uint32_t mean_point_units_ = 1;

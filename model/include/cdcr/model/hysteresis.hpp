@@ -51,7 +51,7 @@ namespace cdcr::model {
 // state the homing move leaves.
 template <typename S>
 struct HysteresisModel {
-  int cables = 0;     // 4 per segment; 0: no hysteresis model
+  int cables = 0;     // the robot's cables; 0: no hysteresis model
   int operators = 0;  // play operators per cable, 1..kMaxHysteresisOperators
   S widths_mm[kMaxCables][kMaxHysteresisOperators] = {};
   S weights[kMaxCables][kMaxHysteresisOperators] = {};
@@ -70,15 +70,15 @@ struct HysteresisModel {
 // Why a hysteresis model is not usable; the image parser reports the same.
 enum class HysteresisCheck : std::uint8_t {
   ok = 0,
-  bad_counts,         // cables not 4 per segment, or operators outside 1..capacity
+  bad_counts,         // cables not the robot's, or operators outside 1..capacity
   bad_width,          // a width not finite, negative or above kMaxHysteresisWidthMm
   bad_weight,         // a weight not finite, negative, or a cable's weights summing above 1
   bad_homing_lag,     // a homing lag not finite or outside [-width, width]
 };
 
 template <typename S>
-HysteresisCheck check_hysteresis(const HysteresisModel<S>& model, int segment_count) {
-  if (model.cables != 4 * segment_count || model.cables > kMaxCables || model.operators < 1 ||
+HysteresisCheck check_hysteresis(const HysteresisModel<S>& model, int cable_count) {
+  if (model.cables != cable_count || model.cables > kMaxCables || model.operators < 1 ||
       model.operators > kMaxHysteresisOperators) {
     return HysteresisCheck::bad_counts;
   }

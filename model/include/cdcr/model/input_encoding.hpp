@@ -67,12 +67,29 @@ constexpr InputEncoding with_history(InputEncoding encoding, bool history) {
   return history ? InputEncoding::bend_vector_history : InputEncoding::bend_vector;
 }
 
-// Inputs the encoding gives a robot of `segments` segments (before any
-// extra input).
+// Inputs of what a segment's cables say beyond the bend (cable_fit.hpp):
+// the common mode, and with four cables the pairs' imbalance.
+constexpr int cable_residual_inputs(int cables) { return cables - 2; }
+
+// Inputs the encoding gives a segment of `cables` cables: its bend, its
+// residuals, where each of its cables last moved.
+constexpr int encoded_segment_inputs(InputEncoding encoding, int cables) {
+  return 2 + (takes_cable_residuals(encoding) ? cable_residual_inputs(cables) : 0) +
+         (takes_history(encoding) ? cables : 0);
+}
+
+// Inputs the encoding gives a robot of `segments` segments of the paper's
+// four cables (before any extra input).
 constexpr int encoded_input_count(InputEncoding encoding, int segments) {
-  return (2 + (takes_cable_residuals(encoding) ? kCableResidualsPerSegment : 0) +
-          (takes_history(encoding) ? kHistoryInputsPerSegment : 0)) *
-         segments;
+  return encoded_segment_inputs(encoding, 4) * segments;
+}
+
+// ... and of any geometry's cables.
+template <typename S, int Max>
+int encoded_input_count(InputEncoding encoding, const RobotGeometry<S, Max>& geometry) {
+  int inputs = 0;
+  for (int i = 0; i < geometry.segment_count; ++i) inputs += encoded_segment_inputs(encoding, geometry.segments[i].cables.count);
+  return inputs;
 }
 
 // The bend's part of x (its first 2n values) from the stacked bend vector.

@@ -21,13 +21,12 @@ inline constexpr int kMaxExtraInputs = 1;
 // the same count (the paper's four segments do: 4 x 4 inputs).
 constexpr int max_model_inputs(int segments) { return 2 * segments + kMaxExtraInputs; }
 
-// Inputs per segment of what its cables say beyond the bend: the cable
-// fit's common mode and pair imbalance (cable_fit.hpp).
+// What a segment's cables say beyond the bend, per segment: the cable
+// fit's common mode and pair imbalance (cable_fit.hpp; the imbalance is an
+// input only with four cables, input_encoding.hpp). A model that takes
+// them, and the cables' history (one input per cable), must fit the same
+// count too (one segment: 2 + 2 + 4 inputs; two: 16).
 inline constexpr int kCableResidualsPerSegment = 2;
-// Inputs per segment of the cables' history: where each of its four cables
-// last moved (hysteresis.hpp, history_inputs). A model that takes them must
-// fit the same count too (one segment: 2 + 2 + 4 inputs; two: 16).
-inline constexpr int kHistoryInputsPerSegment = 4;
 inline constexpr int kMaxInputs = max_model_inputs(kMaxSegments);
 
 // Cables of a segment: three (at 120 degrees, the fewest that read a bend

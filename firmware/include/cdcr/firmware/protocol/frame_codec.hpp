@@ -22,6 +22,7 @@
 // would: a board pays nothing for the table walk.
 
 #include <array>
+#include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <limits>
@@ -137,19 +138,26 @@ struct CableLengths {
     }
     return true;
   }
+  // The last signal of a segment of three cables is "not available" both
+  // ways: NaN in the struct, kCableNotAvailableRaw on the wire (the
+  // receiver knows the segment's cables; a four-cable segment's NaN is its
+  // to refuse).
   static bool put(SignalList signals, const Struct& f, std::uint64_t& word) {
-    int k = 0;
+    std::size_t k = 0;
     for (const SignalSpec* signal : signals) {
-      std::int64_t raw = 0;
-      if (!cable_length_raw(*signal, (f.*Member)[k++], raw)) return false;
+      const double length_mm = (f.*Member)[k++];
+      std::int64_t raw = kCableNotAvailableRaw;
+      if (!(k == signal_count && std::isnan(length_mm)) && !cable_length_raw(*signal, length_mm, raw)) return false;
       word |= placed(*signal, raw);
     }
     return true;
   }
   static DecodeStatus check(SignalList signals, std::uint64_t word) {
+    std::size_t k = 0;
     for (const SignalSpec* signal : signals) {
       const std::int64_t raw = raw_in_word(word, *signal);
-      if (raw == kCableNotAvailableRaw) return DecodeStatus::not_available;
+      const bool last = ++k == signal_count;
+      if (raw == kCableNotAvailableRaw && !last) return DecodeStatus::not_available;
       if (raw == 0) return DecodeStatus::out_of_range;  // a cable has a length
     }
     return DecodeStatus::ok;
@@ -157,7 +165,10 @@ struct CableLengths {
   template <typename... Context>
   static void get(SignalList signals, std::uint64_t word, Struct& f, const Context&...) {
     int k = 0;
-    for (const SignalSpec* signal : signals) (f.*Member)[k++] = physical_in_word(word, *signal);
+    for (const SignalSpec* signal : signals) {
+      const bool absent = raw_in_word(word, *signal) == kCableNotAvailableRaw;
+      (f.*Member)[k++] = absent ? std::numeric_limits<double>::quiet_NaN() : physical_in_word(word, *signal);
+    }
   }
 };
 

@@ -17,6 +17,7 @@
 
 #include <cstddef>
 #include <cstdint>
+#include <limits>
 
 #include "cdcr/firmware/fault.hpp"
 #include "cdcr/firmware/fault_detail.hpp"
@@ -30,14 +31,28 @@
 namespace cdcr::firmware::protocol {
 
 // CABLE_FEEDBACK_s and CABLE_SETPOINT_s: the four cable lengths of a segment.
+// L1..L4; a segment of three cables has no L4: NaN here, "not available"
+// on the wire.
 struct CableFeedback {
   int segment = 0;
-  double lengths_mm[4] = {};  // L1..L4
+  double lengths_mm[4] = {};
 };
 struct CableSetpoint {
   int segment = 0;
-  double lengths_mm[4] = {};  // L1..L4
+  double lengths_mm[4] = {};
 };
+
+// Segment `segment`'s frame from a robot's cable vector (segment by
+// segment): its `count` cables from `first`, then not available.
+template <typename Frame, typename Vector>
+Frame segment_cables_frame(int segment, const Vector& cables_mm, int first, int count) {
+  Frame frame;
+  frame.segment = segment;
+  for (int k = 0; k < 4; ++k) {
+    frame.lengths_mm[k] = k < count ? double(cables_mm[first + k]) : std::numeric_limits<double>::quiet_NaN();
+  }
+  return frame;
+}
 
 // PAYLOAD: kg.
 // The homing move has ended: the robot is at home (HOMING).
