@@ -598,6 +598,58 @@ TEST(CApiInputs, ByCallAndByFrameTheRuntimeSendsTheSameFrames) {
   }
 }
 
+// A robot of three cables a segment: from its image (the cables block), or
+// from the fallback geometry without one. Lengths go in three a segment and
+// the setpoints come out so.
+TEST_F(CApiRuntime, ThreeCablesASegment) {
+  test_support::SyntheticModelOptions options;
+  options.training_points = 8;
+  options.cables_per_segment = 3;
+  options.position_output_factor = 0.1;
+  options.rotation_output_factor = 0.001;
+  init(exporting::write_image(test_support::synthetic_trained_model(options)));
+  EXPECT_EQ(status().state, CDCR_STATE_RUN);
+  int cables = 0;
+  ASSERT_EQ(cdcr_get_segment_cables(&runtime, 1, &cables), CDCR_OK);
+  EXPECT_EQ(cables, 3);
+  EXPECT_EQ(cdcr_get_segment_cables(&runtime, 2, &cables), CDCR_ERROR_INVALID_ARGUMENT);
+  EXPECT_EQ(cdcr_get_segment_cables(&runtime, 0, nullptr), CDCR_ERROR_NULL_ARGUMENT);
+  // Bent a little: eq. (2) for three anchors at 0, -120 and 120 degrees.
+  const std::vector<float> lengths = {119.2f, 120.6f, 120.2f, 120.4f, 119.5f, 120.1f};
+  const std::vector<float> four_a_segment(8, 120.0f);
+  EXPECT_EQ(cdcr_set_cable_lengths(&runtime, four_a_segment.data(), four_a_segment.size()),
+            CDCR_ERROR_INVALID_ARGUMENT);
+  step_with(lengths, 3);
+  cdcr_pose start{};
+  ASSERT_EQ(cdcr_get_pose(&runtime, &start), CDCR_OK);
+  EXPECT_EQ(start.compensated, 1);
+  // One segment's three (the array holds no fourth).
+  const float three[3] = {119.2f, 120.6f, 120.2f};
+  EXPECT_EQ(cdcr_set_segment_cable_lengths(&runtime, 0, three), CDCR_OK);
+  const cdcr_target target = position_target_near(start, 9);
+  ASSERT_EQ(cdcr_set_target(&runtime, &target), CDCR_OK);
+  step_while_solving(lengths);
+  EXPECT_EQ(status().ik_outcome, CDCR_IK_CONVERGED);
+  cdcr_setpoints setpoints{};
+  ASSERT_EQ(cdcr_get_setpoints(&runtime, &setpoints), CDCR_OK);
+  EXPECT_EQ(setpoints.cable_count, 6);
+  for (int i = 0; i < 6; ++i) EXPECT_TRUE(std::isfinite(setpoints.lengths_mm[i]) && setpoints.lengths_mm[i] > 0.0f) << i;
+
+  // Without an image, the fallback's three.
+  config.model_image = nullptr;
+  config.model_image_size = 0;
+  config.fallback_geometry = cdcr_geometry{2, 120.0f, 67.0f, 1.5707963f, 3};
+  ASSERT_EQ(cdcr_init(&runtime, &config), CDCR_OK);
+  ASSERT_EQ(cdcr_get_segment_cables(&runtime, 0, &cables), CDCR_OK);
+  EXPECT_EQ(cables, 3);
+  step_with(lengths);
+  cdcr_pose nominal{};
+  ASSERT_EQ(cdcr_get_pose(&runtime, &nominal), CDCR_OK);
+  EXPECT_EQ(nominal.compensated, 0);
+  config.fallback_geometry = cdcr_geometry{2, 120.0f, 67.0f, 1.5707963f, 5};
+  EXPECT_EQ(cdcr_init(&runtime, &config), CDCR_ERROR_INVALID_ARGUMENT);
+}
+
 TEST_F(CApiRuntime, EveryUnusableArgumentHasItsErrorCode) {
   cdcr_status s{};
   cdcr_pose pose{};

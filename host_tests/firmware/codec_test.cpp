@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include <Eigen/Core>
 #include <gtest/gtest.h>
 
 #include <cdcr/firmware/fault_detail.hpp>
@@ -257,11 +258,39 @@ TEST(Frames, CableDecoderRejectsMalformedFrames) {
   CableFeedback feedback;
   EXPECT_EQ(decode(frame_of(0x100, {1, 0, 1, 0, 1, 0}), feedback), DecodeStatus::wrong_dlc);
   EXPECT_EQ(decode(frame_of(0x100, {1, 0, 0xFF, 0xFF, 1, 0, 1, 0}), feedback), DecodeStatus::not_available);
+  EXPECT_EQ(decode(frame_of(0x100, {0xFF, 0xFF, 1, 0, 1, 0, 1, 0}), feedback), DecodeStatus::not_available);
   EXPECT_EQ(decode(frame_of(0x100, {1, 0, 0, 0, 1, 0, 1, 0}), feedback), DecodeStatus::out_of_range);
+  EXPECT_EQ(decode(frame_of(0x100, {1, 0, 1, 0, 1, 0, 0, 0}), feedback), DecodeStatus::out_of_range);
   EXPECT_EQ(decode(frame_of(0x108, {1, 0, 1, 0, 1, 0, 1, 0}), feedback), DecodeStatus::wrong_id);
   feedback.segment = 5;
   EXPECT_EQ(decode(frame_of(0x0FF, {1, 0, 1, 0, 1, 0, 1, 0}), feedback), DecodeStatus::wrong_id);
   EXPECT_EQ(feedback.segment, 5);  // untouched on failure
+}
+
+// A segment of three cables: L4 is "not available" on the wire and NaN in
+// the struct, both ways; only L4 may be missing.
+TEST(Frames, ASegmentOfThreeCablesLeavesL4NotAvailable) {
+  hal::CanFrame frame;
+  const double nan = std::nan("");
+  ASSERT_TRUE(encode(CableSetpoint{2, {100, 101.5, 99.25, nan}}, frame));
+  EXPECT_EQ(bytes_of(frame), (std::vector<std::uint8_t>{0x10, 0x27, 0xA6, 0x27, 0xC5, 0x26, 0xFF, 0xFF}));
+  CableSetpoint setpoint;
+  ASSERT_EQ(decode(frame, setpoint), DecodeStatus::ok);
+  EXPECT_DOUBLE_EQ(setpoint.lengths_mm[2], 99.25);
+  EXPECT_TRUE(std::isnan(setpoint.lengths_mm[3]));
+  EXPECT_FALSE(encode(CableSetpoint{2, {nan, 101.5, 99.25, 100}}, frame));
+  EXPECT_FALSE(encode(CableSetpoint{2, {100, 101.5, nan, 100}}, frame));
+  CableFeedback feedback;
+  EXPECT_EQ(decode(frame_of(0x100, {1, 0, 1, 0, 0xFF, 0xFF, 1, 0}), feedback), DecodeStatus::not_available);
+  ASSERT_EQ(decode(frame_of(0x100, {1, 0, 1, 0, 1, 0, 0xFF, 0xFF}), feedback), DecodeStatus::ok);
+  EXPECT_TRUE(std::isnan(feedback.lengths_mm[3]));
+  // The frame a robot's cable vector gives for a segment of three.
+  const Eigen::VectorXd cables = (Eigen::VectorXd(7) << 1, 2, 3, 4, 5, 6, 7).finished();
+  const CableFeedback third = segment_cables_frame<CableFeedback>(1, cables, 4, 3);
+  EXPECT_EQ(third.segment, 1);
+  EXPECT_EQ(third.lengths_mm[0], 5);
+  EXPECT_EQ(third.lengths_mm[2], 7);
+  EXPECT_TRUE(std::isnan(third.lengths_mm[3]));
 }
 
 TEST(Frames, TargetPositionZCarriesModeTrackingAndSequence) {

@@ -57,7 +57,7 @@ inline model::CableVector<double, firmware::kMaxSegments> bent_cables(const firm
   g.segment_count = geometry.segment_count;
   for (int s = 0; s < g.segment_count; ++s) {
     g.segments[s] = {double(geometry.segments[s].backbone_length_mm), double(geometry.segments[s].anchor_radius_mm),
-                     double(geometry.segments[s].theta_max_rad)};
+                     double(geometry.segments[s].theta_max_rad), geometry.segments[s].cables.cast<double>()};
   }
   model::JointVector<double> joints(2 * g.segment_count);
   for (int s = 0; s < g.segment_count; ++s) {

@@ -28,7 +28,8 @@ class RuntimeTest : public ::testing::Test {
   void start_runtime(const hal::Hal& hal) {
     runtime = std::make_unique<firmware::Runtime>(hal, firmware::Geometry::uniform(2, 120.0f, 67.0f));
     runtime->init();
-    drives = std::make_unique<sim::SimulatedCableDrives>(platform->drives_node, bent_cables(runtime->geometry()), 50.0);
+    drives = std::make_unique<sim::SimulatedCableDrives>(platform->drives_node, bent_cables(runtime->geometry()), 50.0,
+                                                         sim::cables_per_segment(runtime->geometry()));
     const hal::CanFilter host_filters[] = {firmware::protocol::kIkReportFrames, firmware::protocol::kStatusFrames,
                                            firmware::protocol::kCableSetpointFrames};
     platform->host_node.set_filters(host_filters, 3);

@@ -37,6 +37,9 @@ struct SyntheticModelOptions {
   // model): widths 0.2 to 0.7 mm, weights summing to 0.6 to 1 per cable,
   // the homing lags the homing move leaves on this geometry.
   int hysteresis_operators = 0;
+  // Cables per segment: the paper's four at 90 degrees, or three at 120
+  // (an image with the cables block).
+  int cables_per_segment = 4;
 };
 
 // A hysteresis model for `geometry` with random but valid values (widths
@@ -47,7 +50,7 @@ model::HysteresisModel<double> synthetic_hysteresis(const model::RobotGeometry<d
                                                     Rng& rng) {
   const auto uniform = [&rng](double low, double high) { return std::uniform_real_distribution<double>(low, high)(rng); };
   model::HysteresisModel<double> h;
-  h.cables = 4 * geometry.segment_count;
+  h.cables = geometry.cable_count();
   h.operators = operators;
   for (int c = 0; c < h.cables; ++c) {
     const double total = uniform(0.6, 1.0);
@@ -71,10 +74,16 @@ inline training::TrainedModel synthetic_trained_model(const SyntheticModelOption
   m.encoding = model::with_history(m.encoding, options.history);
   m.geometry = model::RobotGeometry<double>::uniform(options.segments, 120.0, 67.0);
   m.geometry.segments[options.segments - 1].backbone_length_mm = 95.5;  // not all segments alike
+  if (options.cables_per_segment != 4) {
+    for (int s = 0; s < options.segments; ++s) {
+      m.geometry.segments[s].cables = model::CableLayout<double>::evenly_spaced(options.cables_per_segment);
+    }
+  }
 
   const int n = options.training_points;
-  const int residuals = options.cable_residuals ? 2 * options.segments : 0;
-  const int history = options.history ? 4 * options.segments : 0;
+  const int residuals_per_segment = options.cables_per_segment - 2;
+  const int residuals = options.cable_residuals ? residuals_per_segment * options.segments : 0;
+  const int history = options.history ? options.cables_per_segment * options.segments : 0;
   const int d = 2 * options.segments + residuals + history + (options.payload_input ? 1 : 0);
   m.inputs.resize(n, d);
   for (int i = 0; i < n; ++i) {
@@ -90,8 +99,8 @@ inline training::TrainedModel synthetic_trained_model(const SyntheticModelOption
       }
     }
     for (int s = 0; s < options.segments && residuals > 0; ++s) {
-      m.inputs(i, 2 * options.segments + 2 * s) = uniform(-1.5, 0.0);
-      m.inputs(i, 2 * options.segments + 2 * s + 1) = uniform(-1.0, 1.0);
+      m.inputs(i, 2 * options.segments + residuals_per_segment * s) = uniform(-1.5, 0.0);
+      if (residuals_per_segment == 2) m.inputs(i, 2 * options.segments + 2 * s + 1) = uniform(-1.0, 1.0);
     }
     for (int c = 0; c < history; ++c) m.inputs(i, 2 * options.segments + residuals + c) = uniform(-1.0, 1.0);
     if (options.payload_input) m.inputs(i, d - 1) = uniform(0.0, 1.0);

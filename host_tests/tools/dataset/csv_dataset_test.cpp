@@ -47,6 +47,24 @@ TEST(DatasetCsv, ParsesCableColumns) {
   EXPECT_EQ(data.content_hash, fnv1a64(text));
 }
 
+// Three cables a segment, or three and four in one robot; written back
+// with the same columns.
+TEST(DatasetCsv, SegmentsOfThreeCables) {
+  const std::string text = "l1_1,l1_2,l1_3,l2_1,l2_2,l2_3,l2_4\n120,121.5,119,1,2,3,4\n";
+  const Dataset data = parse_dataset_csv(text);
+  EXPECT_EQ(data.segment_count, 2);
+  EXPECT_EQ(data.segment_cables, (std::vector<int>{3, 4}));
+  EXPECT_EQ(data.cable_count(), 7);
+  ASSERT_EQ(data.cables_mm.cols(), 7);
+  EXPECT_EQ(data.cables_mm(0, 2), 119.0);
+  EXPECT_EQ(data.cables_mm(0, 3), 1.0);
+  const std::string written = format_dataset_csv(data);
+  EXPECT_EQ(written.substr(0, written.find('\n') + 1), "l1_1,l1_2,l1_3,l2_1,l2_2,l2_3,l2_4\n");
+  const Dataset back = parse_dataset_csv(written);
+  EXPECT_EQ(back.segment_cables, data.segment_cables);
+  EXPECT_EQ(back.cables_mm, data.cables_mm);
+}
+
 TEST(DatasetCsv, ParsesPosesAsHamiltonQuaternionWFirst) {
   const Eigen::Quaterniond q(Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, -0.5).normalized()));
   char row[256];
