@@ -41,4 +41,7 @@ train_unless_unchanged(robot.csv model.img)
 # budget with a compliance block: cdcr train identifies the segments'
 # compliance under the load and exports the block.
 train_unless_unchanged(payload_robot.csv payload_model.img --payload-range 0,1)
-run(${MAKE_GOLDEN} ${OUT_DIR}/model.img ${OUT_DIR} ${OUT_DIR}/payload_model.img)
+# The same robot with three cables a segment, for the cycle budget of a
+# three-cable robot (the image's cables block).
+train_unless_unchanged(three_cable_robot.csv three_cable_model.img --cables-per-segment 3)
+run(${MAKE_GOLDEN} ${OUT_DIR}/model.img ${OUT_DIR} ${OUT_DIR}/payload_model.img ${OUT_DIR}/three_cable_model.img)

@@ -9,6 +9,9 @@
 //   cdcr_model_image_compliance.cpp  PAYLOAD_IMAGE (a payload model of the
 //                                 same robot with a compliance block): the
 //                                 cycle budget with the payload's sag
+//   cdcr_model_image_three_cables.cpp  THREE_CABLE_IMAGE (a model of the
+//                                 robot with three cables a segment): the
+//                                 cycle budget of a three-cable robot
 //   qemu_golden.hpp               cable inputs as they travel on the bus, and
 //                                 the poses the host computes for them in
 //                                 double: compensated with the image, and
@@ -81,8 +84,8 @@ void append_pose(const cdcr::model::Pose<double>& pose, std::ostringstream& posi
 }  // namespace
 
 int main(int argc, char** argv) {
-  if (argc != 4) {
-    std::fprintf(stderr, "usage: make_qemu_golden IMAGE OUT_DIR PAYLOAD_IMAGE\n");
+  if (argc != 5) {
+    std::fprintf(stderr, "usage: make_qemu_golden IMAGE OUT_DIR PAYLOAD_IMAGE THREE_CABLE_IMAGE\n");
     return 2;
   }
   const std::string dir = argv[2];
@@ -217,6 +220,20 @@ int main(int argc, char** argv) {
     c_options.description = std::string("a payload model with a compliance block, from ") + argv[3];
     write_text(dir + "/cdcr_model_image_compliance.cpp",
                cdcr::exporting::format_c_source(payload_image.data(), payload_image.size(), c_options));
+
+    const std::vector<std::uint8_t> three_cable_image = cdcr::exporting::read_binary_file(argv[4]);
+    cdcr::model::ImageView three_cable_view{};
+    if (const auto s = cdcr::model::parse_image(three_cable_image.data(), three_cable_image.size(), three_cable_view,
+                                                cdcr::model::ImageCapacity{});
+        s != cdcr::model::ImageStatus::ok) {
+      throw std::runtime_error(std::string(argv[4]) + ": " + cdcr::model::to_string(s));
+    }
+    if (three_cable_view.cable_count != 3 * three_cable_view.segment_count) {
+      throw std::runtime_error(std::string(argv[4]) + ": not three cables a segment");
+    }
+    c_options.description = std::string("a model of the robot with three cables a segment, from ") + argv[4];
+    write_text(dir + "/cdcr_model_image_three_cables.cpp",
+               cdcr::exporting::format_c_source(three_cable_image.data(), three_cable_image.size(), c_options));
 
     // In the middle of the training data: only the CRC can tell.
     image[image.size() / 2] ^= 0xFF;

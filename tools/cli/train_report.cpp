@@ -131,8 +131,13 @@ std::string hysteresis_text(const TrainRun& run) {
   const model::HysteresisModel<double>& m = s.result.model.hysteresis;
   if (!m.empty()) {
     t += "  widths (mm) per cable:";
-    for (int c = 0; c < m.cables; ++c) {
-      t += c % 4 == 0 ? " |" : "";
+    // A bar before each segment's cables.
+    const model::RobotGeometry<double>& geometry = s.result.model.geometry;
+    for (int c = 0, segment = 0; c < m.cables; ++c) {
+      if (segment < geometry.segment_count && c == geometry.first_cable(segment)) {
+        t += " |";
+        ++segment;
+      }
       for (int k = 0; k < m.operators; ++k) t += fmt::format("{}{:.3f}", k == 0 ? " " : "/", m.widths_mm[c][k]);
     }
     t += "\n  weights:";

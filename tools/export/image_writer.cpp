@@ -70,7 +70,8 @@ void put_cables(ImageBuffer& image, std::size_t block, const model::RobotGeometr
     image.put_float(at + 4 * count, layout.count);
     for (int j = 0; j < model::kMaxCablesPerSegment; ++j) {
       image.put_float(at + 4 * (angles + j),
-                      j < layout.count ? std::atan2(layout.anchor_y[j], layout.anchor_x[j]) : 0.0);
+                      // + 0.0: the angle on the x axis is 0, not -0.
+                      j < layout.count ? std::atan2(layout.anchor_y[j], layout.anchor_x[j]) + 0.0 : 0.0);
     }
   }
 }

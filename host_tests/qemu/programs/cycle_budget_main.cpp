@@ -262,12 +262,13 @@ std::uint32_t report_unit_costs(const model::ImageView& image) {
   }
   model::CableVector<float, firmware::kMaxSegments> cables;
   cdcr::hal::CanFrame frames[firmware::kMaxSegments];
+  const firmware::Geometry& geometry = runtime.geometry();
   const std::uint32_t setpoints = counter.instructions([&] {
-    model::cables_from_joints(joints, runtime.geometry(), cables);
+    model::cables_from_joints(joints, geometry, cables);
     for (int s = 0; s < segments; ++s) {
-      protocol::encode(
-          protocol::CableSetpoint{s, {cables[4 * s], cables[4 * s + 1], cables[4 * s + 2], cables[4 * s + 3]}},
-          frames[s]);
+      protocol::encode(protocol::segment_cables_frame<protocol::CableSetpoint>(s, cables, geometry.first_cable(s),
+                                                                               geometry.segments[s].cables.count),
+                       frames[s]);
     }
   });
   // The residuals are read through volatile: the codec inlines into this
@@ -433,13 +434,35 @@ WORKLOAD_STEP bool start(Workload& workload) {
     return false;
   }
   if (with_compliance) report_compliance_costs();
+  const firmware::Geometry& geometry = runtime.geometry();
+  if ((geometry.cable_count() == 3 * segments) != cdcr::qemu_programs::kExpectThreeCables) {
+    console::console_write(cdcr::qemu_programs::kExpectThreeCables ? "FAIL: the image's segments have not three cables\n"
+                                                                   : "FAIL: an image of three cables a segment\n");
+    return false;
+  }
   return true;
 }
 
-// The drives start where golden case 0 has them; forward-only cycles.
+// The drives start where golden case 0 has them (the golden cases are the
+// four-cable robot's; a three-cable robot starts at a bend of its own);
+// forward-only cycles.
 WORKLOAD_STEP void forward_only_cycles(Workload& workload) {
+  const firmware::Geometry& geometry = runtime.geometry();
+  firmware::Cables start(geometry.cable_count());
+  if (geometry.paper_cables()) {
+    for (int i = 0; i < start.size(); ++i) start[i] = float(cdcr::qemu_golden::kCablesMm[0][i]);
+  } else {
+    model::JointVector<float> joints(2 * segments);
+    for (int s = 0; s < segments; ++s) {
+      joints[2 * s] = 0.4f * float(s);
+      joints[2 * s + 1] = 0.12f;
+    }
+    model::cables_from_joints(joints, geometry, start);
+  }
   for (int s = 0; s < segments; ++s) {
-    for (int k = 0; k < 4; ++k) drives.lengths_mm[s][k] = float(cdcr::qemu_golden::kCablesMm[0][4 * s + k]);
+    const protocol::CableFeedback lengths = protocol::segment_cables_frame<protocol::CableFeedback>(
+        s, start, geometry.first_cable(s), geometry.segments[s].cables.count);
+    for (int k = 0; k < 4; ++k) drives.lengths_mm[s][k] = float(lengths.lengths_mm[k]);
   }
   for (int i = 0; i < 100; ++i) workload.cycle();
 }

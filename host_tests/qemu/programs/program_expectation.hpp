@@ -14,5 +14,7 @@ extern const bool kExpectDegradedBoot;
 extern const bool kExpectHysteresisBlock;
 // The image has a compliance block: the runtime sags the nominal pose.
 extern const bool kExpectComplianceBlock;
+// The image's segments have three cables each (its cables block).
+extern const bool kExpectThreeCables;
 
 }  // namespace cdcr::qemu_programs

@@ -7,6 +7,7 @@
 // above the nominal model's.
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <fstream>
 #include <iostream>
 #include <iterator>
@@ -56,6 +57,38 @@ TEST(TrainEndToEnd, SimulateTrainEvalRemovesMostOfTheError) {
   EXPECT_GT(initial_mm, 1.0);
   EXPECT_LT(compensated_mm, 0.25 * initial_mm) << run.out;
   EXPECT_LT(compensated_deg, 0.25 * initial_deg) << run.out;
+}
+
+// A robot of three cables a segment at 120 degrees, through the same
+// chain: its image carries the cables block, and it reaches the noise floor
+// and holds its radii as the four-cable robot does.
+TEST(TrainEndToEnd, AThreeCableRobotReachesItsNoiseFloor) {
+  const std::string dir = testing::TempDir();
+  const std::string train = "'" + dir + "three_cables_train.csv'";
+  const std::string test = "'" + dir + "three_cables_test.csv'";
+  const std::string image = "'" + dir + "three_cables_model.img'";
+  CliRun run = run_cdcr("simulate --cables-per-segment 3 --samples 700 --seed 1 --out " + train);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  run = run_cdcr("simulate --cables-per-segment 3 --samples 200 --seed 1 --session 1 --json --out " + test);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const double floor_mm = nlohmann::json::parse(run.out).at("noise_floor").at("position_mm").get<double>();
+  run = run_cdcr("train --data " + train + " --out " + image);
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  run = run_cdcr("inspect " + image + " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json inspected = nlohmann::json::parse(run.out);
+  ASSERT_TRUE(inspected.at("cables").is_array()) << run.out;
+  EXPECT_EQ(inspected.at("cables").at(0).at("count").get<double>(), 3.0);
+  run = run_cdcr("eval --model " + image + " --data " + test + " --json");
+  ASSERT_EQ(run.exit_code, 0) << run.err;
+  const nlohmann::json result = nlohmann::json::parse(run.out);
+  const double compensated_mm = result.at("compensated").at("position_mm").get<double>();
+  std::printf("three cables: compensated %.3f mm, noise floor %.3f mm (%.2fx); r95 covers %.1f %%\n", compensated_mm,
+              floor_mm, compensated_mm / floor_mm, 100.0 * result.at("coverage").at("r95_mm").get<double>());
+  EXPECT_LT(compensated_mm, 1.3 * floor_mm) << run.out;
+  EXPECT_GE(result.at("coverage").at("r95_mm").get<double>(), 0.9) << run.out;
+  EXPECT_LE(result.at("coverage").at("r95_mm").get<double>(), 0.985) << run.out;
+  EXPECT_EQ(result.at("extrapolating").get<int>(), 0) << run.out;
 }
 
 // The radii the image carries, checked as a user would: on a test set

@@ -117,14 +117,18 @@ namespace cable_feedback {
 inline constexpr MessageSpec kMessage{
     "CABLE_FEEDBACK", 0x100, kSegmentIdSlots, 8, "DRIVES", signal_list(cable_lengths::kSignals), kCableFeedbackFrames};
 inline constexpr MessageNotes kNotes{
-    &kMessage, "RUNTIME", "Achieved cable lengths of segment {segment}; raw 65535 = not available, 0 is invalid."};
+    &kMessage, "RUNTIME",
+    "Achieved cable lengths of segment {segment}; raw 65535 = not available, 0 is invalid. A segment of three cables "
+    "has no L4: 65535."};
 }
 
 // 0x110 + s: commanded cable lengths of segment s.
 namespace cable_setpoint {
 inline constexpr MessageSpec kMessage{
     "CABLE_SETPOINT", 0x110, kSegmentIdSlots, 8, "RUNTIME", signal_list(cable_lengths::kSignals), kCableSetpointFrames};
-inline constexpr MessageNotes kNotes{&kMessage, "DRIVES", "Commanded cable lengths of segment {segment}."};
+inline constexpr MessageNotes kNotes{&kMessage, "DRIVES",
+                                     "Commanded cable lengths of segment {segment}; a segment of three cables has no "
+                                     "L4: 65535."};
 }
 
 // 0x120: target orientation, before the commit frame of a pose target.
