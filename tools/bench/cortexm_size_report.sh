@@ -1,6 +1,6 @@
 #!/usr/bin/env bash
 # Memory report for Cortex-M ELF files, with the budget a board must fit:
-#   code  .vectors, .text (with .rodata), .ARM.*, .init_array   <= 112 KiB
+#   code  .vectors, .text (with .rodata), .ARM.*, .init_array   <= 120 KiB
 #   RAM   .data + .bss + the .stack reservation                  <= 32 KiB
 # The model image (.cdcr_model) is reported on its own: it is flashed
 # separately and sized by the model, not the firmware.
@@ -15,8 +15,11 @@ set -euo pipefail
 # the moments' Jacobian and a small solve, and its inverse for IK) took the
 # Cortex-M7 program 5.4 KB further, past 96 KiB; 108 KiB since IK's
 # preference among redundant solutions (its null-space step, 4 KB); 112 KiB
-# since the cable fit's residuals as GP inputs (6 KB).
-readonly code_budget=$((112 * 1024))
+# since the cable fit's residuals as GP inputs (6 KB); 120 KiB since three
+# cables a segment (6.9 KB: every read-out of the cables through the
+# segment's layout, a layout's weights derived from its angles, the cables
+# block's checks).
+readonly code_budget=$((120 * 1024))
 readonly ram_budget=$((32 * 1024))
 size_tool=${CDCR_SIZE:-arm-none-eabi-size}
 

@@ -29,15 +29,26 @@ namespace cdcr::model {
 // stay what eqs. (3)-(5) give, bit for bit.
 template <typename S>
 struct CableLayout {
-  int count = 4;
-  std::array<S, kMaxCablesPerSegment> anchor_x{S(1), S(0), S(-1), S(0)};
-  std::array<S, kMaxCablesPerSegment> anchor_y{S(0), S(-1), S(0), S(1)};
+  int count;
+  std::array<S, kMaxCablesPerSegment> anchor_x;
+  std::array<S, kMaxCablesPerSegment> anchor_y;
   // Rows of W, `count` weights each.
-  std::array<S, kMaxCablesPerSegment> mean_weights{S(0.25), S(0.25), S(0.25), S(0.25)};
-  std::array<S, kMaxCablesPerSegment> chord_x_weights{S(-1), S(0), S(1), S(0)};
-  std::array<S, kMaxCablesPerSegment> chord_y_weights{S(0), S(1), S(0), S(-1)};
+  std::array<S, kMaxCablesPerSegment> mean_weights;
+  std::array<S, kMaxCablesPerSegment> chord_x_weights;
+  std::array<S, kMaxCablesPerSegment> chord_y_weights;
   // n with four cables (its first entry positive); zeros with three.
-  std::array<S, kMaxCablesPerSegment> imbalance_weights{S(0.5), S(-0.5), S(0.5), S(-0.5)};
+  std::array<S, kMaxCablesPerSegment> imbalance_weights;
+
+  // The paper's layout. Not inlined: every geometry holds one a segment,
+  // and the boards' code would repeat the 24 values at each geometry made.
+  [[gnu::noinline]] CableLayout()
+      : count(4),
+        anchor_x{S(1), S(0), S(-1), S(0)},
+        anchor_y{S(0), S(-1), S(0), S(1)},
+        mean_weights{S(0.25), S(0.25), S(0.25), S(0.25)},
+        chord_x_weights{S(-1), S(0), S(1), S(0)},
+        chord_y_weights{S(0), S(1), S(0), S(-1)},
+        imbalance_weights{S(0.5), S(-0.5), S(0.5), S(-0.5)} {}
 
   // Anchors at psi_j = -(j - 1) 360 / count degrees, cable 1 on the x axis.
   static CableLayout evenly_spaced(int count) {
