@@ -216,5 +216,35 @@ TEST(HysteresisTrackerLimit, OnlyAModelThatCannotReadBeyondTheLimitIsPulledWithi
   }
 }
 
+// The same with three cables a segment at 0, -120 and 120 degrees: the
+// chord D = -(4/3) sum_j l_j e_j (eq. (2) fitted to three anchors) shrinks
+// to the limit along itself, the cables' mean stays.
+TEST(HysteresisTrackerLimit, ThreeCablesArePulledWithinTheLimitAlongTheirChord) {
+  test_support::SyntheticModelOptions options;
+  options.cables_per_segment = 3;
+  options.hysteresis_operators = 1;
+  const std::vector<std::uint8_t> image = exporting::write_image(test_support::synthetic_trained_model(options));
+  RobotModel robot;
+  HysteresisTracker tracker;
+  ASSERT_NO_FATAL_FAILURE(bind_robot(image, true, robot, tracker));
+  ASSERT_TRUE(tracker.active());
+  ASSERT_EQ(robot.geometry.cable_count(), 6);
+  const model::SegmentGeometry<float>& g = robot.geometry.segments[0];
+  const float limit = 4.0f * g.anchor_radius_mm * std::sin(0.5f * g.theta_max_rad);
+  // Twice the limit towards cable 2's anchor, at -120 degrees.
+  Cables commanded = Cables::Constant(6, 100.0f);
+  commanded[0] = 100.0f + 0.5f * limit;
+  commanded[1] = 100.0f - limit;
+  commanded[2] = 100.0f + 0.5f * limit;
+  const Cables effective = tracker.track(commanded);
+  const float half_root3 = 0.5f * std::sqrt(3.0f);
+  const float chord_x = -(4.0f / 3.0f) * (effective[0] - 0.5f * effective[1] - 0.5f * effective[2]);
+  const float chord_y = -(4.0f / 3.0f) * (-half_root3 * effective[1] + half_root3 * effective[2]);
+  EXPECT_NEAR(chord_x, -0.5f * limit, 1e-3f * limit);
+  EXPECT_NEAR(chord_y, -half_root3 * limit, 1e-3f * limit);
+  EXPECT_NEAR(effective[0] + effective[1] + effective[2], 300.0f, 1e-3f);
+  for (int c = 3; c < 6; ++c) EXPECT_EQ(effective[c], commanded[c]);
+}
+
 }  // namespace
 }  // namespace cdcr::firmware
