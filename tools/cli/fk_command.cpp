@@ -14,24 +14,23 @@
 namespace cdcr::cli {
 namespace {
 
-constexpr int kCablesPerSegment = 4;
-
 std::string segments(std::size_t count) { return fmt::format("{} segment{}", count, count == 1 ? "" : "s"); }
 
 int segment_count_from_cables(std::size_t cable_count, const GeometryOptions& geometry) {
   constexpr std::size_t capacity = model::RobotGeometry<double>::kCapacity;
-  if (cable_count % kCablesPerSegment != 0) {
-    throw InputError(
-        fmt::format("--cables: {} values is not a multiple of 4 (four cables per segment)", cable_count));
+  const auto per_segment = static_cast<std::size_t>(cables_per_segment(geometry));
+  if (cable_count % per_segment != 0) {
+    throw InputError(fmt::format("--cables: {} values is not a multiple of {} ({} cables per segment)", cable_count,
+                                 per_segment, per_segment));
   }
-  if (cable_count / kCablesPerSegment > capacity) {
+  if (cable_count / per_segment > capacity) {
     throw InputError(fmt::format("--cables: {} values make {}, more than the {} supported", cable_count,
-                                 segments(cable_count / kCablesPerSegment), capacity));
+                                 segments(cable_count / per_segment), capacity));
   }
-  const int count = static_cast<int>(cable_count / kCablesPerSegment);
+  const int count = static_cast<int>(cable_count / per_segment);
   if (geometry.segment_count && *geometry.segment_count != count) {
     throw InputError(fmt::format("--cables: {} values make {}, but --segments is {}", cable_count,
-                                 segments(cable_count / kCablesPerSegment), *geometry.segment_count));
+                                 segments(cable_count / per_segment), *geometry.segment_count));
   }
   return count;
 }

@@ -85,6 +85,8 @@ int cables_for(const GeometryOptions& options, const std::vector<int>& segment_c
 
 }  // namespace
 
+int cables_per_segment(const GeometryOptions& options) { return cables_for(options, {}, 0); }
+
 model::RobotGeometry<double> make_geometry(const GeometryOptions& options, int segment_count,
                                            const std::vector<int>& segment_cables) {
   require_positive(options.backbone_length_mm, "--length", "mm");

@@ -41,4 +41,7 @@ void add_geometry_options(CLI::App& command, GeometryOptions& options, const std
 model::RobotGeometry<double> make_geometry(const GeometryOptions& options, int segment_count,
                                            const std::vector<int>& segment_cables = {});
 
+// The cables of a segment the flags give (without a dataset): 3 or 4.
+int cables_per_segment(const GeometryOptions& options);
+
 }  // namespace cdcr::cli
