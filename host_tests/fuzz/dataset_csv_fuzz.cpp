@@ -19,7 +19,11 @@ using namespace cdcr::dataset;
 
 void check_accepted(const Dataset& data, std::string_view text, PoseColumns poses) {
   require(data.segment_count >= 1 && data.segment_count <= 8);
-  require(data.cables_mm.cols() == 4 * data.segment_count);
+  // A segment has three or four cables; all four is written as no list at all.
+  require(data.segment_cables.empty() ||
+          data.segment_cables.size() == static_cast<std::size_t>(data.segment_count));
+  for (const int cables : data.segment_cables) require(cables == 3 || cables == 4);
+  require(data.cables_mm.cols() == data.cable_count());
   require(data.sample_count() >= 1);
   require(data.cables_mm.allFinite());
   require(data.content_hash == fnv1a64(text));
@@ -41,6 +45,7 @@ void check_accepted(const Dataset& data, std::string_view text, PoseColumns pose
 
   const Dataset back = parse_dataset_csv(format_dataset_csv(data, "fuzz"), poses);
   require(back.segment_count == data.segment_count && back.has_poses == data.has_poses);
+  for (int i = 0; i < data.segment_count; ++i) require(back.cables_of(i) == data.cables_of(i));
   require(back.has_payload == data.has_payload && back.payload_kg.size() == data.payload_kg.size());
   require(back.has_time == data.has_time && back.time_s.size() == data.time_s.size());
   require(back.session_starts == data.session_starts);

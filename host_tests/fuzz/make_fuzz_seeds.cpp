@@ -147,6 +147,12 @@ int main(int argc, char** argv) {
   sequence.time_s << 0.75, 1.5, 40.0, 41.25;
   sequence.session_starts = cdcr::dataset::session_starts_from_times(sequence.time_s);
   write(root / "csv" / "time_sequence.csv", cdcr::dataset::format_dataset_csv(sequence, "a motion sequence"));
+  // A segment of three cables before one of four.
+  cdcr::dataset::Dataset three_then_four = small_dataset(2, 3, true);
+  three_then_four.segment_cables = {3, 4};
+  three_then_four.cables_mm = three_then_four.cables_mm.leftCols(7).eval();
+  write(root / "csv" / "three_then_four_cables.csv",
+        cdcr::dataset::format_dataset_csv(three_then_four, "three cables, then four"));
   write(root / "csv" / "crlf_bom_comments.csv",
         std::string("\xEF\xBB\xBF# exported\r\n\r\nl1_1,l1_2,l1_3,l1_4,x,y,z,qw,qx,qy,qz\r\n"
                     "120,+121.5,119, 118 ,1e1,-0,240,1,0,0,0\r\n# end\r\n"));
