@@ -170,6 +170,14 @@ TEST(CanFrameBits, TheWorstCasesAreTheKernelsTable) {
   EXPECT_EQ(fast.nominal, 17u + 4u + kTrailer);
 }
 
+TEST(CanFrameBits, WithoutStuffingIsTheWorstCaseLessItsStuffBits) {
+  EXPECT_EQ(can_frame_bits_without_stuffing(8, CanFormat::classical).total(), 111u);
+  EXPECT_EQ(can_frame_bits_without_stuffing(64, CanFormat::fd).total(), 579u);
+  const CanFrameBits fast = can_frame_bits_without_stuffing(64, CanFormat::fd_bit_rate_switch);
+  EXPECT_EQ(fast.nominal, 17u + kTrailer);
+  EXPECT_EQ(fast.total(), 579u);
+}
+
 TEST(CanFrameBits, NoContentTakesMoreThanTheWorstCase) {
   // Every one-byte payload and a spread of identifiers, both formats.
   for (std::uint32_t id = 0; id <= 0x7FF; id += 0x3B) {
@@ -180,6 +188,7 @@ TEST(CanFrameBits, NoContentTakesMoreThanTheWorstCase) {
         const CanFrameBits worst = can_frame_bits_worst_case(1, format);
         ASSERT_LE(bits.total(), worst.total());
         ASSERT_LE(bits.nominal, worst.nominal);
+        ASSERT_GE(bits.total(), can_frame_bits_without_stuffing(1, format).total());
       }
     }
   }

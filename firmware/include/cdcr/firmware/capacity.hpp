@@ -119,6 +119,12 @@ inline constexpr int kConsoleLineBytes = 96;
 
 namespace cdcr::firmware {
 
+// The most of a CAN bus's time a configuration may plan to use, at its
+// worst case (protocol/bus_budget.hpp): above it, arbitration delays for the
+// lowest-priority frames grow without a useful bound and a burst of the
+// host's own frames (an update, a payload) has no room.
+inline constexpr double kMaxBusLoad = 0.70;
+
 // STATUS and STATS go out every this many cycles: at 1 kHz a heartbeat per
 // cycle would take a fifth of a 1 Mbit/s bus on its own.
 inline constexpr int kStatusEveryCycles = 10;

@@ -204,6 +204,20 @@ inline constexpr CanFrameBits can_frame_bits_worst_case(std::size_t length, CanF
   return bits;
 }
 
+// The fewest bits a frame of `length` data bytes takes: no stuff bit at all.
+inline constexpr CanFrameBits can_frame_bits_without_stuffing(std::size_t length, CanFormat format) {
+  CanFrameBits bits = can_frame_bits_worst_case(length, format);
+  const std::uint32_t arbitration_stuff = format == CanFormat::classical ? 0 : (detail::kFdArbitrationBits - 1) / 4;
+  if (format == CanFormat::fd_bit_rate_switch) {
+    bits.nominal -= arbitration_stuff;
+    bits.data -= bits.stuff - arbitration_stuff;
+  } else {
+    bits.nominal -= bits.stuff;
+  }
+  bits.stuff = 0;
+  return bits;
+}
+
 // The frame's time on the wire (ns, rounded up); 0 for a rate of 0.
 inline constexpr std::int64_t can_frame_time_ns(const CanFrameBits& bits, const CanBitRates& rates) {
   if (rates.nominal == 0 || (bits.data > 0 && rates.data == 0)) return 0;

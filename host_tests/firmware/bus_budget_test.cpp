@@ -1,0 +1,78 @@
+// The bus budget (firmware/protocol/bus_budget.hpp) against frames counted by
+// hand. A classical data frame of d bytes with an 11-bit identifier has
+// n = 34 + 8d bits from SOF to the end of its CRC, at most (n - 1) / 4 stuff
+// bits among them, and 13 after (CRC delimiter, ACK, EOF, intermission):
+//   d = 8: 98 + 24 + 13 = 135 bits;  d = 7: 90 + 22 + 13 = 125;
+//   d = 6: 82 + 20 + 13 = 115.
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "cdcr/firmware/protocol/bus_budget.hpp"
+
+namespace cdcr::firmware::protocol {
+namespace {
+
+const MessageLoad* line_of(const BusBudget& budget, const std::string& name) {
+  for (int i = 0; i < budget.message_count; ++i) {
+    if (name == budget.messages[i].message->name) return &budget.messages[i];
+  }
+  return nullptr;
+}
+
+constexpr BusSetup kClassical1Mbit{hal::CanFormat::classical, {1000000, 0}};
+
+TEST(BusBudget, ThePapersRobotEstimatingAt1kHz) {
+  BusTraffic traffic;  // 4 segments, 1 kHz, a pose every cycle, STATUS/STATS every 10
+  traffic.uncertainty_cycles = 5;
+  const BusBudget budget = bus_budget(traffic, kClassical1Mbit);
+  // A second: 4,000 CABLE_FEEDBACK (8 bytes), 1,000 each of POSE_POSITION_XY
+  // (8), POSE_POSITION_Z (6) and POSE_ORIENTATION (8), 200 POSE_UNCERTAINTY
+  // (7), 100 each of STATUS and STATS (8).
+  const double bits = 4000 * 135.0 + 1000 * 135.0 + 1000 * 115.0 + 1000 * 135.0 + 200 * 125.0 + 200 * 135.0;
+  EXPECT_NEAR(budget.load, bits / 1e6, 1e-12);
+  EXPECT_NEAR(budget.frames_per_s, 7400.0, 1e-9);
+  EXPECT_FALSE(budget.fits());  // 0.977: most of the bus at the worst case
+  ASSERT_NE(line_of(budget, "CABLE_FEEDBACK"), nullptr);
+  EXPECT_EQ(line_of(budget, "CABLE_FEEDBACK")->worst_bits, 135u);
+  EXPECT_EQ(line_of(budget, "POSE_POSITION_Z")->worst_bits, 115u);
+  EXPECT_EQ(line_of(budget, "POSE_UNCERTAINTY")->worst_bits, 125u);
+  EXPECT_EQ(line_of(budget, "CABLE_SETPOINT"), nullptr);  // nothing streamed
+  // Without stuffing: 111, 95 (d = 6) and 103 (d = 7) bits.
+  const double unstuffed = 4000 * 111.0 + 2000 * 111.0 + 1000 * 95.0 + 200 * 103.0 + 200 * 111.0;
+  EXPECT_NEAR(budget.unstuffed_load, unstuffed / 1e6, 1e-12);
+}
+
+TEST(BusBudget, StreamingAddsTargetsSetpointsAndAReportPerTarget) {
+  BusTraffic traffic;
+  traffic.streaming = true;
+  traffic.uncertainty_cycles = 5;
+  const BusBudget estimating = bus_budget(BusTraffic{4, 1000, false, 1, 10, 5}, kClassical1Mbit);
+  const BusBudget budget = bus_budget(traffic, kClassical1Mbit);
+  // 4,000 CABLE_SETPOINT, 1,000 each of TARGET_ORIENTATION, _POSITION_XY
+  // (8 bytes) and _POSITION_Z (6), 1,100 IK_REPORT (8).
+  const double more = 4000 * 135.0 + 2000 * 135.0 + 1000 * 115.0 + 1100 * 135.0;
+  EXPECT_NEAR(budget.load - estimating.load, more / 1e6, 1e-12);
+  EXPECT_GT(budget.load, 1.8);
+  EXPECT_EQ(line_of(budget, "IK_REPORT")->frames_per_s, 1100.0);
+}
+
+TEST(BusBudget, RatesAndBitRatesScaleIt) {
+  BusTraffic traffic;
+  traffic.uncertainty_cycles = 5;
+  const BusBudget base = bus_budget(traffic, kClassical1Mbit);
+  traffic.pose_every = 4;
+  const BusBudget fewer_poses = bus_budget(traffic, kClassical1Mbit);
+  EXPECT_NEAR(base.load - fewer_poses.load, 0.75 * 1000 * (135.0 + 115.0 + 135.0) / 1e6, 1e-12);
+  const BusBudget half_rate = bus_budget(traffic, BusSetup{hal::CanFormat::classical, {500000, 0}});
+  EXPECT_NEAR(half_rate.load, 2.0 * fewer_poses.load, 1e-12);
+  traffic.cycle_hz = 500;
+  EXPECT_NEAR(bus_budget(traffic, kClassical1Mbit).load, 0.5 * fewer_poses.load, 1e-12);
+  traffic.segments = 2;
+  // 500 Hz, 2 segments, a pose every 4 cycles, radii every 5, STATUS/STATS every 10.
+  const double bits = 1000 * 135.0 + 125 * (135.0 + 115.0 + 135.0) + 100 * 125.0 + 50 * 135.0 * 2;
+  EXPECT_NEAR(bus_budget(traffic, kClassical1Mbit).load, bits / 1e6, 1e-12);
+}
+
+}  // namespace
+}  // namespace cdcr::firmware::protocol
