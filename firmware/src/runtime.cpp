@@ -112,7 +112,7 @@ void Runtime::run_cycle(const hal::TimerTick& tick, CycleInputs* inputs) {
     hysteresis_.widen(model_, variance_.result());
     publish_uncertainty();
   }
-  if (cycle_ % kStatusEveryCycles == 0) publish_status();
+  if (cycle_ % std::uint32_t(publish_rates_.status_every) == 0) publish_status();
   scheduler_.charge_update(update_.step(cycle_, model_.geometry, plan.update_offer));
   if (update_.switch_pending()) reload_model();
   // IK last: the pose, STATUS and the staleness check never wait for it.
@@ -230,10 +230,22 @@ void Runtime::update_pose() {
       has_pose_ = true;
       last_valid_cycle_ = cycle_;
       if (state_ == RuntimeState::fault) enter(mode());
-      publish_pose();
-      if (!variance_.running() && latest_pose_.compensated && model_.uncertainty.has_variance()) {
+      const bool pose_due =
+          !published_since_boot_ || cycle_ - last_pose_cycle_ >= std::uint32_t(publish_rates_.pose_every);
+      if (pose_due) {
+        publish_pose();
+        published_since_boot_ = true;
+        last_pose_cycle_ = cycle_;
+      }
+      // Radii are of a pose that went out (POSE_UNCERTAINTY names it by its
+      // sequence), at most every uncertainty_every cycles.
+      const bool variance_due = pose_due && (!variance_begun_since_boot_ || cycle_ - last_variance_begin_cycle_ >=
+                                                                                std::uint32_t(publish_rates_.uncertainty_every));
+      if (variance_due && !variance_.running() && latest_pose_.compensated && model_.uncertainty.has_variance()) {
         variance_.begin(model_.uncertainty, latest_pose_, static_cast<std::uint8_t>(cycle_ & 0xFF));
         hysteresis_.begin_variance(model_, latest_pose_);
+        variance_begun_since_boot_ = true;
+        last_variance_begin_cycle_ = cycle_;
       }
     } else {
       statistics_.rejected_cable_sets += 1;
@@ -245,6 +257,12 @@ void Runtime::update_pose() {
     enter(RuntimeState::fault);
     if (ik_.running()) ik_.end(protocol::IkOutcome::aborted_fault);
   }
+}
+
+bool Runtime::set_publish_rates(const PublishRates& rates) {
+  if (!rates.valid()) return false;
+  publish_rates_ = rates;
+  return true;
 }
 
 void Runtime::publish_pose() {

@@ -24,7 +24,7 @@ constexpr BusSetup kClassical1Mbit{hal::CanFormat::classical, {1000000, 0}};
 
 TEST(BusBudget, ThePapersRobotEstimatingAt1kHz) {
   BusTraffic traffic;  // 4 segments, 1 kHz, a pose every cycle, STATUS/STATS every 10
-  traffic.uncertainty_cycles = 5;
+  traffic.rates.uncertainty_every = 5;
   const BusBudget budget = bus_budget(traffic, kClassical1Mbit);
   // A second: 4,000 CABLE_FEEDBACK (8 bytes), 1,000 each of POSE_POSITION_XY
   // (8), POSE_POSITION_Z (6) and POSE_ORIENTATION (8), 200 POSE_UNCERTAINTY
@@ -46,8 +46,10 @@ TEST(BusBudget, ThePapersRobotEstimatingAt1kHz) {
 TEST(BusBudget, StreamingAddsTargetsSetpointsAndAReportPerTarget) {
   BusTraffic traffic;
   traffic.streaming = true;
-  traffic.uncertainty_cycles = 5;
-  const BusBudget estimating = bus_budget(BusTraffic{4, 1000, false, 1, 10, 5}, kClassical1Mbit);
+  traffic.rates.uncertainty_every = 5;
+  BusTraffic estimating_only = traffic;
+  estimating_only.streaming = false;
+  const BusBudget estimating = bus_budget(estimating_only, kClassical1Mbit);
   const BusBudget budget = bus_budget(traffic, kClassical1Mbit);
   // 4,000 CABLE_SETPOINT, 1,000 each of TARGET_ORIENTATION, _POSITION_XY
   // (8 bytes) and _POSITION_Z (6), 1,100 IK_REPORT (8).
@@ -59,9 +61,9 @@ TEST(BusBudget, StreamingAddsTargetsSetpointsAndAReportPerTarget) {
 
 TEST(BusBudget, RatesAndBitRatesScaleIt) {
   BusTraffic traffic;
-  traffic.uncertainty_cycles = 5;
+  traffic.rates.uncertainty_every = 5;
   const BusBudget base = bus_budget(traffic, kClassical1Mbit);
-  traffic.pose_every = 4;
+  traffic.rates.pose_every = 4;
   const BusBudget fewer_poses = bus_budget(traffic, kClassical1Mbit);
   EXPECT_NEAR(base.load - fewer_poses.load, 0.75 * 1000 * (135.0 + 115.0 + 135.0) / 1e6, 1e-12);
   const BusBudget half_rate = bus_budget(traffic, BusSetup{hal::CanFormat::classical, {500000, 0}});

@@ -366,5 +366,62 @@ TEST_F(RuntimeUncertaintyTest, WithoutAVarianceBlockNoRadiiGoOut) {
   EXPECT_FALSE(runtime->has_uncertainty());
 }
 
+// Publish rates (publish_rates.hpp): the pose every 4 cycles, a variance
+// begun at most every 18 and only on a pose that went out (so every 20
+// here: 18 cycles on is not a pose's cycle), STATUS and STATS every 25; the
+// estimate still runs every cycle.
+TEST_F(RuntimeUncertaintyTest, PublishRatesSpaceTheRuntimesOwnFrames) {
+  boot(image_with_variance(64));
+  ASSERT_EQ(runtime->state(), RuntimeState::run);
+  PublishRates rates;
+  rates.pose_every = 4;
+  rates.uncertainty_every = 18;
+  rates.status_every = 25;
+  ASSERT_TRUE(runtime->set_publish_rates(rates));
+  PublishRates invalid = rates;
+  invalid.pose_every = 0;
+  EXPECT_FALSE(runtime->set_publish_rates(invalid));
+  invalid = rates;
+  invalid.status_every = kMaxPublishEvery + 1;
+  EXPECT_FALSE(runtime->set_publish_rates(invalid));
+  EXPECT_EQ(runtime->publish_rates().pose_every, 4);
+  listen_to_poses();
+
+  int status_frames = 0;
+  std::vector<int> pose_cycles;
+  std::vector<std::uint8_t> pose_sequences;
+  std::vector<int> radii_cycles;
+  std::vector<std::uint8_t> radii_sequences;
+  ASSERT_EQ(runtime->statistics().cycles, 0u);
+  for (int cycle = 0; cycle < 100; ++cycle) {
+    cycles(1);
+    ASSERT_TRUE(runtime->has_pose());
+    for (const hal::CanFrame& frame : host_frames()) {
+      protocol::PosePositionZ z;
+      if (protocol::decode(frame, z) == protocol::DecodeStatus::ok) {
+        pose_cycles.push_back(cycle);
+        pose_sequences.push_back(z.sequence);
+      }
+      protocol::PoseUncertainty u;
+      if (protocol::decode(frame, u) == protocol::DecodeStatus::ok) {
+        radii_cycles.push_back(cycle);
+        radii_sequences.push_back(u.sequence);
+      }
+      protocol::Status status;
+      if (protocol::decode(frame, status) == protocol::DecodeStatus::ok) ++status_frames;
+    }
+  }
+  ASSERT_EQ(pose_cycles.size(), 25u);
+  for (std::size_t i = 1; i < pose_cycles.size(); ++i) EXPECT_EQ(pose_cycles[i] - pose_cycles[i - 1], 4);
+  ASSERT_EQ(radii_cycles.size(), 5u);  // begun in cycles 1, 21, 41, 61 and 81
+  for (std::size_t i = 1; i < radii_cycles.size(); ++i) EXPECT_EQ(radii_cycles[i] - radii_cycles[i - 1], 20);
+  for (const std::uint8_t sequence : radii_sequences) {
+    EXPECT_NE(std::find(pose_sequences.begin(), pose_sequences.end(), sequence), pose_sequences.end())
+        << "radii of a pose that did not go out: " << int(sequence);
+  }
+  EXPECT_EQ(runtime->statistics().poses_published, 25u);
+  EXPECT_EQ(status_frames, 4);  // cycles 25, 50, 75 and 100
+}
+
 }  // namespace
 }  // namespace cdcr::firmware

@@ -34,6 +34,7 @@
 #include "cdcr/firmware/model_update.hpp"
 #include "cdcr/firmware/outbox.hpp"
 #include "cdcr/firmware/protocol.hpp"
+#include "cdcr/firmware/publish_rates.hpp"
 #include "cdcr/hal/hal.hpp"
 
 namespace cdcr::firmware {
@@ -84,6 +85,11 @@ class Runtime {
   // pose and the next IK evaluation use the new one. Without a payload input
   // a valid payload is accepted and changes nothing.
   bool set_payload_kg(Scalar payload_kg);
+  // How often the runtime's own frames go out (publish_rates.hpp); kept
+  // across init() and model switches. False, and the rates unchanged, for
+  // rates that are not valid().
+  bool set_publish_rates(const PublishRates& rates);
+  const PublishRates& publish_rates() const { return publish_rates_; }
   // HOMING: the homing move has just ended, the robot is at home
   // (hysteresis_tracker.hpp); without a hysteresis block, nothing.
   void set_homed() { hysteresis_.homed(model_.geometry); }
@@ -175,6 +181,12 @@ class Runtime {
   bool segment_seen_[kMaxSegments] = {};
   bool fresh_cables_ = false;
   std::uint32_t last_valid_cycle_ = 0;
+
+  PublishRates publish_rates_{};
+  std::uint32_t last_pose_cycle_ = 0;
+  std::uint32_t last_variance_begin_cycle_ = 0;
+  bool published_since_boot_ = false;
+  bool variance_begun_since_boot_ = false;
 
   PoseEstimate latest_pose_;
   bool has_pose_ = false;

@@ -16,9 +16,10 @@
 //                    superseded, ...) and one every kIkProgressEveryCycles
 //                    while a request runs;
 //   POSE_*           three frames every pose_every cycles;
-//   POSE_UNCERTAINTY every uncertainty_cycles: as each variance evaluation
-//                    ends (it spans at least one cycle);
-//   STATUS, STATS    one each every status_every cycles.
+//   POSE_UNCERTAINTY one every uncertainty_every cycles: a variance begins
+//                    at most that often and ends at least a cycle on (the
+//                    model's own evaluation may take longer: fewer frames);
+//   STATUS, STATS    one each every status_every cycles (publish_rates.hpp).
 // PAYLOAD, HOMING and a model update's frames are the host's, sent when it
 // chooses: the budget leaves them the room between its load and the limit
 // (an update's UPDATE_DATA frames should be paced to fit there).
@@ -26,6 +27,7 @@
 #include <cstdint>
 
 #include "cdcr/firmware/capacity.hpp"
+#include "cdcr/firmware/publish_rates.hpp"
 #include "cdcr/firmware/protocol/messages.hpp"
 #include "cdcr/hal/can_timing.hpp"
 
@@ -36,9 +38,7 @@ struct BusTraffic {
   int segments = 4;
   std::uint32_t cycle_hz = 1000;
   bool streaming = false;  // the host streams a pose target every cycle
-  int pose_every = 1;      // cycles between poses
-  int status_every = kStatusEveryCycles;
-  int uncertainty_cycles = 1;  // cycles between radii (the shortest variance evaluation)
+  PublishRates rates{};
 };
 
 // The bus it runs on.
@@ -97,12 +97,13 @@ inline BusBudget bus_budget(const BusTraffic& traffic, const BusSetup& bus) {
     detail::add_message(budget, bus, target_position_z::kMessage, cycles);
     detail::add_message(budget, bus, ik_report::kMessage, cycles + every(kIkProgressEveryCycles));
   }
-  detail::add_message(budget, bus, pose_position_xy::kMessage, every(traffic.pose_every));
-  detail::add_message(budget, bus, pose_position_z::kMessage, every(traffic.pose_every));
-  detail::add_message(budget, bus, pose_orientation::kMessage, every(traffic.pose_every));
-  detail::add_message(budget, bus, pose_uncertainty::kMessage, every(traffic.uncertainty_cycles));
-  detail::add_message(budget, bus, status::kMessage, every(traffic.status_every));
-  detail::add_message(budget, bus, stats::kMessage, every(traffic.status_every));
+  const PublishRates& rates = traffic.rates;
+  detail::add_message(budget, bus, pose_position_xy::kMessage, every(rates.pose_every));
+  detail::add_message(budget, bus, pose_position_z::kMessage, every(rates.pose_every));
+  detail::add_message(budget, bus, pose_orientation::kMessage, every(rates.pose_every));
+  detail::add_message(budget, bus, pose_uncertainty::kMessage, every(rates.uncertainty_every));
+  detail::add_message(budget, bus, status::kMessage, every(rates.status_every));
+  detail::add_message(budget, bus, stats::kMessage, every(rates.status_every));
   return budget;
 }
 
