@@ -1,7 +1,7 @@
 #!/usr/bin/env python3
 """What makes the real robot's recordings hard, measured on the independent robot's real-like files.
 
-    real_like_bench.py babbling FILE.csv [--report ROBOT.json] [--train-rows 1500] [--cdcr CDCR] [--json]
+    real_like_bench.py babbling FILE.csv [--report ROBOT.json] [--train-rows 1500] [--cdcr CDCR] [--kernels] [--json]
     real_like_bench.py repeatability FILE.csv [--report ROBOT.json] [--json]
 
 babbling: the rows in order, the first 80 % to train and the last 20 % to
@@ -13,6 +13,10 @@ test (as the lab's), then
     normalised outputs, 2 restarts) from the cables to the tip position,
     given all cables, and given only the two differences l3 - l1, l2 - l4;
     at most --train-rows training rows, evenly spaced;
+  - with --kernels: how far other exact GPs on the same rows get, all four
+    cables given: Matern kernels (nu 1.5 and 2.5, ARD) in place of the
+    squared exponential, and each also given the sign of each cable's last
+    move (-1, 0, +1, from the rows in order);
   - the noise floor of the robot's report (--report: independent_robot.py's
     JSON, the first session's), when given;
   - with --cdcr (the cdcr executable): the project's model, `cdcr train` on
@@ -122,14 +126,16 @@ def read(path):
     return length_mm, radius_mm, table[:, cables], table[:, position]
 
 
-def fit_gp(x_train, y_train, x_test, seed=0):
-    """scikit-learn's GP, ARD squared exponential + white noise, on standardised inputs; the test predictions."""
+def fit_gp(x_train, y_train, x_test, seed=0, matern_nu=None):
+    """scikit-learn's GP, ARD squared exponential (or Matern of matern_nu) + white noise, on standardised
+    inputs; the test predictions."""
     from sklearn.gaussian_process import GaussianProcessRegressor
-    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, WhiteKernel
+    from sklearn.gaussian_process.kernels import RBF, ConstantKernel, Matern, WhiteKernel
     mean, scale = x_train.mean(axis=0), x_train.std(axis=0)
     scale[scale == 0.0] = 1.0
-    kernel = ConstantKernel(1.0, (1e-3, 1e3)) * RBF(np.ones(x_train.shape[1]), (1e-2, 1e3)) \
-        + WhiteKernel(1e-2, (1e-6, 1.0))
+    ones = np.ones(x_train.shape[1])
+    shape = RBF(ones, (1e-2, 1e3)) if matern_nu is None else Matern(ones, (1e-2, 1e3), nu=matern_nu)
+    kernel = ConstantKernel(1.0, (1e-3, 1e3)) * shape + WhiteKernel(1e-2, (1e-6, 1.0))
     gp = GaussianProcessRegressor(kernel, normalize_y=True, n_restarts_optimizer=2, random_state=seed)
     gp.fit((x_train - mean) / scale, y_train)
     return gp.predict((x_test - mean) / scale), gp.kernel_
@@ -143,7 +149,7 @@ def split(n):
     return int(round(TRAIN_SHARE * n))
 
 
-def babbling(path, train_rows, cdcr=None):
+def babbling(path, train_rows, cdcr=None, kernels=False):
     length_mm, radius_mm, cables, position = read(path)
     n = len(cables)
     cut = split(n)
@@ -160,6 +166,13 @@ def babbling(path, train_rows, cdcr=None):
         predicted, kernel = fit_gp(inputs[pick], position[pick], inputs[cut:])
         out[name] = mean_distance(predicted, position[cut:])
         out[name.replace("_mm", "_kernel")] = str(kernel)
+    if kernels:
+        moves = np.sign(np.diff(cables, axis=0, prepend=cables[:1]))
+        with_sign = np.hstack([cables, moves])
+        for name, inputs, nu in (("gp_matern15_mm", cables, 1.5), ("gp_matern25_mm", cables, 2.5),
+                                 ("gp_sign_mm", with_sign, None), ("gp_sign_matern15_mm", with_sign, 1.5)):
+            predicted, _ = fit_gp(inputs[pick], position[pick], inputs[cut:], matern_nu=nu)
+            out[name] = mean_distance(predicted, position[cut:])
     if cdcr:
         test = list(range(cut, n))
         out["cdcr_same_rows"] = cdcr_model(cdcr, path, pick, test, False, length_mm, radius_mm)
@@ -201,6 +214,13 @@ def repeatability(path, cdcr=None):
         predicted, kernel = fit_gp(inputs[:cut], position[:cut], inputs[cut:])
         out[name] = mean_distance(predicted, position[cut:])
         out[name.replace("_mm", "_kernel")] = str(kernel)
+    if kernels:
+        moves = np.sign(np.diff(cables, axis=0, prepend=cables[:1]))
+        with_sign = np.hstack([cables, moves])
+        for name, inputs, nu in (("gp_matern15_mm", cables, 1.5), ("gp_matern25_mm", cables, 2.5),
+                                 ("gp_sign_mm", with_sign, None), ("gp_sign_matern15_mm", with_sign, 1.5)):
+            predicted, _ = fit_gp(inputs[pick], position[pick], inputs[cut:], matern_nu=nu)
+            out[name] = mean_distance(predicted, position[cut:])
     if cdcr:
         test = list(range(cut, n))
         out["cdcr_sequence"] = cdcr_model(cdcr, path, range(cut), test, True, length_mm, radius_mm)
@@ -216,9 +236,11 @@ def main(argv=None):
     parser.add_argument("--report", help="independent_robot.py's --report JSON: adds the first session's floor")
     parser.add_argument("--train-rows", type=int, default=1500, help="babbling: training rows used (default 1500)")
     parser.add_argument("--cdcr", help="the cdcr executable, to measure the project's model too")
+    parser.add_argument("--kernels", action="store_true",
+                        help="babbling: also Matern kernels and the sign of each cable's last move")
     parser.add_argument("--json", action="store_true", help="print the figures as one JSON object")
     args = parser.parse_args(argv)
-    out = (babbling(args.file, args.train_rows, args.cdcr) if args.collection == "babbling"
+    out = (babbling(args.file, args.train_rows, args.cdcr, args.kernels) if args.collection == "babbling"
            else repeatability(args.file, args.cdcr))
     if args.report:
         with open(args.report) as f:

@@ -16,21 +16,25 @@
 # With --cdcr, the babbling runs also train and evaluate the project's model
 # (cdcr train on the same rows as the GP, and on the first 80 % as a
 # sequence; cdcr eval on the last 20 %), and the repeatability runs the
-# project's sequence model with and without the history inputs.
+# project's sequence model with and without the history inputs. With
+# --kernels, the babbling runs also fit Matern kernels and GPs given the sign
+# of each cable's last move (real_like_bench.py --kernels).
 # Needs numpy and scikit-learn (the sklearn group); builds nothing. Writes to
 # $BUILD_DIR/real_like_bench/.
 #
-#   bash tools/bench/run_real_like_bench.sh [--seeds "1 2"] [--rows 4022] [--cdcr build/bin/cdcr]
+#   bash tools/bench/run_real_like_bench.sh [--seeds "1 2"] [--rows 4022] [--cdcr build/bin/cdcr] [--kernels]
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/../.."
 
 seeds="1 2"
 rows=4022
 cdcr_option=()
+kernels_option=()
 while [ $# -gt 0 ]; do
   case $1 in
     --cdcr) cdcr_option=(--cdcr "$2"); shift 2 ;;
     --seeds) seeds=$2; shift 2 ;;
+    --kernels) kernels_option=(--kernels); shift ;;
     --rows) rows=$2; shift 2 ;;
     *) echo "run_real_like_bench.sh: error: unknown option '$1'" >&2; exit 2 ;;
   esac
@@ -45,7 +49,7 @@ for seed in $seeds; do
   nice -n 19 "$python" tools/bench/independent_robot.py --preset lab-1seg --collection babbling --seed "$seed" \
     --rows "$rows,1" --out-dir "$work_dir/babbling$seed" --report "$work_dir/babbling$seed.json" >/dev/null
   nice -n 19 "$python" tools/bench/real_like_bench.py babbling "$work_dir/babbling$seed/session0.csv" \
-    --report "$work_dir/babbling$seed.json" "${cdcr_option[@]}" | tee "$work_dir/babbling$seed.txt"
+    --report "$work_dir/babbling$seed.json" "${cdcr_option[@]}" "${kernels_option[@]}" | tee "$work_dir/babbling$seed.txt"
   echo "== repeatability, seed $seed =="
   nice -n 19 "$python" tools/bench/independent_robot.py --preset lab-1seg --collection repeatability \
     --seed "$seed" --rows 1,1 --out-dir "$work_dir/repeatability$seed" \

@@ -11,6 +11,7 @@
 
 #include <CLI/CLI.hpp>
 
+#include "cli/bus_command.hpp"
 #include "cli/cli_errors.hpp"
 #include "cli/command_output.hpp"
 #include "cli/fk_command.hpp"
@@ -77,6 +78,7 @@ int main(int argc, char** argv) {
   register_inspect_command(app, output);
   register_export_command(app, output);
   register_simulate_command(app, output);
+  register_bus_command(app, output);
 #if CDCR_HAVE_DEPLOY
   register_deploy_command(app, output);
 #endif
