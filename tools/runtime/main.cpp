@@ -12,7 +12,9 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
+#include <fmt/format.h>
 
+#include "cli/bus_command.hpp"
 #include "cli/cli_errors.hpp"
 #include "runtime_modes.hpp"
 
@@ -54,6 +56,14 @@ int main(int argc, char** argv) {
                "--sim following a streamed circle (a TRACKING pose target every cycle), once round");
   app.add_option("--circle-radius", circle_radius_mm, "--circle radius, mm")->capture_default_str();
   app.add_option("--circle-speed", circle_speed_mm_s, "--circle tip speed, mm/s")->capture_default_str();
+  BusChoice bus;
+  cdcr::cli::add_bitrate_option(app, bus.bitrate,
+                                "the bus's bit rate, bit/s: the bus budget (cdcr bus) is printed and a configuration "
+                                "above its limit refused; --sim times its bus at this rate (0: an untimed bus, "
+                                "frames delivered at once)");
+  cdcr::cli::add_publish_rate_options(app, bus.rates);
+  auto* streaming_option = app.add_flag("--streaming", bus.streaming,
+                                        "with --can and --bitrate: plan the budget for a target streamed every cycle");
   replay_option->excludes(sim_option);
   can_option->excludes(sim_option)->excludes(replay_option);
   try {
@@ -64,6 +74,13 @@ int main(int argc, char** argv) {
     if (circle && !run_sim) throw CLI::ValidationError("--circle needs --sim");
     if (hysteresis && !run_sim) throw CLI::ValidationError("--hysteresis needs --sim");
     if (!flash_dir.empty() && can_interface.empty()) throw CLI::ValidationError("--flash-dir needs --can");
+    if (streaming_option->count() > 0 && can_interface.empty()) {
+      throw CLI::ValidationError("--streaming needs --can (--sim --circle streams)");
+    }
+    if (!bus.rates.valid()) {
+      throw CLI::ValidationError(fmt::format("--pose-every, --uncertainty-every and --status-every must be 1 to {} cycles",
+                                             cdcr::firmware::kMaxPublishEvery));
+    }
     if (spin_option->count() > 0 && can_interface.empty()) throw CLI::ValidationError("--spin needs --can");
     if (!replay_path.empty() && (image_path.empty() || out_path.empty())) {
       throw CLI::ValidationError("--replay needs --image and --out");
@@ -77,11 +94,16 @@ int main(int argc, char** argv) {
   try {
     if (!can_interface.empty()) {
       return run_on_socketcan(image_path, can_interface, rate_hz, app.count("--seconds") > 0 ? seconds : 0.0,
-                              flash_dir, spin);
+                              flash_dir, spin, bus);
     }
     const SimulatedRobotChoice robot{ideal_robot, hysteresis};
-    if (run_sim && circle) return follow_circle(image_path, rate_hz, circle_radius_mm, circle_speed_mm_s, robot);
-    return run_sim ? simulate(image_path, rate_hz, seconds, robot) : replay(image_path, replay_path, out_path);
+    if (run_sim && circle) {
+      return follow_circle(image_path, rate_hz, circle_radius_mm, circle_speed_mm_s, robot, bus);
+    }
+    return run_sim ? simulate(image_path, rate_hz, seconds, robot, bus) : replay(image_path, replay_path, out_path);
+  } catch (const cdcr::cli::UsageError& e) {
+    std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());
+    return kExitUsage;
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());
     return kExitUsage;

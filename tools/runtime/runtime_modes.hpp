@@ -4,9 +4,28 @@
 // std::invalid_argument for an option value out of range (a usage error) and
 // cli::InputError for input it cannot use (cli_errors.hpp).
 
+#include <cstdint>
 #include <string>
 
+#include <cdcr/firmware/publish_rates.hpp>
+
 namespace cdcr::runtime_host {
+
+// The bus and the runtime's publish rates (firmware/publish_rates.hpp). With
+// a bit rate the configuration's bus budget (cdcr bus) is printed before the
+// run and a configuration above the limit is refused; --sim then times its
+// bus at that rate (0: the untimed, infinitely fast bus) and reports what it
+// carried.
+struct BusChoice {
+  std::uint32_t bitrate = 0;
+  firmware::PublishRates rates{};
+  bool streaming = false;  // --can: plan for a target streamed every cycle (--circle streams)
+};
+
+// Prints the budget of `segments` at rate_hz on `bus` and throws
+// cli::InputError, one line, when it is above the limit; nothing without a
+// bit rate.
+void check_bus_budget(int segments, double rate_hz, bool streaming, const BusChoice& bus);
 
 // --replay: the forward path over recorded cable lengths, as fast as
 // possible, into a pose CSV.
@@ -26,15 +45,16 @@ struct SimulatedRobotChoice {
 // --sim: the closed loop with simulated drives and robot over the virtual
 // bus, at a fixed rate in lockstep simulated time; the six demo targets
 // (--seconds 3), with --hysteresis each approached from two sides.
-int simulate(const std::string& image_path, double rate_hz, double seconds, const SimulatedRobotChoice& robot);
+int simulate(const std::string& image_path, double rate_hz, double seconds, const SimulatedRobotChoice& robot,
+             const BusChoice& bus);
 // --sim --circle: the same loop following a streamed circle.
 int follow_circle(const std::string& image_path, double rate_hz, double radius_mm, double speed_mm_s,
-                  const SimulatedRobotChoice& robot);
+                  const SimulatedRobotChoice& robot, const BusChoice& bus);
 
 // --can: the runtime itself on a SocketCAN interface, in real time, until
 // `seconds` have passed (0: no limit) or SIGINT/SIGTERM.
 int run_on_socketcan(const std::string& image_path, const std::string& interface_name, double rate_hz,
-                     double seconds, const std::string& flash_dir, bool spin);
+                     double seconds, const std::string& flash_dir, bool spin, const BusChoice& bus);
 
 // The cycle rate every mode accepts: (0, 100000] Hz.
 void require_rate(double rate_hz);

@@ -17,6 +17,7 @@
 #include <cdcr/sim/lockstep_timer.hpp>
 #include <cdcr/sim/virtual_can.hpp>
 
+#include "bus_tally.hpp"
 #include "export/binary_file.hpp"
 #include "runtime_modes.hpp"
 #include "sim/simulated_drives.hpp"
@@ -53,15 +54,34 @@ sim::SimulatorConfig robot_config(const SimulatedRobotChoice& choice) {
 // The runtime on the simulated board (with the image, if one is given), and
 // the simulated robot whose cables it reads and moves.
 struct SimulatedLoop {
-  SimulatedLoop(const std::string& image_path, const SimulatedRobotChoice& choice)
+  SimulatedLoop(const std::string& image_path, const SimulatedRobotChoice& choice, const BusChoice& bus_choice)
       : runtime(with_image(platform, image_path).hal, fw::Geometry::prototype()),
         geometry(booted(runtime).geometry().cast<double>()),
-        robot(geometry, robot_config(choice)) {}
+        robot(geometry, robot_config(choice)),
+        bus(bus_choice) {
+    runtime.set_publish_rates(bus.rates);
+    if (bus.bitrate > 0) {
+      platform.bus.set_timing(platform.clock, {bus.bitrate, 0});
+      platform.bus.set_observer(&bus_tally);
+    }
+  }
+
+  // What the timed bus carried, against the budget's worst case (nothing
+  // on the untimed bus).
+  void print_bus_report(double rate_hz, bool streaming) const {
+    if (bus.bitrate == 0) return;
+    std::fputs(timed_bus_report(platform.bus, platform.clock.now_ns(), bus_tally, geometry.segment_count, rate_hz,
+                                streaming, bus)
+                   .c_str(),
+               stdout);
+  }
 
   sim::SimulatedPlatform platform;
   fw::Runtime runtime;
   model::RobotGeometry<double> geometry;
   sim::SimulatedRobot robot;
+  BusChoice bus;
+  BusTally bus_tally;
 };
 
 // The simulated drives on the loop's bus, the host's node that sends the
@@ -78,7 +98,10 @@ struct DrivenLoop {
     host.set_filters(&protocol::kIkReportFrames, 1);
   }
 
-  void start_timer() { loop.platform.timer.start(period_ns); }
+  void start_timer() {
+    loop.bus_tally.set_releases(loop.platform.clock.now_ns() + period_ns, period_ns);
+    loop.platform.timer.start(period_ns);
+  }
 
   // Waits for the next tick and moves the drives, and the robot's cables
   // with them, one period on.
@@ -194,13 +217,14 @@ void run_homing_move(const model::RobotGeometry<double>& geometry, const sim::Si
 }  // namespace
 
 int follow_circle(const std::string& image_path, double rate_hz, double radius_mm, double speed_mm_s,
-                  const SimulatedRobotChoice& robot_choice) {
+                  const SimulatedRobotChoice& robot_choice, const BusChoice& bus) {
   require_rate(rate_hz);
   if (!(radius_mm > 0) || !(radius_mm <= 100)) throw std::invalid_argument("--circle-radius must be in (0, 100] mm");
   if (!(speed_mm_s > 0) || !(speed_mm_s <= 500)) {
     throw std::invalid_argument("--circle-speed must be in (0, 500] mm/s");
   }
-  SimulatedLoop loop(image_path, robot_choice);
+  SimulatedLoop loop(image_path, robot_choice, bus);
+  check_bus_budget(loop.geometry.segment_count, rate_hz, true, bus);
   fw::Runtime& runtime = loop.runtime;
   const model::RobotGeometry<double>& geometry = loop.geometry;
   sim::SimulatedRobot& robot = loop.robot;
@@ -223,7 +247,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   cdcr::hal::CanBus& host = driven.host;
   driven.start_timer();
 
-  long cycles = 0, poses_missing = 0;
+  long cycles = 0, poses_missing = 0, cycles_since_pose = 0;
   std::int64_t host_max_ns = 0;
   const auto cycle = [&] {
     const cdcr::hal::TimerTick tick = driven.advance_drives();
@@ -233,7 +257,9 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
     host_max_ns = std::max<std::int64_t>(
         host_max_ns,
         std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::steady_clock::now() - begin).count());
-    if (runtime.statistics().poses_published != poses + 1) ++poses_missing;
+    // A pose is due every --pose-every cycles.
+    cycles_since_pose = runtime.statistics().poses_published != poses ? 0 : cycles_since_pose + 1;
+    if (cycles_since_pose >= bus.rates.pose_every) ++poses_missing;
     ++cycles;
     driven.drain_host();
   };
@@ -300,6 +326,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
               "missing %ld, overruns %u, rejected frames %u; slowest cycle on this host %.1f us\n",
               runtime.setpoints_published() - setpoints_before, stream_cycles, cycles_without_setpoints, cycles,
               poses_missing, stats.overruns, stats.rejected_frames, double(host_max_ns) * 1e-3);
+  loop.print_bus_report(rate_hz, true);
   return 0;
 }
 
@@ -351,8 +378,9 @@ double mean_mm(const ErrorTally& tally, long count) { return count > 0 ? tally.s
 // at a target is checked, the last one included.
 class RandomTargetRun {
  public:
-  RandomTargetRun(const std::string& image_path, double rate_hz, const SimulatedRobotChoice& robot_choice)
-      : loop_(image_path, robot_choice),
+  RandomTargetRun(const std::string& image_path, double rate_hz, const SimulatedRobotChoice& robot_choice,
+                  const BusChoice& bus)
+      : loop_(image_path, robot_choice, bus),
         geometry_(loop_.geometry),
         rate_hz_(rate_hz),
         two_sided_(robot_choice.hysteresis),
@@ -386,9 +414,12 @@ class RandomTargetRun {
     }
   }
 
+  // Checks the bus budget (with a bit rate), before anything runs.
+  void check_budget() const { check_bus_budget(geometry_.segment_count, rate_hz_, false, loop_.bus); }
   void print_report() const;
 
  private:
+  void print_run_report() const;
   fw::Runtime& runtime() { return loop_.runtime; }
   const fw::Runtime& runtime() const { return loop_.runtime; }
   const sim::SimulatedRobot& robot() const { return loop_.robot; }
@@ -521,6 +552,11 @@ class RandomTargetRun {
 };
 
 void RandomTargetRun::print_report() const {
+  print_run_report();
+  loop_.print_bus_report(rate_hz_, false);
+}
+
+void RandomTargetRun::print_run_report() const {
   const RandomTargetTallies& t = tallies_;
   const fw::CycleStatistics& stats = runtime().statistics();
   std::printf("state %s, fault: %s\n", fw::to_string(runtime().state()), fw::to_string(runtime().active_fault()));
@@ -560,10 +596,12 @@ void RandomTargetRun::print_report() const {
 
 }  // namespace
 
-int simulate(const std::string& image_path, double rate_hz, double seconds, const SimulatedRobotChoice& robot_choice) {
+int simulate(const std::string& image_path, double rate_hz, double seconds, const SimulatedRobotChoice& robot_choice,
+             const BusChoice& bus) {
   require_rate(rate_hz);
   if (!(seconds > 0) || !(seconds <= 3600)) throw std::invalid_argument("--seconds must be in (0, 3600]");
-  RandomTargetRun run(image_path, rate_hz, robot_choice);
+  RandomTargetRun run(image_path, rate_hz, robot_choice, bus);
+  run.check_budget();
   run.run(seconds);
   run.print_report();
   return 0;

@@ -50,7 +50,7 @@ void print_cycle_statistics(const fw::Runtime& runtime, const cdcr::hal::CanErro
 // The runtime on a real bus: the same object the board runs, on the Linux
 // backends, until the duration ends or a signal asks it to stop.
 int run_on_socketcan(const std::string& image_path, const std::string& interface_name, double rate_hz,
-                     double seconds, const std::string& flash_dir, bool spin) {
+                     double seconds, const std::string& flash_dir, bool spin, const BusChoice& bus_choice) {
   require_rate(rate_hz);
   if (seconds != 0 && (!(seconds > 0) || !(seconds <= 86400))) {
     throw std::invalid_argument("--seconds must be in (0, 86400]");
@@ -78,6 +78,8 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   static const cdcr::hal::Hal hal{clock, timer, bus, storage, console, flash_dir.empty() ? nullptr : &flash};
   static fw::Runtime runtime(hal, fw::Geometry::prototype());
   runtime.init();
+  runtime.set_publish_rates(bus_choice.rates);
+  check_bus_budget(runtime.geometry().segment_count, rate_hz, bus_choice.streaming, bus_choice);
 
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
   const std::int64_t start_ns = clock.now_ns();
@@ -93,7 +95,8 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   return 0;
 }
 #else
-int run_on_socketcan(const std::string&, const std::string&, double, double, const std::string&, bool) {
+int run_on_socketcan(const std::string&, const std::string&, double, double, const std::string&, bool,
+                     const BusChoice&) {
   throw InputError("--can needs a Linux host (SocketCAN)");
 }
 #endif

@@ -1,0 +1,46 @@
+#!/usr/bin/env bash
+# The streamed circle on a timed bus (cdcr-runtime --sim --bitrate): the
+# paper's robot at 1 kHz streaming on one classical 1 Mbit/s bus is refused
+# before it runs, with its budget; at 250 Hz with radii every 5 cycles it
+# fits (51.3 % worst case) and runs in closed loop with every frame on the
+# wire for its time: none late for its cycle, the measured load between the
+# budget's load without a stuff bit and its worst case, setpoints in every
+# streamed cycle after the first 3 and the following error within the
+# demo's bounds.
+#
+#   timed_bus_circle_test.sh CDCR_RUNTIME MODEL_IMAGE
+set -euo pipefail
+runtime=$1 image=$2
+fail() {
+  echo "timed bus circle: $*" >&2
+  exit 1
+}
+
+set +e
+refused=$("$runtime" --image "$image" --sim --circle --bitrate 1000000 2>&1 >/dev/null)
+status=$?
+set -e
+echo "$refused"
+[[ $status -eq 1 ]] || fail "1 kHz streaming on 1 Mbit/s exited $status, expected 1"
+[[ $(wc -l <<<"$refused") -eq 1 ]] || fail "the refusal is not one line"
+[[ $refused == "cdcr-runtime: error: the CAN bus would carry up to 215.1 % of its time"* ]] ||
+  fail "the refusal does not give the load"
+
+out=$("$runtime" --image "$image" --sim --circle --bitrate 1000000 --rate 250 --uncertainty-every 5)
+echo "$out"
+read -r measured worst unstuffed late < <(sed -n \
+  's/^bus at 1000000 bit\/s: measured load \([0-9.]*\) % .*worst case \([0-9.]*\) %, without stuffing \([0-9.]*\) %), [0-9]* frames, \([0-9]*\) late.*/\1 \2 \3 \4/p' \
+  <<<"$out")
+[[ -n ${late:-} ]] || fail "no bus figures in the output"
+missed=$(sed -n 's/^setpoints sent in .* (none in \([0-9]*\) after the first 3).*/\1/p' <<<"$out")
+read -r mean max < <(sed -n 's/.*of which following.*: mean \([0-9.]*\) mm, max \([0-9.]*\) mm.*/\1 \2/p' <<<"$out")
+verdict=$(awk -v m="$measured" -v w="$worst" -v u="$unstuffed" -v late="$late" -v missed="${missed:-x}" \
+  -v mean="${mean:-x}" -v max="${max:-x}" 'BEGIN {
+  if (late + 0 > 0) { print late " frames late for their cycle"; exit }
+  if (m + 0 < u + 0 || m + 0 > w + 0) { print "measured load " m " % outside [" u ", " w "] %"; exit }
+  if (missed == "x" || missed + 0 > 0) { print "streamed cycles without setpoints: " missed; exit }
+  if (max == "x" || mean + 0 > 0.01 || max + 0 > 0.05) { print "following error mean " mean ", max " max " mm"; exit }
+  print "ok"
+}')
+echo "timed bus circle: $verdict"
+[[ $verdict == ok ]]

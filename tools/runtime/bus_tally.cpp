@@ -1,0 +1,108 @@
+#include "bus_tally.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+
+#include <fmt/format.h>
+
+#include <cdcr/firmware/protocol/messages.hpp>
+
+#include "cli/bus_command.hpp"
+#include "cli/cli_errors.hpp"
+#include "runtime_modes.hpp"
+
+namespace cdcr::runtime_host {
+
+namespace protocol = cdcr::firmware::protocol;
+
+std::int64_t BusTally::deadline_ns(std::int64_t queued_ns) const {
+  if (queued_ns < first_release_ns_) return first_release_ns_;
+  const std::int64_t periods = (queued_ns - first_release_ns_) / period_ns_;
+  return first_release_ns_ + (periods + 1) * period_ns_;
+}
+
+void BusTally::on_transfer(const sim::CanTransfer& transfer) {
+  const protocol::MessageSpec* message = nullptr;
+  for (const protocol::MessageSpec* m : protocol::kMessages) {
+    if (m->carries(transfer.frame.id)) message = m;
+  }
+  auto kind = std::find_if(kinds_.begin(), kinds_.end(), [&](const Kind& k) { return k.message == message; });
+  if (kind == kinds_.end()) {
+    kinds_.push_back(Kind{message, {}, 0});
+    kind = kinds_.end() - 1;
+  }
+  kind->latency_us.push_back(double(transfer.end_ns - transfer.queued_ns) * 1e-3);
+  ++frames_;
+  if (first_release_ns_ >= 0 && period_ns_ > 0 && transfer.end_ns > deadline_ns(transfer.queued_ns)) {
+    ++kind->late;
+    ++late_;
+  }
+}
+
+namespace {
+
+double quantile(std::vector<double> values, double q) {
+  if (values.empty()) return 0.0;
+  std::sort(values.begin(), values.end());
+  const std::size_t index = std::min(values.size() - 1, static_cast<std::size_t>(std::ceil(q * double(values.size())) - 1));
+  return values[index];
+}
+
+}  // namespace
+
+std::string BusTally::table() const {
+  std::vector<Kind> kinds = kinds_;
+  std::sort(kinds.begin(), kinds.end(), [](const Kind& a, const Kind& b) {
+    const std::uint32_t ia = a.message != nullptr ? a.message->id : 0x800;
+    const std::uint32_t ib = b.message != nullptr ? b.message->id : 0x800;
+    return ia < ib;
+  });
+  std::string text = fmt::format("  {:<20} {:>8} {:>30} {:>6}\n", "message", "frames", "latency p50 / p99 / max (us)",
+                                 "late");
+  for (const Kind& k : kinds) {
+    text += fmt::format("  {:<20} {:>8} {:>12.1f} / {:>6.1f} / {:>6.1f} {:>6}\n",
+                        k.message != nullptr ? k.message->name : "(not the protocol's)", k.latency_us.size(),
+                        quantile(k.latency_us, 0.5), quantile(k.latency_us, 0.99),
+                        k.latency_us.empty() ? 0.0 : *std::max_element(k.latency_us.begin(), k.latency_us.end()), k.late);
+  }
+  return text;
+}
+
+namespace {
+
+cli::BusOptions bus_options(int segments, double rate_hz, bool streaming, const BusChoice& bus) {
+  cli::BusOptions options;
+  options.segments = segments;
+  options.rate_hz = rate_hz;
+  options.streaming = streaming;
+  options.rates = bus.rates;
+  options.bitrate = bus.bitrate;
+  return options;
+}
+
+}  // namespace
+
+std::string timed_bus_report(const sim::VirtualCanBus& bus, std::int64_t now_ns, const BusTally& tally, int segments,
+                             double rate_hz, bool streaming, const BusChoice& choice) {
+  const protocol::BusBudget budget = cli::bus_budget_of(bus_options(segments, rate_hz, streaming, choice));
+  const double measured = BusTally::measured_load(bus, now_ns);
+  return fmt::format("bus at {} bit/s: measured load {:.1f} % over {:.3f} s (the budget's worst case {:.1f} %, "
+                     "without stuffing {:.1f} %), {} frames, {} late for their cycle\n",
+                     choice.bitrate, 100.0 * measured, double(now_ns) * 1e-9, 100.0 * budget.load,
+                     100.0 * budget.unstuffed_load, tally.frames(), tally.late()) +
+         tally.table();
+}
+
+void check_bus_budget(int segments, double rate_hz, bool streaming, const BusChoice& bus) {
+  if (bus.bitrate == 0) return;
+  const cli::BusOptions options = bus_options(segments, rate_hz, streaming, bus);
+  cli::validate_bus_options(options);
+  const protocol::BusBudget budget = cli::bus_budget_of(options);
+  std::fputs(cli::format_bus_budget(budget, options).c_str(), stdout);
+  if (const std::string refusal = cli::bus_budget_refusal(budget, options); !refusal.empty()) {
+    throw cli::InputError(refusal);
+  }
+}
+
+}  // namespace cdcr::runtime_host
