@@ -214,13 +214,6 @@ def repeatability(path, cdcr=None):
         predicted, kernel = fit_gp(inputs[:cut], position[:cut], inputs[cut:])
         out[name] = mean_distance(predicted, position[cut:])
         out[name.replace("_mm", "_kernel")] = str(kernel)
-    if kernels:
-        moves = np.sign(np.diff(cables, axis=0, prepend=cables[:1]))
-        with_sign = np.hstack([cables, moves])
-        for name, inputs, nu in (("gp_matern15_mm", cables, 1.5), ("gp_matern25_mm", cables, 2.5),
-                                 ("gp_sign_mm", with_sign, None), ("gp_sign_matern15_mm", with_sign, 1.5)):
-            predicted, _ = fit_gp(inputs[pick], position[pick], inputs[cut:], matern_nu=nu)
-            out[name] = mean_distance(predicted, position[cut:])
     if cdcr:
         test = list(range(cut, n))
         out["cdcr_sequence"] = cdcr_model(cdcr, path, range(cut), test, True, length_mm, radius_mm)
