@@ -3,8 +3,14 @@
 // decode exactly the frames the runtime packs. The build runs it; nobody
 // edits its output.
 //
-// Usage: cdcr_write_dbc <out.dbc>
+// Usage: cdcr_write_dbc <out.dbc> [--id-base BASE]
+//
+// BASE (decimal or 0x-hexadecimal; default 0x100) moves every identifier
+// with the protocol's window (messages.hpp, kDefaultIdBase): the DBC of a
+// runtime started with that base. The file is written to a temporary name
+// beside it and renamed, so a reader never sees half of it.
 
+#include <cstdint>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
@@ -76,7 +82,9 @@ void write_signal(std::ostream& out, const SignalSpec& signal, const char* recei
       << "] " << quoted(signal.unit, signal.name) << ' ' << receiver << '\n';
 }
 
-void write_dbc(std::ostream& out) {
+void write_dbc(std::ostream& out, std::uint32_t base) {
+  const std::uint32_t shift = id_offset(base);
+  const auto on_bus = [shift](std::uint32_t id) { return (id + shift) % (hal::kMaxStandardId + 1); };
   out << "VERSION " << quoted(kDbcVersion, "VERSION") << "\n\n";
   out << "NS_ :\n\nBS_:\n\nBU_:";
   for (const char* node : kDbcNodes) out << ' ' << node;
@@ -86,7 +94,7 @@ void write_dbc(std::ostream& out) {
     check_notes(*notes);
     const MessageSpec* message = notes->message;
     for (int i = 0; i < message->id_count; ++i) {
-      out << "BO_ " << message->id + i << ' ' << frame_name(*message, i) << ": " << int(message->dlc) << ' '
+      out << "BO_ " << on_bus(message->id + i) << ' ' << frame_name(*message, i) << ": " << int(message->dlc) << ' '
           << message->sender << '\n';
       for (const SignalSpec* signal : message->signals) write_signal(out, *signal, notes->receiver);
       out << '\n';
@@ -97,7 +105,7 @@ void write_dbc(std::ostream& out) {
   for (const MessageNotes* notes : kMessageNotes) {
     const MessageSpec* message = notes->message;
     for (int i = 0; i < message->id_count; ++i) {
-      const std::uint32_t id = message->id + i;
+      const std::uint32_t id = on_bus(message->id + i);
       const std::string name = frame_name(*message, i);
       if (*notes->comment != '\0') {
         out << "CM_ BO_ " << id << ' ' << quoted(with_segment(notes->comment, i), name) << ";\n";
@@ -117,7 +125,7 @@ void write_dbc(std::ostream& out) {
     for (int i = 0; i < message->id_count; ++i) {
       for (const SignalSpec* signal : message->signals) {
         if (signal->values.count == 0) continue;
-        out << "VAL_ " << message->id + i << ' ' << signal->name;
+        out << "VAL_ " << on_bus(message->id + i) << ' ' << signal->name;
         for (int k = 0; k < signal->values.count; ++k) {
           out << ' ' << signal->values.entries[k].value << ' '
               << quoted(signal->values.entries[k].name, signal->name);
@@ -132,18 +140,35 @@ void write_dbc(std::ostream& out) {
 }  // namespace cdcr::firmware::protocol
 
 int main(int argc, char** argv) {
-  if (argc != 2) {
-    std::cerr << "usage: cdcr_write_dbc <out.dbc>\n";
+  using cdcr::firmware::protocol::is_valid_id_base;
+  std::uint32_t base = cdcr::firmware::protocol::kDefaultIdBase;
+  const bool with_base = argc == 4 && std::string(argv[2]) == "--id-base";
+  if (argc != 2 && !with_base) {
+    std::cerr << "usage: cdcr_write_dbc <out.dbc> [--id-base BASE]\n";
     return 2;
   }
+  if (with_base) {
+    char* end = nullptr;
+    const unsigned long value = std::strtoul(argv[3], &end, 0);
+    if (end == argv[3] || *end != '\0' || value > 0x7FF || !is_valid_id_base(static_cast<std::uint32_t>(value))) {
+      std::cerr << "cdcr_write_dbc: error: --id-base must be a multiple of 8 from 0 to 0x780, got '" << argv[3]
+                << "'\n";
+      return 2;
+    }
+    base = static_cast<std::uint32_t>(value);
+  }
+  const std::string path = argv[1];
+  const std::string temporary = path + ".tmp";
   try {
     std::ostringstream text;
-    cdcr::firmware::protocol::write_dbc(text);
-    std::ofstream out(argv[1], std::ios::binary);
+    cdcr::firmware::protocol::write_dbc(text, base);
+    std::ofstream out(temporary, std::ios::binary);
     out << text.str();
     out.close();
-    if (!out) throw std::runtime_error(std::string("cannot write ") + argv[1]);
+    if (!out) throw std::runtime_error("cannot write " + temporary);
+    if (std::rename(temporary.c_str(), path.c_str()) != 0) throw std::runtime_error("cannot rename it to " + path);
   } catch (const std::exception& error) {
+    std::remove(temporary.c_str());
     std::cerr << "cdcr_write_dbc: error: " << error.what() << '\n';
     return 1;
   }

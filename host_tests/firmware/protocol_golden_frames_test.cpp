@@ -22,6 +22,7 @@
 
 #include <cdcr/firmware/fault_detail.hpp>
 #include <cdcr/firmware/protocol.hpp>
+#include <cdcr/hal/shifted_can_bus.hpp>
 
 namespace cdcr::firmware::protocol {
 namespace {
@@ -414,6 +415,68 @@ TEST(GoldenFrames, EveryMessageOfTheTableHasOne) {
     EXPECT_TRUE(covered) << message->name << " has no golden frame";
   }
   EXPECT_EQ(std::size(kGoldenIds), std::size(kMessages));
+}
+
+// A bus that keeps what is sent and hands back what a test puts in it.
+class RecordingBus final : public hal::CanBus {
+ public:
+  hal::CanStatus send(const hal::CanFrame& frame) override {
+    sent.push_back(frame);
+    return hal::CanStatus::ok;
+  }
+  hal::CanStatus receive(hal::CanFrame& frame) override {
+    if (incoming.empty()) return hal::CanStatus::empty;
+    frame = incoming.front();
+    incoming.erase(incoming.begin());
+    return hal::CanStatus::ok;
+  }
+  bool set_filters(const hal::CanFilter* filters, std::size_t count) override {
+    this->filters.assign(filters, filters + count);
+    return true;
+  }
+  hal::CanErrorCounters error_counters() const override { return {}; }
+
+  std::vector<hal::CanFrame> sent, incoming;
+  std::vector<hal::CanFilter> filters;
+};
+
+// The identifier base moved to 0x300 (messages.hpp, id_offset): the same
+// golden bytes on identifiers 0x200 higher, each way, and the filters with
+// them; a frame at the default identifiers is then foreign.
+TEST(GoldenFrames, AtIdentifierBase0x300EveryFrameMovesWithTheWindow) {
+  RecordingBus wire;
+  hal::ShiftedCanBus bus(wire, id_offset(0x300));
+  const Bytes feedback{0x10, 0x27, 0x39, 0x30, 0x01, 0x00, 0xFE, 0xFF};
+  hal::CanFrame frame;
+  ASSERT_TRUE(encode(CableFeedback{2, {100.0, 123.45, 0.01, 655.34}}, frame));
+  ASSERT_EQ(bus.send(frame), hal::CanStatus::ok);
+  // UPDATE_REPORT, the window's last message: 0x178 -> 0x378.
+  encode(UpdateReport{}, frame);
+  ASSERT_EQ(bus.send(frame), hal::CanStatus::ok);
+  ASSERT_EQ(wire.sent.size(), 2u);
+  EXPECT_EQ(wire.sent[0].id, 0x302u);
+  EXPECT_EQ(Bytes(wire.sent[0].data, wire.sent[0].data + wire.sent[0].dlc), feedback);
+  EXPECT_EQ(wire.sent[1].id, 0x378u);
+
+  wire.incoming.push_back(frame_of(0x302, feedback));
+  wire.incoming.push_back(frame_of(0x102, feedback));  // the default identifier: not ours here
+  hal::CanFrame received;
+  ASSERT_EQ(bus.receive(received), hal::CanStatus::ok);
+  EXPECT_EQ(received.id, 0x102u);
+  CableFeedback cables;
+  ASSERT_EQ(decode(received, cables), DecodeStatus::ok);
+  EXPECT_EQ(cables.segment, 2);
+  ASSERT_EQ(bus.receive(received), hal::CanStatus::ok);
+  EXPECT_EQ(received.id, 0x702u);
+  for (const MessageSpec* message : kMessages) EXPECT_FALSE(message->carries(received.id)) << message->name;
+
+  const hal::CanFilter groups[] = {kCableFeedbackFrames, kTargetFrames, kUpdateRequestFrames};
+  ASSERT_TRUE(bus.set_filters(groups, 3));
+  ASSERT_EQ(wire.filters.size(), 3u);
+  EXPECT_EQ(wire.filters[0].id, 0x300u);
+  EXPECT_EQ(wire.filters[0].mask, 0x7F8u);
+  EXPECT_EQ(wire.filters[1].id, 0x320u);
+  EXPECT_EQ(wire.filters[2].id, 0x370u);
 }
 
 }  // namespace

@@ -136,6 +136,42 @@ ValueMap codec_values(const SignalSpec& signal) {
   return values;
 }
 
+// With the window moved to 0x300 (cdcr_write_dbc --id-base 0x300): every
+// message, signal, value table and comment of the default DBC, each
+// identifier 0x200 higher, and nothing else.
+TEST(DbcAtAnotherBase, IsTheDefaultShiftedByTheBase) {
+  const Dbc shifted = read_dbc(CDCR_DBC_AT_0X300_PATH);
+  const Dbc& base = dbc();
+  ASSERT_EQ(shifted.messages.size(), base.messages.size());
+  for (const auto& [id, message] : base.messages) {
+    ASSERT_EQ(shifted.messages.count(id + 0x200), 1u) << message.name;
+    const DbcMessage& moved = shifted.messages.at(id + 0x200);
+    EXPECT_EQ(moved.name, message.name);
+    EXPECT_EQ(moved.dlc, message.dlc);
+    EXPECT_EQ(moved.signals.size(), message.signals.size()) << message.name;
+  }
+  EXPECT_EQ(shifted.messages.begin()->first, 0x300u);
+  EXPECT_EQ(shifted.messages.begin()->second.name, "CABLE_FEEDBACK_0");
+  ASSERT_EQ(shifted.value_tables.size(), base.value_tables.size());
+  for (const auto& [key, values] : base.value_tables) {
+    ASSERT_EQ(shifted.value_tables.count({key.first + 0x200, key.second}), 1u) << key.second;
+    EXPECT_EQ(shifted.value_tables.at({key.first + 0x200, key.second}), values);
+  }
+  EXPECT_EQ(shifted.signal_notes.size(), base.signal_notes.size());
+}
+
+TEST(IdBase, IsAMultipleOf8WithTheWindowWithinTheIdentifiers) {
+  EXPECT_TRUE(is_valid_id_base(kDefaultIdBase));
+  EXPECT_TRUE(is_valid_id_base(0x300));
+  EXPECT_TRUE(is_valid_id_base(0x000));
+  EXPECT_TRUE(is_valid_id_base(0x780));
+  EXPECT_FALSE(is_valid_id_base(0x788));  // the window would pass 0x7FF
+  EXPECT_FALSE(is_valid_id_base(0x304));
+  EXPECT_EQ(id_offset(kDefaultIdBase), 0u);
+  EXPECT_EQ(id_offset(0x300), 0x200u);
+  EXPECT_EQ(id_offset(0x000), 0x700u);  // -0x100, modulo 2,048
+}
+
 TEST(DbcAgreesWithTheCodec, SameMessages) {
   const auto codec = codec_messages();
   for (const auto& [id, message] : codec) EXPECT_EQ(dbc().messages.count(id), 1u) << "not in the DBC: " << message.name;

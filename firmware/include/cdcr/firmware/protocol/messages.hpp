@@ -27,6 +27,23 @@ inline constexpr const char* kDbcComment =
     "w-first in Q15 (1.0 = 32767). Bits no signal defines are reserved and sent as 0. Generated from the runtime's "
     "codec table, firmware/include/cdcr/firmware/protocol/messages.hpp: change the protocol there, not here.";
 
+// Every identifier of the protocol lies in a window of kIdWindow from its
+// base: the identifiers written in this table are at kDefaultIdBase. A bus
+// whose identifiers there are taken (on a CANopen network 0x100 is TIME and
+// 0x101-0x180 are restricted, CiA 301) moves the whole window to another
+// base, a multiple of 8 with the window within the 11-bit space: the
+// runtime, the drives, the host and the DBC then send and read every frame
+// shifted by id_offset() (hal/shifted_can_bus.hpp).
+inline constexpr std::uint32_t kDefaultIdBase = 0x100;
+inline constexpr std::uint32_t kIdWindow = 0x80;
+constexpr bool is_valid_id_base(std::uint32_t base) {
+  return base % 8 == 0 && base + kIdWindow <= hal::kMaxStandardId + 1;
+}
+// What to add to a table identifier to get the one on the bus (mod 2,048).
+constexpr std::uint32_t id_offset(std::uint32_t base) {
+  return (base + hal::kMaxStandardId + 1 - kDefaultIdBase) % (hal::kMaxStandardId + 1);
+}
+
 // Per-segment messages reserve this many identifiers (base .. base + 7).
 inline constexpr int kSegmentIdSlots = 8;
 
@@ -510,5 +527,13 @@ inline constexpr const MessageNotes* kMessageNotes[] = {
 
 // Every message of the protocol, in the same order.
 inline constexpr auto kMessages = messages_of(kMessageNotes);
+
+constexpr bool all_within_id_window() {
+  for (const MessageSpec* m : kMessages) {
+    if (m->id < kDefaultIdBase || m->id + m->id_count > kDefaultIdBase + kIdWindow) return false;
+  }
+  return true;
+}
+static_assert(all_within_id_window(), "every identifier within the window a base moves");
 
 }  // namespace cdcr::firmware::protocol
