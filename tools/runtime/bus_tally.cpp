@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include <cdcr/firmware/protocol/messages.hpp>
+#include <cdcr/hal/shifted_can_bus.hpp>
 
 #include "cli/bus_command.hpp"
 #include "cli/cli_errors.hpp"
@@ -24,8 +25,10 @@ std::int64_t BusTally::deadline_ns(std::int64_t queued_ns) const {
 
 void BusTally::on_transfer(const sim::CanTransfer& transfer) {
   const protocol::MessageSpec* message = nullptr;
+  const std::uint32_t id = (transfer.frame.id + hal::ShiftedCanBus::kIdentifiers - id_offset_) %
+                           hal::ShiftedCanBus::kIdentifiers;
   for (const protocol::MessageSpec* m : protocol::kMessages) {
-    if (m->carries(transfer.frame.id)) message = m;
+    if (m->carries(id)) message = m;
   }
   auto kind = std::find_if(kinds_.begin(), kinds_.end(), [&](const Kind& k) { return k.message == message; });
   if (kind == kinds_.end()) {
@@ -34,6 +37,8 @@ void BusTally::on_transfer(const sim::CanTransfer& transfer) {
   }
   kind->latency_us.push_back(double(transfer.end_ns - transfer.queued_ns) * 1e-3);
   ++frames_;
+  lowest_id_ = std::min(lowest_id_, transfer.frame.id);
+  highest_id_ = std::max(highest_id_, transfer.frame.id);
   if (first_release_ns_ >= 0 && period_ns_ > 0 && transfer.end_ns > deadline_ns(transfer.queued_ns)) {
     ++kind->late;
     ++late_;
@@ -88,9 +93,11 @@ std::string timed_bus_report(const sim::VirtualCanBus& bus, std::int64_t now_ns,
   const protocol::BusBudget budget = cli::bus_budget_of(bus_options(segments, rate_hz, streaming, choice));
   const double measured = BusTally::measured_load(bus, now_ns);
   return fmt::format("bus at {} bit/s: measured load {:.1f} % over {:.3f} s (the budget's worst case {:.1f} %, "
-                     "without stuffing {:.1f} %), {} frames, {} late for their cycle\n",
+                     "without stuffing {:.1f} %), {} frames on identifiers 0x{:03X} to 0x{:03X}, {} late for "
+                     "their cycle\n",
                      choice.bitrate, 100.0 * measured, double(now_ns) * 1e-9, 100.0 * budget.load,
-                     100.0 * budget.unstuffed_load, tally.frames(), tally.late()) +
+                     100.0 * budget.unstuffed_load, tally.frames(), tally.lowest_id(), tally.highest_id(),
+                     tally.late()) +
          tally.table();
 }
 

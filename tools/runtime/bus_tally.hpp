@@ -21,9 +21,14 @@ class BusTally final : public sim::CanTransferObserver {
     first_release_ns_ = first_release_ns;
     period_ns_ = period_ns;
   }
+  // Frames on the bus at the protocol's identifiers moved by this much.
+  void set_id_offset(std::uint32_t offset) { id_offset_ = offset; }
   void on_transfer(const sim::CanTransfer& transfer) override;
 
   long frames() const { return frames_; }
+  // The lowest and highest identifier seen on the wire.
+  std::uint32_t lowest_id() const { return lowest_id_; }
+  std::uint32_t highest_id() const { return highest_id_; }
   long late() const { return late_; }
   // The bus's share of time carrying frames, over [0, now_ns].
   static double measured_load(const sim::VirtualCanBus& bus, std::int64_t now_ns) {
@@ -41,10 +46,13 @@ class BusTally final : public sim::CanTransferObserver {
   std::int64_t deadline_ns(std::int64_t queued_ns) const;
 
   std::vector<Kind> kinds_;
+  std::uint32_t id_offset_ = 0;
   std::int64_t first_release_ns_ = -1;
   std::int64_t period_ns_ = 0;
   long frames_ = 0;
   long late_ = 0;
+  std::uint32_t lowest_id_ = 0x7FF;
+  std::uint32_t highest_id_ = 0;
 };
 
 struct BusChoice;

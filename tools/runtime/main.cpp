@@ -7,6 +7,7 @@
 // Exit codes as the cdcr command's (cli_errors.hpp).
 
 #include <cstdio>
+#include <cstdlib>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -62,6 +63,10 @@ int main(int argc, char** argv) {
                                 "above its limit refused; --sim times its bus at this rate (0: an untimed bus, "
                                 "frames delivered at once)");
   cdcr::cli::add_publish_rate_options(app, bus.rates);
+  std::string id_base_text;
+  app.add_option("--id-base", id_base_text,
+                 "where the protocol's identifiers start (decimal or 0x-hexadecimal, a multiple of 8 up to 0x780; "
+                 "default 0x100): for a bus shared with other traffic, CANopen's say");
   auto* streaming_option = app.add_flag("--streaming", bus.streaming,
                                         "with --can and --bitrate: plan the budget for a target streamed every cycle");
   replay_option->excludes(sim_option);
@@ -76,6 +81,15 @@ int main(int argc, char** argv) {
     if (!flash_dir.empty() && can_interface.empty()) throw CLI::ValidationError("--flash-dir needs --can");
     if (streaming_option->count() > 0 && can_interface.empty()) {
       throw CLI::ValidationError("--streaming needs --can (--sim --circle streams)");
+    }
+    if (!id_base_text.empty()) {
+      char* end = nullptr;
+      const unsigned long base = std::strtoul(id_base_text.c_str(), &end, 0);
+      if (end == id_base_text.c_str() || *end != '\0' || base > 0x7FF ||
+          !cdcr::firmware::protocol::is_valid_id_base(static_cast<std::uint32_t>(base))) {
+        throw CLI::ValidationError("--id-base must be a multiple of 8 from 0 to 0x780, got '" + id_base_text + "'");
+      }
+      bus.id_base = static_cast<std::uint32_t>(base);
     }
     if (!bus.rates.valid()) {
       throw CLI::ValidationError(fmt::format("--pose-every, --uncertainty-every and --status-every must be 1 to {} cycles",

@@ -7,6 +7,7 @@
 #include <cstdint>
 #include <string>
 
+#include <cdcr/firmware/protocol/messages.hpp>
 #include <cdcr/firmware/publish_rates.hpp>
 
 namespace cdcr::runtime_host {
@@ -17,6 +18,9 @@ namespace cdcr::runtime_host {
 // bus at that rate (0: the untimed, infinitely fast bus) and reports what it
 // carried.
 struct BusChoice {
+  // Where the protocol's identifiers start (firmware/protocol/messages.hpp):
+  // the runtime, the simulated drives and host all send and read there.
+  std::uint32_t id_base = firmware::protocol::kDefaultIdBase;
   std::uint32_t bitrate = 0;
   firmware::PublishRates rates{};
   bool streaming = false;  // --can: plan for a target streamed every cycle (--circle streams)

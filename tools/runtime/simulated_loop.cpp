@@ -55,10 +55,14 @@ sim::SimulatorConfig robot_config(const SimulatedRobotChoice& choice) {
 // the simulated robot whose cables it reads and moves.
 struct SimulatedLoop {
   SimulatedLoop(const std::string& image_path, const SimulatedRobotChoice& choice, const BusChoice& bus_choice)
-      : runtime(with_image(platform, image_path).hal, fw::Geometry::prototype()),
+      : platform(protocol::id_offset(bus_choice.id_base)),
+        runtime(with_image(platform, image_path).hal, fw::Geometry::prototype()),
         geometry(booted(runtime).geometry().cast<double>()),
         robot(geometry, robot_config(choice)),
-        bus(bus_choice) {
+        bus(bus_choice),
+        drives_can(platform.bus.node(1), protocol::id_offset(bus_choice.id_base)),
+        host_can(platform.bus.node(2), protocol::id_offset(bus_choice.id_base)) {
+    bus_tally.set_id_offset(protocol::id_offset(bus.id_base));
     runtime.set_publish_rates(bus.rates);
     if (bus.bitrate > 0) {
       platform.bus.set_timing(platform.clock, {bus.bitrate, 0});
@@ -81,6 +85,9 @@ struct SimulatedLoop {
   model::RobotGeometry<double> geometry;
   sim::SimulatedRobot robot;
   BusChoice bus;
+  // The drives' and the host's nodes, at the runtime's identifiers.
+  cdcr::hal::ShiftedCanBus drives_can;
+  cdcr::hal::ShiftedCanBus host_can;
   BusTally bus_tally;
 };
 
@@ -90,9 +97,9 @@ struct SimulatedLoop {
 struct DrivenLoop {
   DrivenLoop(SimulatedLoop& loop, const model::CableVector<double>& start_cables, double rate_hz)
       : loop(loop),
-        drives(loop.platform.bus.node(1), start_cables, 50.0, sim::cables_per_segment(loop.geometry)),
+        drives(loop.drives_can, start_cables, 50.0, sim::cables_per_segment(loop.geometry)),
         effective_cables(loop.robot.move_cables(drives.cables_mm())),
-        host(loop.platform.bus.node(2)),
+        host(loop.host_can),
         period_ns(static_cast<std::int64_t>(std::llround(1e9 / rate_hz))),
         dt_s(double(period_ns) * 1e-9) {
     host.set_filters(&protocol::kIkReportFrames, 1);

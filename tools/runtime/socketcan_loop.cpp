@@ -7,6 +7,7 @@
 #include <string>
 
 #include <cdcr/firmware/runtime.hpp>
+#include <cdcr/hal/shifted_can_bus.hpp>
 
 #include "cli/cli_errors.hpp"
 #if CDCR_HAVE_LINUX_PLATFORM
@@ -22,6 +23,7 @@ namespace cdcr::runtime_host {
 
 namespace fw = cdcr::firmware;
 namespace model = cdcr::model;
+namespace protocol = cdcr::firmware::protocol;
 using cli::InputError;
 
 #if CDCR_HAVE_LINUX_PLATFORM
@@ -75,7 +77,8 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
 
-  static const cdcr::hal::Hal hal{clock, timer, bus, storage, console, flash_dir.empty() ? nullptr : &flash};
+  static cdcr::hal::ShiftedCanBus runtime_can(bus, protocol::id_offset(bus_choice.id_base));
+  static const cdcr::hal::Hal hal{clock, timer, runtime_can, storage, console, flash_dir.empty() ? nullptr : &flash};
   static fw::Runtime runtime(hal, fw::Geometry::prototype());
   runtime.init();
   runtime.set_publish_rates(bus_choice.rates);
