@@ -13,6 +13,7 @@
 
 #include "cdcr/callbacks/callback_hal.hpp"
 #include "cdcr/firmware/runtime.hpp"
+#include "cdcr/hal/shifted_can_bus.hpp"
 #include "cdcr/model/unit_quaternion.hpp"
 
 namespace cdcr::firmware {
@@ -114,11 +115,18 @@ class InputQueue final : public CycleInputs {
 // Everything cdcr_runtime holds. The HAL comes before the runtime, which
 // keeps references to its parts.
 struct CRuntime {
-  CRuntime(const cdcr_config& config, const Geometry& fallback)
-      : hal(config.callbacks, config.model_image, config.model_image_size), runtime(hal.hal(), fallback) {}
+  CRuntime(const cdcr_config& config, const Geometry& fallback, std::uint32_t id_base)
+      : hal(config.callbacks, config.model_image, config.model_image_size),
+        can(hal.hal().can, protocol::id_offset(id_base)),
+        runtime(with_can(hal.hal(), can), fallback) {}
+
+  static hal::Hal with_can(const hal::Hal& h, hal::CanBus& bus) {
+    return hal::Hal{h.clock, h.timer, bus, h.model_storage, h.console, h.flash};
+  }
 
   std::uint32_t magic = 0;
   callbacks::CallbackHal hal;
+  hal::ShiftedCanBus can;  // the callbacks' bus at the identifier base
   InputQueue inputs;
   Runtime runtime;
 };
@@ -184,7 +192,9 @@ cdcr_result cdcr_init(cdcr_runtime* runtime, const cdcr_config* config) {
   if (config->period_ns < 0) return CDCR_ERROR_INVALID_ARGUMENT;
   firmware::Geometry fallback;
   if (!firmware::geometry_from_config(config->fallback_geometry, fallback)) return CDCR_ERROR_INVALID_ARGUMENT;
-  auto* c = new (firmware::aligned_storage(runtime)) CRuntime(*config, fallback);
+  const std::uint32_t id_base = config->can_id_base == 0 ? protocol::kDefaultIdBase : config->can_id_base;
+  if (!protocol::is_valid_id_base(id_base)) return CDCR_ERROR_INVALID_ARGUMENT;
+  auto* c = new (firmware::aligned_storage(runtime)) CRuntime(*config, fallback, id_base);
   c->hal.timer().start(config->period_ns);
   c->runtime.init();
   c->magic = firmware::kInitializedMagic;

@@ -465,6 +465,55 @@ TEST_F(CApiRuntime, CanCallbacksCarryTheProtocol) {
   EXPECT_EQ(status().fault, CDCR_FAULT_CAN_FILTERS_REFUSED);
 }
 
+// With the identifier base at 0x300 every frame moves 0x200 up, each way:
+// cable feedback at 0x300 + s gives the pose, which goes out at 0x330; the
+// same frames at the default identifiers are foreign.
+TEST_F(CApiRuntime, AnIdentifierBaseMovesEveryFrame) {
+  Bus bus;
+  image = small_image();
+  config = cdcr_config{};
+  config.model_image = image.data();
+  config.model_image_size = std::uint32_t(image.size());
+  config.can_id_base = 0x304;  // not a multiple of 8
+  connect(config.callbacks, bus);
+  EXPECT_EQ(cdcr_init(&runtime, &config), CDCR_ERROR_INVALID_ARGUMENT);
+  config.can_id_base = 0x788;  // the window would pass 0x7FF
+  EXPECT_EQ(cdcr_init(&runtime, &config), CDCR_ERROR_INVALID_ARGUMENT);
+  config.can_id_base = 0x300;
+  ASSERT_EQ(cdcr_init(&runtime, &config), CDCR_OK);
+
+  const std::vector<float> lengths = bent_cables(Geometry::uniform(2, 120.0f, 67.0f));
+  const auto feedback_at = [&](std::uint32_t first_id) {
+    for (int s = 0; s < 2; ++s) {
+      protocol::CableFeedback feedback;
+      feedback.segment = s;
+      for (int k = 0; k < 4; ++k) feedback.lengths_mm[k] = lengths[4 * s + k];
+      hal::CanFrame frame;
+      ASSERT_TRUE(protocol::encode(feedback, frame));
+      cdcr_can_frame out{};
+      out.id = first_id + std::uint32_t(s);
+      out.dlc = frame.dlc;
+      std::memcpy(out.data, frame.data, 8);
+      bus.inbox.push_back(out);
+    }
+  };
+  feedback_at(0x100);  // the default identifiers: not the runtime's any more
+  ASSERT_EQ(cdcr_step(&runtime), CDCR_OK);
+  cdcr_pose pose{};
+  EXPECT_NE(cdcr_get_pose(&runtime, &pose), CDCR_OK);
+  feedback_at(0x300);
+  bus.sent.clear();
+  ASSERT_EQ(cdcr_step(&runtime), CDCR_OK);
+  ASSERT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_OK);
+  bool pose_at_0x330 = false;
+  for (const cdcr_can_frame& frame : bus.sent) {
+    EXPECT_GE(frame.id, 0x300u);
+    EXPECT_LT(frame.id, 0x380u);
+    pose_at_0x330 = pose_at_0x330 || frame.id == 0x330;
+  }
+  EXPECT_TRUE(pose_at_0x330);
+}
+
 // Inputs given by call reach the runtime as their frames would: a runtime
 // fed through cdcr_set_* and one fed the same inputs as frames on its bus
 // send the same frames, byte for byte, with lengths, positions, quaternions

@@ -1,5 +1,6 @@
 #include "bus_command.hpp"
 
+#include <cstdlib>
 #include <memory>
 #include <utility>
 
@@ -24,6 +25,23 @@ void add_publish_rate_options(CLI::App& command, firmware::PublishRates& rates) 
 
 void add_bitrate_option(CLI::App& command, std::uint32_t& bitrate, const std::string& what) {
   command.add_option("--bitrate", bitrate, what)->capture_default_str();
+}
+
+void add_id_base_option(CLI::App& command, std::string& text) {
+  command.add_option("--id-base", text,
+                     "Where the protocol's identifiers start: a multiple of 8 up to 0x780 (default 0x100), for a bus "
+                     "shared with other traffic (CANopen's 0x100 is TIME)");
+}
+
+std::uint32_t parse_id_base(const std::string& text) {
+  if (text.empty()) return protocol::kDefaultIdBase;
+  char* end = nullptr;
+  const unsigned long base = std::strtoul(text.c_str(), &end, 0);
+  if (end == text.c_str() || *end != '\0' || text[0] == '-' || base > hal::kMaxStandardId ||
+      !protocol::is_valid_id_base(static_cast<std::uint32_t>(base))) {
+    throw InputError("--id-base must be a multiple of 8 from 0 to 0x780, got '" + text + "'");
+  }
+  return static_cast<std::uint32_t>(base);
 }
 
 void validate_bus_options(const BusOptions& options) {

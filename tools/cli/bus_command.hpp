@@ -36,6 +36,13 @@ void add_publish_rate_options(CLI::App& command, firmware::PublishRates& rates);
 // --bitrate (bit/s, a bus's nominal rate).
 void add_bitrate_option(CLI::App& command, std::uint32_t& bitrate, const std::string& what);
 
+// --id-base (decimal or 0x-hexadecimal): where the protocol's identifiers
+// start (firmware/protocol/messages.hpp), for cdcr deploy and cdcr-runtime.
+void add_id_base_option(CLI::App& command, std::string& text);
+// The base in `text`, kDefaultIdBase for ""; throws InputError for a base
+// the protocol cannot take.
+std::uint32_t parse_id_base(const std::string& text);
+
 // Throws InputError for values out of range.
 void validate_bus_options(const BusOptions& options);
 firmware::protocol::BusBudget bus_budget_of(const BusOptions& options);

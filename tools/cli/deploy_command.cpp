@@ -11,10 +11,12 @@
 
 #include <cdcr/firmware/capacity.hpp>
 #include <cdcr/firmware/update/update_sender.hpp>
+#include <cdcr/hal/shifted_can_bus.hpp>
 
+#include "bus_command.hpp"
+#include "cdcr/linux/socketcan_bus.hpp"
 #include "cli_errors.hpp"
 #include "export/binary_file.hpp"
-#include "cdcr/linux/socketcan_bus.hpp"
 
 namespace cdcr::cli {
 
@@ -53,9 +55,9 @@ std::int64_t now_ms() {
 // waits for the next flush() instead of being dropped.
 class Link final : public hal::CanBus {
  public:
-  explicit Link(const std::string& interface_name) {
+  Link(const std::string& interface_name, std::uint32_t id_base) : bus_(socket_, protocol::id_offset(id_base)) {
     std::string error;
-    if (!bus_.open(interface_name, error)) throw InputError("CAN interface " + interface_name + ": " + error);
+    if (!socket_.open(interface_name, error)) throw InputError("CAN interface " + interface_name + ": " + error);
     const hal::CanFilter filters[] = {protocol::kUpdateReportFrames};
     bus_.set_filters(filters, 1);
   }
@@ -82,7 +84,8 @@ class Link final : public hal::CanBus {
   hal::CanErrorCounters error_counters() const override { return bus_.error_counters(); }
 
  private:
-  linux_host::SocketCanBus bus_;
+  linux_host::SocketCanBus socket_;
+  hal::ShiftedCanBus bus_;  // the runtime's identifiers, wherever its base puts them
   std::deque<hal::CanFrame> pending_;
 };
 
@@ -114,7 +117,7 @@ protocol::UpdateReport command(Link& link, protocol::UpdateCommand which, double
 
 CommandOutput run_deploy(const DeployCommandOptions& options) {
   CommandOutput output;
-  Link link(options.can_interface);
+  Link link(options.can_interface, parse_id_base(options.id_base));
   if (options.status) {
     const protocol::UpdateReport report = command(link, protocol::UpdateCommand::status, 2.0);
     output.text = fmt::format("state {}, active slot {} (sequence {}), {} blocks in flash, transfer {:04x}{}\n",
@@ -187,6 +190,7 @@ void register_deploy_command(CLI::App& app, CommandOutput& output) {
   command->add_option("--timeout", options->timeout_s, "Give up after this many seconds without progress")
       ->capture_default_str();
   command->add_flag("--quiet", options->quiet, "No progress bar");
+  add_id_base_option(*command, options->id_base);
   image->excludes(status)->excludes(rollback);
   status->excludes(rollback);
   command->callback([options, command, &output] {

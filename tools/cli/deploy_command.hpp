@@ -16,6 +16,7 @@ namespace cdcr::cli {
 struct DeployCommandOptions {
   std::string can_interface;
   std::string image_path;
+  std::string id_base;  // "": the protocol's default
   bool status = false;
   bool rollback = false;
   double timeout_s = 120.0;  // without progress

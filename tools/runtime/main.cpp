@@ -7,7 +7,6 @@
 // Exit codes as the cdcr command's (cli_errors.hpp).
 
 #include <cstdio>
-#include <cstdlib>
 #include <exception>
 #include <stdexcept>
 #include <string>
@@ -64,9 +63,7 @@ int main(int argc, char** argv) {
                                 "frames delivered at once)");
   cdcr::cli::add_publish_rate_options(app, bus.rates);
   std::string id_base_text;
-  app.add_option("--id-base", id_base_text,
-                 "where the protocol's identifiers start (decimal or 0x-hexadecimal, a multiple of 8 up to 0x780; "
-                 "default 0x100): for a bus shared with other traffic, CANopen's say");
+  cdcr::cli::add_id_base_option(app, id_base_text);
   auto* streaming_option = app.add_flag("--streaming", bus.streaming,
                                         "with --can and --bitrate: plan the budget for a target streamed every cycle");
   replay_option->excludes(sim_option);
@@ -82,15 +79,7 @@ int main(int argc, char** argv) {
     if (streaming_option->count() > 0 && can_interface.empty()) {
       throw CLI::ValidationError("--streaming needs --can (--sim --circle streams)");
     }
-    if (!id_base_text.empty()) {
-      char* end = nullptr;
-      const unsigned long base = std::strtoul(id_base_text.c_str(), &end, 0);
-      if (end == id_base_text.c_str() || *end != '\0' || base > 0x7FF ||
-          !cdcr::firmware::protocol::is_valid_id_base(static_cast<std::uint32_t>(base))) {
-        throw CLI::ValidationError("--id-base must be a multiple of 8 from 0 to 0x780, got '" + id_base_text + "'");
-      }
-      bus.id_base = static_cast<std::uint32_t>(base);
-    }
+    bus.id_base = cdcr::cli::parse_id_base(id_base_text);
     if (!bus.rates.valid()) {
       throw CLI::ValidationError(fmt::format("--pose-every, --uncertainty-every and --status-every must be 1 to {} cycles",
                                              cdcr::firmware::kMaxPublishEvery));
@@ -99,6 +88,9 @@ int main(int argc, char** argv) {
     if (!replay_path.empty() && (image_path.empty() || out_path.empty())) {
       throw CLI::ValidationError("--replay needs --image and --out");
     }
+  } catch (const cdcr::cli::InputError& e) {
+    std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());
+    return kExitUsage;
   } catch (const CLI::CallForHelp& e) {
     return app.exit(e);
   } catch (const CLI::ParseError& e) {

@@ -135,6 +135,12 @@ typedef struct cdcr_config {
    * plus k periods, which gives jitter and overrun counts. 0: none kept. */
   int64_t period_ns;
   cdcr_callbacks callbacks;
+  /* Where the protocol's 128 identifiers start on the board's bus: a
+   * multiple of 8 from 0x008 to 0x780, for a bus shared with other traffic
+   * (CANopen's 0x100 is TIME). 0: the protocol's own base, 0x100. The
+   * callbacks then send and receive frames at the moved identifiers, and set
+   * the filters there. */
+  uint32_t can_id_base;
 } cdcr_config;
 
 typedef struct cdcr_target {
