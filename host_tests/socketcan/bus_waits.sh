@@ -17,7 +17,8 @@ prepare_deploy_work() {
 }
 
 # The drives: one cangen per segment sending its FEEDBACK_<segment> frame
-# (from socketcan_check frames) every feeder_gap_ms (10 unless set).
+# (from socketcan_check frames) every feeder_gap_ms (10 unless set), at
+# identifiers <feeder_id_prefix><segment> (10: the protocol's default base).
 feeders=""
 start_feeders() {
   feeders=""
@@ -25,7 +26,7 @@ start_feeders() {
   while [ "$segment" -lt "$SEGMENTS" ]; do
     data=""
     eval "data=\$FEEDBACK_$segment"
-    cangen vcan0 -I "10$segment" -L 8 -D "$data" -g "${feeder_gap_ms:-10}" &
+    cangen vcan0 -I "${feeder_id_prefix:-10}$segment" -L 8 -D "$data" -g "${feeder_gap_ms:-10}" &
     feeders="$feeders $!"
     segment=$((segment + 1))
   done

@@ -13,6 +13,10 @@
 #      socketcan_relay (beside CDCR_CHECK), which loses 5 % of the frames
 #      each way and repeats and reorders 1 % (seeded): the transfer resends
 #      and commits.
+#   4. The protocol moved to identifiers from 0x300 (--id-base): the drives'
+#      frames there bring the runtime to RUN while the old ones at 0x100
+#      still flow, foreign now; a deploy at the same base reaches it and one
+#      at the default base does not.
 #   CDCR_RUNTIME, CDCR_CLI, CDCR_CHECK: host-built binaries; CDCR_WORK_DIR.
 set -u
 . "$(dirname "$0")/bus_waits.sh"
@@ -26,7 +30,7 @@ rm -rf "$flash" "$work"/runtime.err.* "$work"/deploy.* "$work"/relay.err
 eval "$("$CDCR_CHECK" frames "$work/old.img")" || fail "cannot compute the frames"
 
 start_feeders
-stdbuf -oL candump -L -r 4194304 vcan0,130:7F8,150:7FF,178:7FF,7F0:7FF > "$log" &
+stdbuf -oL candump -L -r 4194304 vcan0,130:7F8,150:7FF,178:7FF,7F0:7FF,350:7FF > "$log" &
 candump_pid=$!
 
 restarts=0
@@ -110,6 +114,27 @@ wait "$relay_pid"
 progress "$(cat "$work/deploy.lossy.out"); relay: $(cat "$work/relay.err")"
 "$CDCR_CLI" deploy --can vcan0 --status > "$work/deploy.status" 2>&1 || fail "status: $(cat "$work/deploy.status")"
 grep -q "active slot A" "$work/deploy.status" || fail "status after the faulty link: $(cat "$work/deploy.status")"
+
+# 4. Identifiers from 0x300.
+kill "$runtime_pid"
+wait "$runtime_pid" 2>/dev/null
+default_feeders=$feeders
+feeder_id_prefix=30 start_feeders
+feeders="$feeders $default_feeders"
+"$CDCR_RUNTIME" --image "$work/old.img" --can vcan0 --flash-dir "$flash" --rate 100 --id-base 0x300 \
+  > /dev/null 2> "$work/runtime.err.base" &
+runtime_pid=$!
+in_run_at_0x300() { tail -c 16384 "$log" | awk '$3 ~ /^350#/ { last = $3 } END { exit last !~ /^350#01/ }'; }
+wait_until "the runtime at 0x300 in RUN on the drives' frames at 0x300" in_run_at_0x300
+if "$CDCR_CLI" deploy --can vcan0 --status --timeout 2 > "$work/deploy.status" 2>&1; then
+  fail "a status request at the default base reached the runtime at 0x300: $(cat "$work/deploy.status")"
+fi
+"$CDCR_CLI" deploy --can vcan0 --id-base 0x300 --image "$work/new.img" --quiet > "$work/deploy.base.out" \
+  2> "$work/deploy.base.err" || fail "deploy at 0x300: $(cat "$work/deploy.base.err")"
+"$CDCR_CLI" deploy --can vcan0 --id-base 0x300 --status > "$work/deploy.status" 2>&1 ||
+  fail "status at 0x300: $(cat "$work/deploy.status")"
+grep -q "active slot B" "$work/deploy.status" || fail "status after the deploy at 0x300: $(cat "$work/deploy.status")"
+progress "identifiers from 0x300: $(cat "$work/deploy.base.out"); $(cat "$work/deploy.status")"
 stop_all
 echo "SOCKETCAN_TEST_PASS"
 exit 0
