@@ -68,13 +68,21 @@ CableDifferences<S> cable_differences(const Eigen::MatrixBase<Derived>& cables_m
                                       const SegmentGeometry<S>& geometry) {
   CableDifferences<S> d;
   const CableLayout<S>& layout = geometry.cables;
+  // Cable by cable: Eigen's reductions over a vector of at most four read
+  // packets GCC takes for reads past its end.
+  bool finite = true;
+  bool positive = true;
+  for (Eigen::Index j = 0; j < cables_mm.size(); ++j) {
+    finite = finite && std::isfinite(cables_mm[j]);
+    positive = positive && cables_mm[j] > S(0);
+  }
   if (const Status s = geometry.validate(); s != Status::ok) {
     d.status = s;
   } else if (cables_mm.size() != layout.count) {
     d.status = Status::invalid_segment_count;
-  } else if (!cables_mm.allFinite()) {
+  } else if (!finite) {
     d.status = Status::non_finite_input;
-  } else if (!(cables_mm.minCoeff() > S(0))) {
+  } else if (!positive) {
     d.status = Status::cable_length_not_positive;
   } else {
     d.mean = layout_sum(layout.mean_weights, cables_mm, layout.count);
@@ -139,8 +147,14 @@ Status cables_from_joints(const SegmentJoints<S>& joints, const SegmentGeometry<
   const S r = geometry.anchor_radius_mm * s;
   const CableLayout<S>& layout = geometry.cables;
   SegmentCables<S> cables(layout.count);
-  for (int j = 0; j < layout.count; ++j) cables[j] = mean - r * (b.x() * layout.anchor_x[j] + b.y() * layout.anchor_y[j]);
-  if (!(cables.minCoeff() > S(0))) return Status::cable_length_not_positive;
+  // Checked cable by cable (a NaN fails too): Eigen's minCoeff over a
+  // vector of at most four reads packets GCC takes for reads past its end.
+  bool positive = true;
+  for (int j = 0; j < layout.count; ++j) {
+    cables[j] = mean - r * (b.x() * layout.anchor_x[j] + b.y() * layout.anchor_y[j]);
+    positive = positive && cables[j] > S(0);
+  }
+  if (!positive) return Status::cable_length_not_positive;
   cables_mm = cables;
   return Status::ok;
 }
