@@ -22,6 +22,7 @@
 #include "cdcr/firmware/protocol/message_codec.hpp"
 #include "cdcr/firmware/protocol/messages.hpp"
 #include "cdcr/firmware/protocol/signal_codec.hpp"
+#include "cdcr/hal/shifted_can_bus.hpp"
 
 namespace cdcr::firmware::protocol {
 namespace {
@@ -84,7 +85,7 @@ void write_signal(std::ostream& out, const SignalSpec& signal, const char* recei
 
 void write_dbc(std::ostream& out, std::uint32_t base) {
   const std::uint32_t shift = id_offset(base);
-  const auto on_bus = [shift](std::uint32_t id) { return (id + shift) % (hal::kMaxStandardId + 1); };
+  const auto on_bus = [shift](std::uint32_t id) { return hal::ShiftedCanBus::shifted(id, shift); };
   out << "VERSION " << quoted(kDbcVersion, "VERSION") << "\n\n";
   out << "NS_ :\n\nBS_:\n\nBU_:";
   for (const char* node : kDbcNodes) out << ' ' << node;

@@ -97,6 +97,8 @@ bool Runtime::extrapolating() const {
 void Runtime::run_cycle(const hal::TimerTick& tick, CycleInputs* inputs) {
   const std::int64_t start_ns = hal_.clock.now_ns();
   ++cycle_;
+  if (pose_wait_ > 0) --pose_wait_;
+  if (variance_wait_ > 0) --variance_wait_;
   ik_units_last_cycle_ = 0;
 
   int frames = inputs != nullptr ? inputs->deliver(*this) : 0;
@@ -230,22 +232,18 @@ void Runtime::update_pose() {
       has_pose_ = true;
       last_valid_cycle_ = cycle_;
       if (state_ == RuntimeState::fault) enter(mode());
-      const bool pose_due =
-          !published_since_boot_ || cycle_ - last_pose_cycle_ >= std::uint32_t(publish_rates_.pose_every);
+      const bool pose_due = pose_wait_ == 0;
       if (pose_due) {
         publish_pose();
-        published_since_boot_ = true;
-        last_pose_cycle_ = cycle_;
+        pose_wait_ = std::uint32_t(publish_rates_.pose_every);
       }
       // Radii are of a pose that went out (POSE_UNCERTAINTY names it by its
       // sequence), at most every uncertainty_every cycles.
-      const bool variance_due = pose_due && (!variance_begun_since_boot_ || cycle_ - last_variance_begin_cycle_ >=
-                                                                                std::uint32_t(publish_rates_.uncertainty_every));
-      if (variance_due && !variance_.running() && latest_pose_.compensated && model_.uncertainty.has_variance()) {
+      if (pose_due && variance_wait_ == 0 && !variance_.running() && latest_pose_.compensated &&
+          model_.uncertainty.has_variance()) {
         variance_.begin(model_.uncertainty, latest_pose_, static_cast<std::uint8_t>(cycle_ & 0xFF));
         hysteresis_.begin_variance(model_, latest_pose_);
-        variance_begun_since_boot_ = true;
-        last_variance_begin_cycle_ = cycle_;
+        variance_wait_ = std::uint32_t(publish_rates_.uncertainty_every);
       }
     } else {
       statistics_.rejected_cable_sets += 1;

@@ -156,7 +156,7 @@ TEST_F(CApiPose, PoseCarriesTheRadiiOfTheImagesVariance) {
 // C API gives the nominal pose printed there.
 TEST(CApi, NominalPoseWithoutAnImageIsTable1) {
   const float lengths[16] = {118, 123, 124, 115, 124, 115, 118, 121, 110, 117, 125, 123, 124, 105, 112, 128};
-  const cdcr_geometry geometry = {4, 120.0f, 70.0f, 1.5707963f};
+  const cdcr_geometry geometry = {4, 120.0f, 70.0f, 1.5707963f, 0};
   cdcr_pose pose{};
   cdcr_status status{};
   ASSERT_EQ(c_api_check_pose(nullptr, 0, &geometry, lengths, 16, 1, &pose, &status), 0);
@@ -178,7 +178,7 @@ class CApiRuntime : public ::testing::Test {
     config = cdcr_config{};
     config.model_image = image.empty() ? nullptr : image.data();
     config.model_image_size = std::uint32_t(image.size());
-    config.fallback_geometry = cdcr_geometry{2, 120.0f, 67.0f, 1.5707963f};
+    config.fallback_geometry = cdcr_geometry{2, 120.0f, 67.0f, 1.5707963f, 0};
     ASSERT_EQ(cdcr_init(&runtime, &config), CDCR_OK);
   }
   void step_with(const std::vector<float>& lengths, int steps = 1) {
@@ -422,6 +422,23 @@ void connect(cdcr_callbacks& callbacks, Bus& bus) {
   };
 }
 
+// Two segments' CABLE_FEEDBACK frames of `lengths` into the bus's inbox, at
+// first_id + segment.
+void feed_cables(Bus& bus, const std::vector<float>& lengths, std::uint32_t first_id) {
+  for (int s = 0; s < 2; ++s) {
+    protocol::CableFeedback feedback;
+    feedback.segment = s;
+    for (int k = 0; k < 4; ++k) feedback.lengths_mm[k] = lengths[4 * s + k];
+    hal::CanFrame frame;
+    ASSERT_TRUE(protocol::encode(feedback, frame));
+    cdcr_can_frame out{};
+    out.id = first_id + std::uint32_t(s);
+    out.dlc = frame.dlc;
+    std::memcpy(out.data, frame.data, 8);
+    bus.inbox.push_back(out);
+  }
+}
+
 TEST_F(CApiRuntime, CanCallbacksCarryTheProtocol) {
   Bus bus;
   image = small_image();
@@ -435,18 +452,7 @@ TEST_F(CApiRuntime, CanCallbacksCarryTheProtocol) {
 
   // The same lengths as frames on the caller's bus give the same pose as fed.
   const std::vector<float> lengths = bent_cables(Geometry::uniform(2, 120.0f, 67.0f));
-  for (int s = 0; s < 2; ++s) {
-    protocol::CableFeedback feedback;
-    feedback.segment = s;
-    for (int k = 0; k < 4; ++k) feedback.lengths_mm[k] = lengths[4 * s + k];
-    hal::CanFrame frame;
-    ASSERT_TRUE(protocol::encode(feedback, frame));
-    cdcr_can_frame out{};
-    out.id = frame.id;
-    out.dlc = frame.dlc;
-    std::memcpy(out.data, frame.data, 8);
-    bus.inbox.push_back(out);
-  }
+  feed_cables(bus, lengths, protocol::cable_feedback::kMessage.id);
   ASSERT_EQ(cdcr_step(&runtime), CDCR_OK);
   cdcr_pose from_bus{};
   ASSERT_EQ(cdcr_get_pose(&runtime, &from_bus), CDCR_OK);
@@ -483,25 +489,11 @@ TEST_F(CApiRuntime, AnIdentifierBaseMovesEveryFrame) {
   ASSERT_EQ(cdcr_init(&runtime, &config), CDCR_OK);
 
   const std::vector<float> lengths = bent_cables(Geometry::uniform(2, 120.0f, 67.0f));
-  const auto feedback_at = [&](std::uint32_t first_id) {
-    for (int s = 0; s < 2; ++s) {
-      protocol::CableFeedback feedback;
-      feedback.segment = s;
-      for (int k = 0; k < 4; ++k) feedback.lengths_mm[k] = lengths[4 * s + k];
-      hal::CanFrame frame;
-      ASSERT_TRUE(protocol::encode(feedback, frame));
-      cdcr_can_frame out{};
-      out.id = first_id + std::uint32_t(s);
-      out.dlc = frame.dlc;
-      std::memcpy(out.data, frame.data, 8);
-      bus.inbox.push_back(out);
-    }
-  };
-  feedback_at(0x100);  // the default identifiers: not the runtime's any more
+  feed_cables(bus, lengths, 0x100);  // the default identifiers: not the runtime's any more
   ASSERT_EQ(cdcr_step(&runtime), CDCR_OK);
   cdcr_pose pose{};
   EXPECT_NE(cdcr_get_pose(&runtime, &pose), CDCR_OK);
-  feedback_at(0x300);
+  feed_cables(bus, lengths, 0x300);
   bus.sent.clear();
   ASSERT_EQ(cdcr_step(&runtime), CDCR_OK);
   ASSERT_EQ(cdcr_get_pose(&runtime, &pose), CDCR_OK);
@@ -524,7 +516,7 @@ class CallsAndFrames {
     cdcr_config config{};
     config.model_image = image.data();
     config.model_image_size = std::uint32_t(image.size());
-    config.fallback_geometry = cdcr_geometry{2, 120.0f, 67.0f, 1.5707963f};
+    config.fallback_geometry = cdcr_geometry{2, 120.0f, 67.0f, 1.5707963f, 0};
     for (int i = 0; i < 2; ++i) {
       connect(config.callbacks, buses_[i]);
       EXPECT_EQ(cdcr_init(&runtimes_[i], &config), CDCR_OK);
@@ -714,9 +706,9 @@ TEST_F(CApiRuntime, EveryUnusableArgumentHasItsErrorCode) {
   config.model_image_size = 100;  // a size without an image
   EXPECT_EQ(cdcr_init(&runtime, &config), CDCR_ERROR_NULL_ARGUMENT);
   config.model_image_size = 0;
-  config.fallback_geometry = cdcr_geometry{9, 120.0f, 67.0f, 1.5f};
+  config.fallback_geometry = cdcr_geometry{9, 120.0f, 67.0f, 1.5f, 0};
   EXPECT_EQ(cdcr_init(&runtime, &config), CDCR_ERROR_INVALID_ARGUMENT);
-  config.fallback_geometry = cdcr_geometry{2, 120.0f, -67.0f, 1.5f};
+  config.fallback_geometry = cdcr_geometry{2, 120.0f, -67.0f, 1.5f, 0};
   EXPECT_EQ(cdcr_init(&runtime, &config), CDCR_ERROR_INVALID_ARGUMENT);
   config.fallback_geometry = cdcr_geometry{};
   config.period_ns = -1;

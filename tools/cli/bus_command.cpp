@@ -55,10 +55,13 @@ void validate_bus_options(const BusOptions& options) {
     throw InputError(
         fmt::format("--bitrate must be 10000 to 1000000 bit/s (classical CAN), got {}", options.bitrate));
   }
-  const firmware::PublishRates& r = options.rates;
-  for (const auto& [name, value] : {std::pair<const char*, int>{"--pose-every", r.pose_every},
-                                    {"--uncertainty-every", r.uncertainty_every},
-                                    {"--status-every", r.status_every}}) {
+  validate_publish_rates(options.rates);
+}
+
+void validate_publish_rates(const firmware::PublishRates& rates) {
+  for (const auto& [name, value] : {std::pair<const char*, int>{"--pose-every", rates.pose_every},
+                                    {"--uncertainty-every", rates.uncertainty_every},
+                                    {"--status-every", rates.status_every}}) {
     if (value < 1 || value > firmware::kMaxPublishEvery) {
       throw InputError(fmt::format("{} must be 1 to {} cycles, got {}", name, firmware::kMaxPublishEvery, value));
     }

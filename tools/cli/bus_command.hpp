@@ -43,8 +43,9 @@ void add_id_base_option(CLI::App& command, std::string& text);
 // the protocol cannot take.
 std::uint32_t parse_id_base(const std::string& text);
 
-// Throws InputError for values out of range.
+// Throw InputError for values out of range.
 void validate_bus_options(const BusOptions& options);
+void validate_publish_rates(const firmware::PublishRates& rates);
 firmware::protocol::BusBudget bus_budget_of(const BusOptions& options);
 // The budget as a table, and its verdict.
 std::string format_bus_budget(const firmware::protocol::BusBudget& budget, const BusOptions& options);

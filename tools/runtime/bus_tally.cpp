@@ -25,8 +25,7 @@ std::int64_t BusTally::deadline_ns(std::int64_t queued_ns) const {
 
 void BusTally::on_transfer(const sim::CanTransfer& transfer) {
   const protocol::MessageSpec* message = nullptr;
-  const std::uint32_t id = (transfer.frame.id + hal::ShiftedCanBus::kIdentifiers - id_offset_) %
-                           hal::ShiftedCanBus::kIdentifiers;
+  const std::uint32_t id = hal::ShiftedCanBus::unshifted(transfer.frame.id, id_offset_);
   for (const protocol::MessageSpec* m : protocol::kMessages) {
     if (m->carries(id)) message = m;
   }

@@ -12,7 +12,6 @@
 #include <string>
 
 #include <CLI/CLI.hpp>
-#include <fmt/format.h>
 
 #include "cli/bus_command.hpp"
 #include "cli/cli_errors.hpp"
@@ -80,10 +79,7 @@ int main(int argc, char** argv) {
       throw CLI::ValidationError("--streaming needs --can (--sim --circle streams)");
     }
     bus.id_base = cdcr::cli::parse_id_base(id_base_text);
-    if (!bus.rates.valid()) {
-      throw CLI::ValidationError(fmt::format("--pose-every, --uncertainty-every and --status-every must be 1 to {} cycles",
-                                             cdcr::firmware::kMaxPublishEvery));
-    }
+    cdcr::cli::validate_publish_rates(bus.rates);
     if (spin_option->count() > 0 && can_interface.empty()) throw CLI::ValidationError("--spin needs --can");
     if (!replay_path.empty() && (image_path.empty() || out_path.empty())) {
       throw CLI::ValidationError("--replay needs --image and --out");
@@ -107,9 +103,6 @@ int main(int argc, char** argv) {
       return follow_circle(image_path, rate_hz, circle_radius_mm, circle_speed_mm_s, robot, bus);
     }
     return run_sim ? simulate(image_path, rate_hz, seconds, robot, bus) : replay(image_path, replay_path, out_path);
-  } catch (const cdcr::cli::UsageError& e) {
-    std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());
-    return kExitUsage;
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());
     return kExitUsage;

@@ -44,14 +44,10 @@ void VirtualCanBus::broadcast(const VirtualCanNode& sender, const hal::CanFrame&
 
 hal::CanStatus VirtualCanBus::enqueue(VirtualCanNode& sender, const hal::CanFrame& frame) {
   catch_up();
-  if (sender.tx_count_ == VirtualCanNode::kTxQueueDepth) {
+  if (!sender.tx_.push({frame, clock_->now_ns()})) {
     sender.counters_.tx_dropped += 1;
     return hal::CanStatus::queue_full;
   }
-  VirtualCanNode::Queued& slot = sender.tx_[(sender.tx_head_ + sender.tx_count_) % VirtualCanNode::kTxQueueDepth];
-  slot.frame = frame;
-  slot.queued_ns = clock_->now_ns();
-  ++sender.tx_count_;
   return hal::CanStatus::ok;
 }
 
@@ -61,8 +57,8 @@ int VirtualCanBus::next_winner(std::int64_t& start_ns) const {
   bool any = false;
   std::int64_t earliest = 0;
   for (const VirtualCanNode& n : nodes_) {
-    if (n.tx_count_ == 0) continue;
-    if (!any || n.tx_head().queued_ns < earliest) earliest = n.tx_head().queued_ns;
+    if (n.tx_.empty()) continue;
+    if (!any || n.tx_.front().queued_ns < earliest) earliest = n.tx_.front().queued_ns;
     any = true;
   }
   if (!any) return -1;
@@ -70,8 +66,8 @@ int VirtualCanBus::next_winner(std::int64_t& start_ns) const {
   int winner = -1;
   for (int i = 0; i < kMaxNodes; ++i) {
     const VirtualCanNode& n = nodes_[static_cast<std::size_t>(i)];
-    if (n.tx_count_ == 0 || n.tx_head().queued_ns > start_ns) continue;
-    if (winner < 0 || n.tx_head().frame.id < nodes_[static_cast<std::size_t>(winner)].tx_head().frame.id) winner = i;
+    if (n.tx_.empty() || n.tx_.front().queued_ns > start_ns) continue;
+    if (winner < 0 || n.tx_.front().frame.id < nodes_[static_cast<std::size_t>(winner)].tx_.front().frame.id) winner = i;
   }
   return winner;
 }
@@ -93,14 +89,14 @@ void VirtualCanBus::catch_up() {
     const int winner = next_winner(start);
     // A node may still send at now: arbitration at now waits for it.
     if (winner < 0 || start >= now) return;
-    VirtualCanNode& sender = nodes_[static_cast<std::size_t>(winner)];
-    flight_.frame = sender.tx_head().frame;
+    VirtualCanNode::Queued queued;
+    nodes_[static_cast<std::size_t>(winner)].tx_.pop(queued);
+    flight_.frame = queued.frame;
     flight_.sender = winner;
-    flight_.queued_ns = sender.tx_head().queued_ns;
+    flight_.queued_ns = queued.queued_ns;
     flight_.start_ns = start;
     flight_.bits = hal::can_frame_bits(flight_.frame.id, flight_.frame.data, flight_.frame.dlc, hal::CanFormat::classical);
     flight_.end_ns = start + hal::can_frame_time_ns(flight_.bits, rates_);
-    sender.tx_pop();
     in_flight_ = true;
   }
 }

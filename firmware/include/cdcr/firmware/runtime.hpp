@@ -183,10 +183,10 @@ class Runtime {
   std::uint32_t last_valid_cycle_ = 0;
 
   PublishRates publish_rates_{};
-  std::uint32_t last_pose_cycle_ = 0;
-  std::uint32_t last_variance_begin_cycle_ = 0;
-  bool published_since_boot_ = false;
-  bool variance_begun_since_boot_ = false;
+  // Cycles still to run before the next pose may go out and the next
+  // variance begin (0: now); counted down at the start of every cycle.
+  std::uint32_t pose_wait_ = 0;
+  std::uint32_t variance_wait_ = 0;
 
   PoseEstimate latest_pose_;
   bool has_pose_ = false;

@@ -29,17 +29,24 @@ class ShiftedCanBus final : public CanBus {
 
   std::uint32_t offset() const { return offset_; }
   static constexpr bool valid_offset(std::uint32_t offset) { return offset % 8 == 0; }
+  // An identifier as the bus beneath carries it, and back.
+  static constexpr std::uint32_t shifted(std::uint32_t id, std::uint32_t offset) {
+    return (id + offset % kIdentifiers) % kIdentifiers;
+  }
+  static constexpr std::uint32_t unshifted(std::uint32_t id, std::uint32_t offset) {
+    return (id + kIdentifiers - offset % kIdentifiers) % kIdentifiers;
+  }
 
   CanStatus send(const CanFrame& frame) override {
     if (offset_ == 0 || !is_valid(frame)) return bus_.send(frame);
     CanFrame shifted = frame;
-    shifted.id = (frame.id + offset_) % kIdentifiers;
+    shifted.id = ShiftedCanBus::shifted(frame.id, offset_);
     return bus_.send(shifted);
   }
 
   CanStatus receive(CanFrame& frame) override {
     const CanStatus status = bus_.receive(frame);
-    if (status == CanStatus::ok && offset_ != 0) frame.id = (frame.id + kIdentifiers - offset_) % kIdentifiers;
+    if (status == CanStatus::ok && offset_ != 0) frame.id = unshifted(frame.id, offset_);
     return status;
   }
 
@@ -49,7 +56,7 @@ class ShiftedCanBus final : public CanBus {
     CanFilter shifted[kMaxCanFilters];
     for (std::size_t i = 0; i < count; ++i) {
       if ((filters[i].mask & kFilterMaskBits) != kFilterMaskBits) return false;
-      shifted[i].id = (filters[i].id + offset_) % kIdentifiers;
+      shifted[i].id = ShiftedCanBus::shifted(filters[i].id, offset_);
       shifted[i].mask = filters[i].mask;
     }
     return bus_.set_filters(shifted, count);

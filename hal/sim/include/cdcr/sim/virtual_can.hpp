@@ -48,7 +48,7 @@ class VirtualCanNode final : public hal::CanBus {
 
   std::size_t pending() const { return queue_.size(); }
   // Frames waiting to go on a timed bus (always 0 untimed).
-  std::size_t transmit_pending() const { return tx_count_; }
+  std::size_t transmit_pending() const { return tx_.size(); }
   // Simulates a node dropping off the bus: its sends fail with bus_off.
   void set_bus_off(bool bus_off) { bus_off_ = bus_off; }
 
@@ -59,17 +59,10 @@ class VirtualCanNode final : public hal::CanBus {
     std::int64_t queued_ns = 0;
   };
   void deliver(const hal::CanFrame& frame);
-  const Queued& tx_head() const { return tx_[tx_head_]; }
-  void tx_pop() {
-    tx_head_ = (tx_head_ + 1) % kTxQueueDepth;
-    --tx_count_;
-  }
 
   VirtualCanBus* bus_ = nullptr;
   hal::CanFrameRing<kRxQueueDepth> queue_;
-  std::array<Queued, kTxQueueDepth> tx_{};
-  std::size_t tx_head_ = 0;
-  std::size_t tx_count_ = 0;
+  hal::FixedRing<Queued, kTxQueueDepth> tx_;
   hal::CanFilterBank<> filters_;
   hal::CanErrorCounters counters_{};
   bool bus_off_ = false;
