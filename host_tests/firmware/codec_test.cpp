@@ -345,7 +345,8 @@ TEST(Frames, ReservedBitsMakeAFrameMalformed) {
   IkReport report;
   EXPECT_EQ(decode(frame_of(0x140, {1, 0x10, 0, 0, 0, 0, 0, 0}), report), DecodeStatus::reserved_bits_set);
   PosePositionZ pose;
-  EXPECT_EQ(decode(frame_of(0x131, {0, 0, 0, 0, 0x04, 0}), pose), DecodeStatus::reserved_bits_set);
+  // Bit 2 names the radii of POSE_FD's uncertainty part; bits 3 to 7 are reserved.
+  EXPECT_EQ(decode(frame_of(0x131, {0, 0, 0, 0, 0x08, 0}), pose), DecodeStatus::reserved_bits_set);
   ASSERT_EQ(decode(frame_of(0x131, {0, 0, 0, 0, 0x01, 0}), pose), DecodeStatus::ok);
   EXPECT_TRUE(pose.compensated);
   EXPECT_FALSE(pose.extrapolating);

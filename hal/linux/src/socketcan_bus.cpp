@@ -2,6 +2,7 @@
 
 #include <cerrno>
 #include <cstring>
+#include <string>
 
 #include <linux/can.h>
 #include <linux/can/error.h>
@@ -32,8 +33,9 @@ void SocketCanBus::close() {
   fd_ = -1;
 }
 
-bool SocketCanBus::open(const std::string& interface_name, std::string& error) {
+bool SocketCanBus::open(const std::string& interface_name, std::string& error, bool fd_frames) {
   close();
+  fd_frames_ = false;
   bus_off_ = false;
   counters_ = {};
   socket_rx_drops_ = 0;
@@ -54,6 +56,22 @@ bool SocketCanBus::open(const std::string& interface_name, std::string& error) {
     error = e == ENODEV ? "no CAN interface '" + interface_name + "'" : describe(("interface " + interface_name).c_str(), e);
     return false;
   }
+  const int interface_index = request.ifr_ifindex;  // the MTU request below reuses the union
+  if (fd_frames) {
+    if (::ioctl(fd, SIOCGIFMTU, &request) != 0 || request.ifr_mtu != int(CANFD_MTU)) {
+      ::close(fd);
+      error = "CAN interface '" + interface_name + "' does not carry CAN FD frames (its MTU is not " +
+              std::to_string(CANFD_MTU) + ")";
+      return false;
+    }
+    const int enable_fd = 1;
+    if (::setsockopt(fd, SOL_CAN_RAW, CAN_RAW_FD_FRAMES, &enable_fd, sizeof(enable_fd)) != 0) {
+      const int e = errno;
+      ::close(fd);
+      error = describe("CAN_RAW_FD_FRAMES", e);
+      return false;
+    }
+  }
   // Controller problems arrive as error frames; ask for all of them so the
   // counters see what the controller saw.
   const can_err_mask_t error_mask = CAN_ERR_MASK;
@@ -65,7 +83,7 @@ bool SocketCanBus::open(const std::string& interface_name, std::string& error) {
 
   sockaddr_can address{};
   address.can_family = AF_CAN;
-  address.can_ifindex = request.ifr_ifindex;
+  address.can_ifindex = interface_index;
   if (::bind(fd, reinterpret_cast<const sockaddr*>(&address), sizeof(address)) != 0) {
     const int e = errno;
     ::close(fd);
@@ -73,11 +91,12 @@ bool SocketCanBus::open(const std::string& interface_name, std::string& error) {
     return false;
   }
   fd_ = fd;
+  fd_frames_ = fd_frames;
   return true;
 }
 
 hal::CanStatus SocketCanBus::send(const hal::CanFrame& frame) {
-  if (!hal::is_valid(frame)) {
+  if (!hal::is_valid(frame, fd_frames_)) {
     counters_.tx_dropped += 1;
     return hal::CanStatus::invalid_frame;
   }
@@ -85,12 +104,16 @@ hal::CanStatus SocketCanBus::send(const hal::CanFrame& frame) {
     counters_.tx_dropped += 1;
     return hal::CanStatus::bus_off;
   }
-  can_frame out{};
+  // A classical frame goes as can_frame (CAN_MTU), an FD frame as
+  // canfd_frame (CANFD_MTU): the kernel tells the two apart by size.
+  canfd_frame out{};
   out.can_id = frame.id;
-  out.can_dlc = frame.dlc;
+  out.len = frame.dlc;
+  if (frame.bit_rate_switch()) out.flags |= CANFD_BRS;
   std::memcpy(out.data, frame.data, frame.dlc);
-  const ssize_t written = ::write(fd_, &out, sizeof(out));
-  if (written == ssize_t(sizeof(out))) return hal::CanStatus::ok;
+  const std::size_t size = frame.fd() ? CANFD_MTU : CAN_MTU;
+  const ssize_t written = ::write(fd_, &out, size);
+  if (written == ssize_t(size)) return hal::CanStatus::ok;
   counters_.tx_dropped += 1;
   if (written < 0 && (errno == ENETDOWN || errno == ENXIO || errno == ENODEV)) return hal::CanStatus::bus_off;
   // EAGAIN / ENOBUFS: the interface's transmit queue is full.
@@ -100,7 +123,7 @@ hal::CanStatus SocketCanBus::send(const hal::CanFrame& frame) {
 hal::CanStatus SocketCanBus::receive(hal::CanFrame& frame) {
   if (fd_ < 0) return hal::CanStatus::bus_off;
   for (;;) {
-    can_frame in{};
+    canfd_frame in{};
     iovec buffer{&in, sizeof(in)};
     alignas(cmsghdr) char control[CMSG_SPACE(sizeof(std::uint32_t))];
     msghdr message{};
@@ -122,7 +145,8 @@ hal::CanStatus SocketCanBus::receive(hal::CanFrame& frame) {
         socket_rx_drops_ = dropped;
       }
     }
-    if (got != ssize_t(sizeof(in))) continue;  // not a classic frame
+    const bool fd_frame = got == ssize_t(CANFD_MTU);
+    if (!fd_frame && got != ssize_t(CAN_MTU)) continue;  // not a frame
     if (in.can_id & CAN_ERR_FLAG) {
       note_error_frame(in.can_id, in.data);
       continue;
@@ -131,7 +155,9 @@ hal::CanStatus SocketCanBus::receive(hal::CanFrame& frame) {
     if (in.can_id & (CAN_RTR_FLAG | CAN_EFF_FLAG)) continue;
     bus_off_ = false;
     frame.id = in.can_id & kStandardIdMask;
-    frame.dlc = in.can_dlc > 8 ? 8 : in.can_dlc;
+    const std::uint8_t limit = fd_frame ? hal::kMaxFdDataBytes : hal::kMaxDataBytes;
+    frame.dlc = in.len > limit ? limit : in.len;
+    frame.flags = fd_frame ? std::uint8_t(hal::kCanFdFrame | ((in.flags & CANFD_BRS) ? hal::kCanBitRateSwitch : 0)) : 0;
     std::memset(frame.data, 0, sizeof(frame.data));
     std::memcpy(frame.data, in.data, frame.dlc);
     return hal::CanStatus::ok;

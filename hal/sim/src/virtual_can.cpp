@@ -7,7 +7,8 @@ hal::CanStatus VirtualCanNode::send(const hal::CanFrame& frame) {
     counters_.tx_dropped += 1;
     return hal::CanStatus::bus_off;
   }
-  if (!hal::is_valid(frame)) {
+  if (!hal::is_valid(frame, fd_capable()) ||
+      (frame.bit_rate_switch() && bus_->timed() && bus_->rates().data == 0)) {
     counters_.tx_dropped += 1;
     return hal::CanStatus::invalid_frame;
   }
@@ -15,6 +16,8 @@ hal::CanStatus VirtualCanNode::send(const hal::CanFrame& frame) {
   bus_->broadcast(*this, frame);
   return hal::CanStatus::ok;
 }
+
+bool VirtualCanNode::fd_capable() const { return bus_->fd(); }
 
 hal::CanStatus VirtualCanNode::receive(hal::CanFrame& frame) {
   bus_->catch_up();
@@ -95,7 +98,7 @@ void VirtualCanBus::catch_up() {
     flight_.sender = winner;
     flight_.queued_ns = queued.queued_ns;
     flight_.start_ns = start;
-    flight_.bits = hal::can_frame_bits(flight_.frame.id, flight_.frame.data, flight_.frame.dlc, hal::CanFormat::classical);
+    flight_.bits = hal::can_frame_bits(flight_.frame);
     flight_.end_ns = start + hal::can_frame_time_ns(flight_.bits, rates_);
     in_flight_ = true;
   }

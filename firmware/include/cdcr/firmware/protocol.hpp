@@ -20,6 +20,7 @@
 // (host_tests/firmware/protocol_golden_frames_test.cpp) pin every message's
 // bytes.
 
+#include "cdcr/firmware/protocol/fd_frames.hpp"
 #include "cdcr/firmware/protocol/frame_codec.hpp"
 #include "cdcr/firmware/protocol/frames.hpp"
 #include "cdcr/firmware/protocol/message_codec.hpp"

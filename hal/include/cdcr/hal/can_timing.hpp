@@ -29,6 +29,8 @@
 #include <cstddef>
 #include <cstdint>
 
+#include "cdcr/hal/can_bus.hpp"
+
 namespace cdcr::hal {
 
 enum class CanFormat : std::uint8_t {
@@ -52,14 +54,8 @@ struct CanFrameBits {
   std::uint32_t total() const { return nominal + data; }
 };
 
-inline constexpr std::size_t kMaxFdDataBytes = 64;
-
-// The lengths a CAN FD frame can carry (0 to 8, 12, 16, 20, 24, 32, 48, 64)
-// and their data length codes; a classical frame carries 0 to 8.
-inline constexpr bool is_fd_length(std::size_t length) {
-  return length <= 8 || length == 12 || length == 16 || length == 20 || length == 24 || length == 32 ||
-         length == 48 || length == 64;
-}
+// The data length code of an FD length (is_fd_length, can_bus.hpp); a
+// classical frame's is its length.
 inline constexpr std::uint8_t fd_length_code(std::size_t length) {
   if (length <= 8) return static_cast<std::uint8_t>(length);
   if (length <= 24) return static_cast<std::uint8_t>(9 + (length - 12) / 4);
@@ -174,6 +170,16 @@ inline CanFrameBits can_frame_bits(std::uint32_t id, const std::uint8_t* data, s
     bits.nominal += data_phase;
   }
   return bits;
+}
+
+// The format a frame is sent in, from its flags.
+inline constexpr CanFormat format_of(const CanFrame& frame) {
+  if (!frame.fd()) return CanFormat::classical;
+  return frame.bit_rate_switch() ? CanFormat::fd_bit_rate_switch : CanFormat::fd;
+}
+
+inline CanFrameBits can_frame_bits(const CanFrame& frame) {
+  return can_frame_bits(frame.id, frame.data, frame.dlc, format_of(frame));
 }
 
 // The most bits a frame of `length` data bytes can take: the stuffed part

@@ -38,7 +38,7 @@ class ShiftedCanBus final : public CanBus {
   }
 
   CanStatus send(const CanFrame& frame) override {
-    if (offset_ == 0 || !is_valid(frame)) return bus_.send(frame);
+    if (offset_ == 0 || !is_valid(frame, bus_.fd_capable())) return bus_.send(frame);
     CanFrame shifted = frame;
     shifted.id = ShiftedCanBus::shifted(frame.id, offset_);
     return bus_.send(shifted);
@@ -63,6 +63,7 @@ class ShiftedCanBus final : public CanBus {
   }
 
   CanErrorCounters error_counters() const override { return bus_.error_counters(); }
+  bool fd_capable() const override { return bus_.fd_capable(); }
 
  private:
   CanBus& bus_;

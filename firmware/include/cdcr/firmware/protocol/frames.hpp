@@ -86,6 +86,7 @@ struct PosePositionZ {
   bool compensated = false;    // FLAGS bit 0
   std::uint8_t sequence = 0;
   bool extrapolating = false;  // FLAGS bit 1
+  bool radii = false;          // FLAGS bit 2: POSE_FD's uncertainty part holds radii (POSE_FD only)
 };
 struct PoseUncertainty {
   double r95_position_mm = 0;     // saturates at 65.535 mm
@@ -169,7 +170,8 @@ template <>
 struct FrameFields<PosePositionZ>
     : MessageFields<pose_position_z::kMessage, field::Value<&PosePositionZ::z_mm>,
                     field::FlagSet<field::Flag<pose_position_z::kFlagCompensated, &PosePositionZ::compensated>,
-                                   field::Flag<pose_position_z::kFlagExtrapolating, &PosePositionZ::extrapolating>>,
+                                   field::Flag<pose_position_z::kFlagExtrapolating, &PosePositionZ::extrapolating>,
+                                   field::Flag<pose_position_z::kFlagRadii, &PosePositionZ::radii>>,
                     field::Value<&PosePositionZ::sequence>> {};
 template <>
 struct FrameFields<PoseOrientation>

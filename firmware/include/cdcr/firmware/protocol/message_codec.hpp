@@ -96,6 +96,48 @@ struct MessageNotes {
   SignalNotes signals = {};
 };
 
+// A CAN FD message made of classical messages: part k is a frame of its
+// message, laid out as that message is, in bytes 8k to 8k + 7 (the bytes
+// beyond the part's DLC are reserved, 0). One frame then carries what
+// several classical frames would, each signal where its message has it, so
+// the FD messages need no layouts of their own and decode with the same
+// checks. A per-index FD message (id_count > 1) carries its parts' messages
+// for segment `segment + index * part_count`.
+struct MessagePart {
+  const MessageSpec* message;
+  std::uint8_t segment = 0;  // of a per-segment message; 0 otherwise
+};
+
+struct FdMessageSpec {
+  const char* name;       // as in the DBC; a per-index message is <name>_<index> there
+  std::uint32_t id;       // the identifier, or index 0's
+  std::uint8_t id_count;  // 1, or one identifier per index
+  std::uint8_t length;    // data bytes: 8 per part (an FD length, hal::is_fd_length)
+  const char* sender;     // DBC node
+  const MessagePart* parts;
+  std::uint8_t part_count;
+  hal::CanFilter group;  // acceptance filter of the frame group the message belongs to
+
+  constexpr bool carries(std::uint32_t frame_id) const { return frame_id >= id && frame_id - id < id_count; }
+  // The segment part k of the frame at `index` is of (per-segment parts).
+  constexpr int part_segment(int part, int index) const { return parts[part].segment + index * part_count; }
+};
+
+inline constexpr int kPartBytes = 8;
+
+template <std::size_t N>
+constexpr FdMessageSpec fd_message(const char* name, std::uint32_t id, std::uint8_t id_count, const char* sender,
+                                   const MessagePart (&parts)[N], hal::CanFilter group) {
+  return {name, id, id_count, static_cast<std::uint8_t>(N * kPartBytes), sender, parts, static_cast<std::uint8_t>(N),
+          group};
+}
+
+struct FdMessageNotes {
+  const FdMessageSpec* message;
+  const char* receiver;  // DBC node
+  const char* comment = "";
+};
+
 // The messages of a list of notes, in its order.
 template <std::size_t N>
 constexpr std::array<const MessageSpec*, N> messages_of(const MessageNotes* const (&notes)[N]) {
@@ -123,6 +165,46 @@ inline hal::CanFrame empty_frame(const MessageSpec& message, int index = 0) {
   frame.id = message.id + static_cast<std::uint32_t>(index);
   frame.dlc = message.dlc;
   return frame;
+}
+
+// Part k of an FD frame of `message` (at `index`) as the classical frame of
+// its message: the identifier it has as a classical frame, its DLC, its bytes.
+inline hal::CanFrame part_frame(const FdMessageSpec& message, const hal::CanFrame& frame, int part, int index = 0) {
+  const MessagePart& p = message.parts[part];
+  hal::CanFrame classical;
+  classical.id = p.message->id + static_cast<std::uint32_t>(p.message->id_count > 1 ? message.part_segment(part, index) : 0);
+  classical.dlc = p.message->dlc;
+  for (int i = 0; i < p.message->dlc; ++i) classical.data[i] = frame.data[part * kPartBytes + i];
+  return classical;
+}
+
+// An FD frame of `message` at `index` with every bit 0 (flags: FD; the
+// sender's bus adds bit-rate switching).
+inline hal::CanFrame empty_frame(const FdMessageSpec& message, int index = 0) {
+  hal::CanFrame frame;
+  frame.id = message.id + static_cast<std::uint32_t>(index);
+  frame.dlc = message.length;
+  frame.flags = hal::kCanFdFrame;
+  return frame;
+}
+
+// Puts a classical frame's bytes into part k of an FD frame.
+inline void put_part(hal::CanFrame& frame, int part, const hal::CanFrame& classical) {
+  for (int i = 0; i < kPartBytes; ++i) frame.data[part * kPartBytes + i] = i < classical.dlc ? classical.data[i] : 0;
+}
+
+// What a decoder of an FD message checks before its parts: the identifier,
+// an FD frame of the message's length, the reserved bytes after each part's
+// DLC. Each part is then checked as its classical message (check_frame).
+inline DecodeStatus check_fd_frame(const FdMessageSpec& message, const hal::CanFrame& frame) {
+  if (!message.carries(frame.id)) return DecodeStatus::wrong_id;
+  if (!frame.fd() || frame.dlc != message.length) return DecodeStatus::wrong_dlc;
+  for (int k = 0; k < message.part_count; ++k) {
+    for (int i = message.parts[k].message->dlc; i < kPartBytes; ++i) {
+      if (frame.data[k * kPartBytes + i] != 0) return DecodeStatus::reserved_bits_set;
+    }
+  }
+  return DecodeStatus::ok;
 }
 
 // What every decoder checks first: identifier, length, reserved bits and the

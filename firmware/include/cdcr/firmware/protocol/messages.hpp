@@ -51,8 +51,9 @@ inline constexpr int kSegmentIdSlots = 8;
 // of its group and no other message of the protocol (a test checks it).
 inline constexpr hal::CanFilter kCableFeedbackFrames{0x100, 0x7F8};  // CABLE_FEEDBACK_0..7
 inline constexpr hal::CanFilter kCableSetpointFrames{0x110, 0x7F8};  // CABLE_SETPOINT_0..7
-inline constexpr hal::CanFilter kTargetFrames{0x120, 0x7FC};         // TARGET_ORIENTATION, _POSITION_XY, _POSITION_Z
-inline constexpr hal::CanFilter kPoseFrames{0x130, 0x7FC};           // POSE_POSITION_XY, _POSITION_Z, POSE_ORIENTATION
+inline constexpr hal::CanFilter kTargetFrames{0x120, 0x7FC};         // TARGET_ORIENTATION, _POSITION_XY, _POSITION_Z, TARGET_FD
+inline constexpr hal::CanFilter kCableSetpointsFdFrames{0x118, 0x7F8};  // CABLE_SETPOINTS_FD_0..1
+inline constexpr hal::CanFilter kPoseFrames{0x130, 0x7F8};           // POSE_POSITION_XY, _POSITION_Z, _ORIENTATION, _UNCERTAINTY, POSE_FD
 inline constexpr hal::CanFilter kIkReportFrames{0x140, 0x7FF};       // IK_REPORT
 inline constexpr hal::CanFilter kStatusFrames{0x150, 0x7FE};         // STATUS, STATS
 inline constexpr hal::CanFilter kPayloadFrames{0x160, 0x7FE};        // PAYLOAD, HOMING
@@ -202,17 +203,20 @@ inline constexpr MessageNotes kNotes{&kMessage, "HOST"};
 namespace pose_position_z {
 inline constexpr SignalSpec kZ{"Z", 0, 32, true, kLengthScaleMm, 0, -21474836.48, 21474836.47, "mm"};
 // Bit 0: compensated by the GP model (RUN); bit 1: the model extrapolates
-// at this pose (see pose_uncertainty); the other bits are 0.
+// at this pose (see pose_uncertainty); bit 2, in POSE_FD only: its
+// POSE_UNCERTAINTY part holds radii; the other bits are 0.
 inline constexpr SignalSpec kFlags{"FLAGS", 32, 8, false, 1, 0, 0, 255, ""};
 inline constexpr std::int64_t kFlagCompensated = 0x01;
 inline constexpr std::int64_t kFlagExtrapolating = 0x02;
+inline constexpr std::int64_t kFlagRadii = 0x04;
 inline constexpr SignalSpec kSequence{"SEQUENCE", 40, 8, false, 1, 0, 0, 255, ""};
 inline constexpr const SignalSpec* kSignals[] = {&kZ, &kFlags, &kSequence};
 inline constexpr MessageSpec kMessage{"POSE_POSITION_Z", 0x131, 1, 6, "RUNTIME", signal_list(kSignals), kPoseFrames};
 inline constexpr SignalNote kSignalNotes[] = {
     {&kFlags,
      "Bit 0: pose compensated by the GP model (RUN); clear in DEGRADED. Bit 1: the model extrapolates at this pose "
-     "(outside the input range it was fitted on, or by its variance; see POSE_UNCERTAINTY). The other bits are 0."},
+     "(outside the input range it was fitted on, or by its variance; see POSE_UNCERTAINTY). Bit 2, in POSE_FD only: "
+     "its POSE_UNCERTAINTY part holds radii (the latest, of the pose its SEQUENCE names). The other bits are 0."},
 };
 inline constexpr MessageNotes kNotes{&kMessage, "HOST", "", signal_notes(kSignalNotes)};
 }  // namespace pose_position_z
@@ -514,6 +518,61 @@ inline constexpr MessageNotes kNotes{
     signal_notes(kSignalNotes)};
 }  // namespace update_report
 
+// CAN FD messages (message_codec.hpp, FdMessageSpec): on a bus configured
+// for CAN FD the runtime sends every frame as an FD frame, and these carry
+// in one frame what takes several classical frames. Each part is laid out
+// as its classical message, in its own 8 bytes.
+
+// 0x118 + g: the commanded cable lengths of segments 4g to 4g + 3, from the
+// runtime, replacing CABLE_SETPOINT_s on an FD bus: one frame for a robot
+// of up to four segments. A segment the robot lacks has every length 65535.
+namespace cable_setpoints_fd {
+inline constexpr int kSegmentsPerFrame = 4;
+inline constexpr MessagePart kParts[] = {
+    {&cable_setpoint::kMessage, 0}, {&cable_setpoint::kMessage, 1}, {&cable_setpoint::kMessage, 2},
+    {&cable_setpoint::kMessage, 3}};
+inline constexpr int kFrames = kSegmentIdSlots / kSegmentsPerFrame;
+inline constexpr FdMessageSpec kMessage =
+    fd_message("CABLE_SETPOINTS_FD", 0x118, kFrames, "RUNTIME", kParts, kCableSetpointsFdFrames);
+inline constexpr FdMessageNotes kNotes{
+    &kMessage, "DRIVES",
+    "CAN FD: the commanded cable lengths of four segments, from segment 4 x the frame's index on, each as its "
+    "CABLE_SETPOINT frame; sent instead of CABLE_SETPOINT on an FD bus. A segment the robot lacks has every length "
+    "65535."};
+}  // namespace cable_setpoints_fd
+
+// 0x123: a whole target in one frame, as its three classical frames would
+// carry it: orientation, position x, y, and position z (which commits).
+namespace target_fd {
+inline constexpr MessagePart kParts[] = {
+    {&target_orientation::kMessage}, {&target_position_xy::kMessage}, {&target_position_z::kMessage}};
+inline constexpr FdMessageSpec kMessage = fd_message("TARGET_FD", 0x123, 1, "HOST", kParts, kTargetFrames);
+inline constexpr FdMessageNotes kNotes{
+    &kMessage, "RUNTIME",
+    "CAN FD: a whole target, committed: the TARGET_ORIENTATION, TARGET_POSITION_XY and TARGET_POSITION_Z frames in "
+    "one (the orientation part is read for MODE = 1 only)."};
+}  // namespace target_fd
+
+// 0x134: the pose, its flags and the latest radii in one frame.
+namespace pose_fd {
+inline constexpr MessagePart kParts[] = {{&pose_position_xy::kMessage},
+                                         {&pose_position_z::kMessage},
+                                         {&pose_orientation::kMessage},
+                                         {&pose_uncertainty::kMessage}};
+inline constexpr FdMessageSpec kMessage = fd_message("POSE_FD", 0x134, 1, "RUNTIME", kParts, kPoseFrames);
+inline constexpr FdMessageNotes kNotes{
+    &kMessage, "HOST",
+    "CAN FD: the compensated pose, sent instead of POSE_POSITION_XY, POSE_POSITION_Z, POSE_ORIENTATION and "
+    "POSE_UNCERTAINTY on an FD bus. The POSE_UNCERTAINTY part holds the latest radii (its SEQUENCE names their "
+    "pose) when POSE_POSITION_Z FLAGS bit 2 is set, and is 0 before the first radii."};
+}  // namespace pose_fd
+
+// The FD messages, as the FD DBC lists them after the classical ones.
+inline constexpr const FdMessageNotes* kFdMessageNotes[] = {&cable_setpoints_fd::kNotes, &target_fd::kNotes,
+                                                           &pose_fd::kNotes};
+inline constexpr const FdMessageSpec* kFdMessages[] = {&cable_setpoints_fd::kMessage, &target_fd::kMessage,
+                                                      &pose_fd::kMessage};
+
 // Every message of the protocol with its notes, as the DBC lists them.
 inline constexpr const MessageNotes* kMessageNotes[] = {
     &cable_feedback::kNotes,     &cable_setpoint::kNotes,   &target_orientation::kNotes,
@@ -534,6 +593,19 @@ constexpr bool all_within_id_window() {
   }
   return true;
 }
+constexpr bool fd_messages_fit() {
+  for (const FdMessageSpec* m : kFdMessages) {
+    if (m->id < kDefaultIdBase || m->id + m->id_count > kDefaultIdBase + kIdWindow) return false;
+    if (!hal::is_fd_length(m->length) || m->length > hal::kMaxFdDataBytes) return false;
+    for (int k = 0; k < m->part_count; ++k) {
+      if (m->parts[k].message->dlc > kPartBytes) return false;
+    }
+  }
+  return true;
+}
 static_assert(all_within_id_window(), "every identifier within the window a base moves");
+static_assert(fd_messages_fit(), "every FD message within the window, at an FD length, its parts 8 bytes each");
+static_assert(cable_setpoints_fd::kFrames * cable_setpoints_fd::kSegmentsPerFrame >= kSegmentIdSlots,
+              "the FD setpoint frames cover every segment slot");
 
 }  // namespace cdcr::firmware::protocol

@@ -11,7 +11,7 @@
 // FIFO); whenever the bus is idle, the frames at the head of every node's
 // queue arbitrate and the lowest identifier goes on the wire; it takes its
 // bits at the bus's rates (hal/can_timing.hpp, the stuffing of its actual
-// content, the interframe space included) and is delivered when its last
+// content in its format, classical or FD, the interframe space included) and is delivered when its last
 // bit has passed. Time is the clock's: the bus catches up to the clock's
 // now on every receive() and send(), deciding arbitration only for instants
 // strictly before now, since a node may still send at now itself.
@@ -45,6 +45,7 @@ class VirtualCanNode final : public hal::CanBus {
     return filters_.assign(filters, count);
   }
   hal::CanErrorCounters error_counters() const override { return counters_; }
+  bool fd_capable() const override;
 
   std::size_t pending() const { return queue_.size(); }
   // Frames waiting to go on a timed bus (always 0 untimed).
@@ -97,9 +98,14 @@ class VirtualCanBus {
 
   VirtualCanNode& node(int index) { return nodes_[static_cast<std::size_t>(index)]; }
 
-  // Makes the bus timed, at `rates` (nominal > 0), on `clock`'s time; frames
-  // are classical. Before any frame is sent.
+  // Makes the bus timed, at `rates` (nominal > 0; data > 0 for FD frames
+  // that switch their bit rate), on `clock`'s time. Before any frame is sent.
   void set_timing(const hal::MonotonicClock& clock, const hal::CanBitRates& rates);
+  // A CAN FD bus: its nodes send FD frames as well as classical ones (an FD
+  // frame that switches its bit rate only on a bus timed with a data rate,
+  // or on an untimed one). Classical by default.
+  void set_fd(bool fd) { fd_ = fd; }
+  bool fd() const { return fd_; }
   bool timed() const { return clock_ != nullptr; }
   const hal::CanBitRates& rates() const { return rates_; }
   void set_observer(CanTransferObserver* observer) { observer_ = observer; }
@@ -123,6 +129,7 @@ class VirtualCanBus {
   const hal::MonotonicClock* clock_ = nullptr;
   hal::CanBitRates rates_{};
   CanTransferObserver* observer_ = nullptr;
+  bool fd_ = false;
   bool in_flight_ = false;
   CanTransfer flight_{};
   std::int64_t idle_from_ns_ = 0;  // when the last frame's interframe space ended
