@@ -274,13 +274,33 @@ bool IkRequest::set_setpoints(const Joints& joints) {
   }
   // The joints are the effective lengths'; the drives are sent what makes them.
   if (hysteresis_ != nullptr) hysteresis_->commanded_for(cables);
+  // One CABLE_SETPOINT per segment, or on an FD bus four segments a
+  // CABLE_SETPOINTS_FD frame.
   hal::CanFrame frames[kMaxSegments];
-  for (int s = 0, first = 0; s < model_.geometry.segment_count; first += model_.geometry.segments[s].cables.count, ++s) {
-    const auto setpoint = protocol::segment_cables_frame<protocol::CableSetpoint>(
-        s, cables, first, model_.geometry.segments[s].cables.count);
-    if (!protocol::encode(setpoint, frames[s])) return false;
+  const int segments = model_.geometry.segment_count;
+  int frame_count = 0;
+  if (outbox_.drives_fd()) {
+    constexpr int kPerFrame = protocol::cable_setpoints_fd::kSegmentsPerFrame;
+    for (int index = 0, first = 0; index * kPerFrame < segments; ++index) {
+      protocol::CableSetpointsFd setpoints;
+      setpoints.index = index;
+      for (int s = index * kPerFrame; s < segments && s < (index + 1) * kPerFrame; ++s) {
+        const int count = model_.geometry.segments[s].cables.count;
+        setpoints.segments[setpoints.segment_count++] =
+            protocol::segment_cables_frame<protocol::CableSetpoint>(s, cables, first, count);
+        first += count;
+      }
+      if (!protocol::encode(setpoints, frames[frame_count++])) return false;
+    }
+  } else {
+    for (int s = 0, first = 0; s < segments; first += model_.geometry.segments[s].cables.count, ++s) {
+      const auto setpoint = protocol::segment_cables_frame<protocol::CableSetpoint>(
+          s, cables, first, model_.geometry.segments[s].cables.count);
+      if (!protocol::encode(setpoint, frames[frame_count++])) return false;
+    }
   }
-  for (int s = 0; s < model_.geometry.segment_count; ++s) setpoint_frames_[s] = frames[s];
+  for (int k = 0; k < frame_count; ++k) setpoint_frames_[k] = frames[k];
+  setpoint_frame_count_ = frame_count;
   setpoints_mm_ = cables;
   setpoint_joints_ = joints;
   has_setpoints_ = true;
@@ -288,7 +308,7 @@ bool IkRequest::set_setpoints(const Joints& joints) {
 }
 
 void IkRequest::publish_setpoints() {
-  for (int s = 0; s < model_.geometry.segment_count; ++s) outbox_.send(setpoint_frames_[s]);
+  for (int k = 0; k < setpoint_frame_count_; ++k) outbox_.send_to_drives(setpoint_frames_[k]);
   setpoints_published_ += 1;
 }
 

@@ -22,18 +22,32 @@ protocol::PoseOrientation orientation_frame(const model::Mat3<Scalar>& rotation)
 }  // namespace
 
 Runtime::Runtime(const hal::Hal& hal, const Geometry& fallback_geometry)
-    : hal_(hal), fallback_geometry_(fallback_geometry), outbox_(hal.can), update_(hal.flash, hal.can) {
+    : hal_(hal),
+      fallback_geometry_(fallback_geometry),
+      host_bus_(hal.can),
+      drives_bus_(hal.drives_can != nullptr ? *hal.drives_can : hal.can),
+      outbox_(host_bus_, drives_bus_),
+      update_(hal.flash, host_bus_) {
   model_.geometry = fallback_geometry;
 }
 
 RuntimeState Runtime::init() {
   state_ = RuntimeState::boot;
+  // The host's inputs, the model update's frames last (only where there is
+  // a flash to write them to), and the drives' feedback: on the host's bus
+  // too without a bus of their own.
   static constexpr hal::CanFilter kFilters[] = {protocol::kCableFeedbackFrames, protocol::kTargetFrames,
                                                 protocol::kPayloadFrames, protocol::kUpdateRequestFrames};
   static_assert(sizeof(kFilters) / sizeof(kFilters[0]) <= kMaxCanFilters, "more filters than a controller must offer");
-  // The model update's frames only where there is a flash to write them to.
-  const std::size_t filter_count = sizeof(kFilters) / sizeof(kFilters[0]) - (update_.enabled() ? 0 : 1);
-  can_filters_accepted_ = hal_.can.set_filters(kFilters, filter_count);
+  const hal::CanFilter* host_filters = kFilters;
+  std::size_t host_filter_count = sizeof(kFilters) / sizeof(kFilters[0]) - (update_.enabled() ? 0 : 1);
+  can_filters_accepted_ = true;
+  if (has_drives_bus()) {
+    ++host_filters;
+    --host_filter_count;
+    can_filters_accepted_ = drives_bus_.set_filters(kFilters, 1);
+  }
+  can_filters_accepted_ = host_bus_.set_filters(host_filters, host_filter_count) && can_filters_accepted_;
 
   const BootFault boot = load_model(update_, hal_.model_storage, fallback_geometry_, model_);
   boot_fault_ = boot.code;
@@ -101,11 +115,9 @@ void Runtime::run_cycle(const hal::TimerTick& tick, CycleInputs* inputs) {
   if (variance_wait_ > 0) --variance_wait_;
   ik_units_last_cycle_ = 0;
 
-  int frames = inputs != nullptr ? inputs->deliver(*this) : 0;
-  hal::CanFrame frame;
-  for (; frames < kMaxRxFramesPerCycle && hal_.can.receive(frame) == hal::CanStatus::ok; ++frames) {
-    handle_frame(frame);
-  }
+  const int delivered = inputs != nullptr ? inputs->deliver(*this) : 0;
+  receive_frames(host_bus_, delivered);
+  if (has_drives_bus()) receive_frames(drives_bus_, 0);
 
   if (state_ != RuntimeState::boot) update_pose();
   fresh_cables_ = false;
@@ -123,6 +135,13 @@ void Runtime::run_cycle(const hal::TimerTick& tick, CycleInputs* inputs) {
   }
 
   statistics_.record_cycle(tick, start_ns, hal_.clock.now_ns(), hal_.timer.period_ns());
+}
+
+// A bus's frames of this cycle, after `frames` already counted against its bound.
+int Runtime::receive_frames(hal::CanBus& bus, int frames) {
+  hal::CanFrame frame;
+  for (; frames < kMaxRxFramesPerCycle && bus.receive(frame) == hal::CanStatus::ok; ++frames) handle_frame(frame);
+  return frames;
 }
 
 // Between two cycles' work: the request being solved was for the old
@@ -257,6 +276,17 @@ void Runtime::update_pose() {
   }
 }
 
+bool Runtime::set_can_formats(hal::CanFormat host, hal::CanFormat drives) {
+  if (state_ != RuntimeState::boot || cycle_ != 0) return false;
+  if (!has_drives_bus() && host != drives) return false;
+  hal::FormattedCanBus probe_host(hal_.can);
+  hal::FormattedCanBus probe_drives(has_drives_bus() ? *hal_.drives_can : hal_.can);
+  if (!probe_host.set_format(host) || !probe_drives.set_format(drives)) return false;
+  host_bus_.set_format(host);
+  drives_bus_.set_format(drives);
+  return true;
+}
+
 bool Runtime::set_publish_rates(const PublishRates& rates) {
   if (!rates.valid()) return false;
   publish_rates_ = rates;
@@ -264,6 +294,10 @@ bool Runtime::set_publish_rates(const PublishRates& rates) {
 }
 
 void Runtime::publish_pose() {
+  if (host_bus_.fd()) {
+    publish_fd_pose();
+    return;
+  }
   const Pose& pose = latest_pose_.pose;
   hal::CanFrame frame;
   protocol::encode(protocol::PosePositionXy{pose.position_mm.x(), pose.position_mm.y()}, frame);
@@ -277,9 +311,24 @@ void Runtime::publish_pose() {
   statistics_.poses_published += 1;
 }
 
-// The radii of a variance that ended this cycle.
-void Runtime::publish_uncertainty() {
-  if (state_ == RuntimeState::fault) return;
+// The pose, its flags and the latest radii (of the pose their sequence
+// names) in one POSE_FD frame.
+void Runtime::publish_fd_pose() {
+  const Pose& pose = latest_pose_.pose;
+  protocol::PoseFd message;
+  message.position_xy = {pose.position_mm.x(), pose.position_mm.y()};
+  message.position_z = {pose.position_mm.z(), latest_pose_.compensated, static_cast<std::uint8_t>(cycle_ & 0xFF),
+                        extrapolating()};
+  message.position_z.radii = has_uncertainty();
+  message.orientation = orientation_frame(pose.rotation);
+  if (has_uncertainty()) message.uncertainty = uncertainty_frame();
+  hal::CanFrame frame;
+  protocol::encode(message, frame);
+  outbox_.send(frame);
+  statistics_.poses_published += 1;
+}
+
+protocol::PoseUncertainty Runtime::uncertainty_frame() const {
   const model::PoseUncertainty<Scalar>& radii = variance_.result();
   protocol::PoseUncertainty message;
   message.r95_position_mm = radii.r95_mm;
@@ -288,8 +337,15 @@ void Runtime::publish_uncertainty() {
   message.extrapolating = radii.extrapolating;
   message.outside_range = radii.outside_range;
   message.sequence = variance_.result_sequence();
+  return message;
+}
+
+// The radii of a variance that ended this cycle; on an FD bus they go with
+// the next POSE_FD.
+void Runtime::publish_uncertainty() {
+  if (state_ == RuntimeState::fault || host_bus_.fd()) return;
   hal::CanFrame frame;
-  protocol::encode(message, frame);
+  protocol::encode(uncertainty_frame(), frame);
   outbox_.send(frame);
 }
 

@@ -15,7 +15,7 @@ namespace {
 
 const MessageLoad* line_of(const BusBudget& budget, const std::string& name) {
   for (int i = 0; i < budget.message_count; ++i) {
-    if (name == budget.messages[i].message->name) return &budget.messages[i];
+    if (name == budget.messages[i].name) return &budget.messages[i];
   }
   return nullptr;
 }
@@ -74,6 +74,57 @@ TEST(BusBudget, RatesAndBitRatesScaleIt) {
   // 500 Hz, 2 segments, a pose every 4 cycles, radii every 5, STATUS/STATS every 10.
   const double bits = 1000 * 135.0 + 125 * (135.0 + 115.0 + 135.0) + 100 * 125.0 + 50 * 135.0 * 2;
   EXPECT_NEAR(bus_budget(traffic, kClassical1Mbit).load, bits / 1e6, 1e-12);
+}
+
+// A CAN FD frame with the bit-rate switch, 11-bit identifier, d data bytes:
+// at the nominal rate SOF, identifier, RRS, IDE, FDF, res, BRS (17 bits)
+// with at most 4 stuff bits, then CRC delimiter, ACK, EOF and intermission
+// (13): 34 bits. At the data rate ESI and DLC (5), 8d data bits, at most
+// (21 + 8d) / 4 - 4 dynamic stuff bits, and the CRC field: stuff count (4),
+// CRC (17 up to 16 bytes, 21 above), its fixed stuff bits (one per 4 bits)
+// and delimiter: 27 or 32 bits. At 1 Mbit/s and 5 Mbit/s:
+//   d = 8:  34 + (5 + 64 + 17 + 27) = 34 + 113:  34 + 22.6 = 56.6 us;
+//   d = 24: 34 + (5 + 192 + 49 + 32) = 34 + 278: 34 + 55.6 = 89.6 us;
+//   d = 32: 34 + (5 + 256 + 65 + 32) = 34 + 358: 34 + 71.6 = 105.6 us.
+constexpr BusSetup kFd1And5Mbit{hal::CanFormat::fd_bit_rate_switch, {1000000, 5000000}};
+
+TEST(BusBudget, ThePapersRobotStreamingOnOneFdBus) {
+  BusTraffic traffic;
+  traffic.streaming = true;
+  const BusBudget budget = bus_budget(traffic, kFd1And5Mbit);
+  // A second: 4,000 CABLE_FEEDBACK and 1,100 IK_REPORT, 100 each of STATUS
+  // and STATS (8 bytes); one CABLE_SETPOINTS_FD for the 4 segments and one
+  // POSE_FD (32 bytes) and one TARGET_FD (24) every cycle.
+  const double us = (4000 + 1100 + 200) * 56.6 + 2000 * 105.6 + 1000 * 89.6;
+  EXPECT_NEAR(budget.load, us / 1e6, 1e-9);
+  EXPECT_TRUE(budget.fits());  // 0.601
+  EXPECT_EQ(line_of(budget, "POSE_FD")->worst_bits, 34u + 358u);
+  EXPECT_EQ(line_of(budget, "TARGET_FD")->worst_bits, 34u + 278u);
+  EXPECT_EQ(line_of(budget, "CABLE_SETPOINTS_FD")->frames_per_s, 1000.0);
+  for (const char* classical : {"POSE_POSITION_XY", "POSE_UNCERTAINTY", "TARGET_POSITION_Z", "CABLE_SETPOINT"}) {
+    EXPECT_EQ(line_of(budget, classical), nullptr) << classical;
+  }
+  traffic.segments = 5;  // a second setpoint frame
+  EXPECT_EQ(line_of(bus_budget(traffic, kFd1And5Mbit), "CABLE_SETPOINTS_FD")->frames_per_s, 2000.0);
+}
+
+TEST(BusBudget, TwoBusesShareTheTrafficOut) {
+  BusTraffic traffic;
+  traffic.streaming = true;
+  BusSetup host = kFd1And5Mbit, drives = kFd1And5Mbit;
+  host.role = BusRole::host;
+  drives.role = BusRole::drives;
+  const BusBudget shared = bus_budget(traffic, kFd1And5Mbit);
+  const BusBudget on_host = bus_budget(traffic, host);
+  const BusBudget on_drives = bus_budget(traffic, drives);
+  EXPECT_NEAR(on_host.load + on_drives.load, shared.load, 1e-12);
+  EXPECT_NEAR(on_drives.load, (4000 * 56.6 + 1000 * 105.6) / 1e6, 1e-9);
+  EXPECT_EQ(on_drives.message_count, 2);
+  EXPECT_EQ(line_of(on_host, "CABLE_FEEDBACK"), nullptr);
+  EXPECT_NE(line_of(on_host, "TARGET_FD"), nullptr);
+  // Classical drives' bus: CABLE_SETPOINT per segment.
+  BusSetup classical_drives{hal::CanFormat::classical, {1000000, 0}, BusRole::drives};
+  EXPECT_NEAR(bus_budget(traffic, classical_drives).load, 8000 * 135.0 / 1e6, 1e-12);
 }
 
 }  // namespace

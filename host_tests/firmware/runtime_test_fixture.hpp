@@ -25,14 +25,21 @@ class RuntimeTest : public ::testing::Test {
   // In two steps, for a test that puts a controller double between the
   // runtime and its node of the bus.
   void make_platform(const std::vector<std::uint8_t>& image) { platform = std::make_unique<SimulatedPlatform>(image); }
-  void start_runtime(const hal::Hal& hal) {
+  // `host_format` and `drives_format`: the runtime's frames on its buses
+  // (Runtime::set_can_formats); `drives_node`: where the drives listen
+  // (the platform's own node 1 unless the HAL has a drives bus).
+  void start_runtime(const hal::Hal& hal, hal::CanFormat host_format = hal::CanFormat::classical,
+                     hal::CanFormat drives_format = hal::CanFormat::classical, hal::CanBus* drives_node = nullptr) {
     runtime = std::make_unique<firmware::Runtime>(hal, firmware::Geometry::uniform(2, 120.0f, 67.0f));
+    ASSERT_TRUE(runtime->set_can_formats(host_format, drives_format));
     runtime->init();
-    drives = std::make_unique<sim::SimulatedCableDrives>(platform->drives_node, bent_cables(runtime->geometry()), 50.0,
+    drives = std::make_unique<sim::SimulatedCableDrives>(drives_node != nullptr ? *drives_node : platform->drives_node,
+                                                         bent_cables(runtime->geometry()), 50.0,
                                                          sim::cables_per_segment(runtime->geometry()));
     const hal::CanFilter host_filters[] = {firmware::protocol::kIkReportFrames, firmware::protocol::kStatusFrames,
-                                           firmware::protocol::kCableSetpointFrames};
-    platform->host_node.set_filters(host_filters, 3);
+                                           firmware::protocol::kCableSetpointFrames,
+                                           firmware::protocol::kCableSetpointsFdFrames};
+    platform->host_node.set_filters(host_filters, 4);
   }
 
   void cycles(int count) {

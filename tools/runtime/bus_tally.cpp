@@ -24,14 +24,18 @@ std::int64_t BusTally::deadline_ns(std::int64_t queued_ns) const {
 }
 
 void BusTally::on_transfer(const sim::CanTransfer& transfer) {
-  const protocol::MessageSpec* message = nullptr;
+  const char* name = nullptr;
+  std::uint32_t first_id = 0x800;
   const std::uint32_t id = hal::ShiftedCanBus::unshifted(transfer.frame.id, id_offset_);
   for (const protocol::MessageSpec* m : protocol::kMessages) {
-    if (m->carries(id)) message = m;
+    if (m->carries(id)) name = m->name, first_id = m->id;
   }
-  auto kind = std::find_if(kinds_.begin(), kinds_.end(), [&](const Kind& k) { return k.message == message; });
+  for (const protocol::FdMessageSpec* m : protocol::kFdMessages) {
+    if (m->carries(id)) name = m->name, first_id = m->id;
+  }
+  auto kind = std::find_if(kinds_.begin(), kinds_.end(), [&](const Kind& k) { return k.name == name; });
   if (kind == kinds_.end()) {
-    kinds_.push_back(Kind{message, {}, 0});
+    kinds_.push_back(Kind{name, first_id, {}, 0});
     kind = kinds_.end() - 1;
   }
   kind->latency_us.push_back(double(transfer.end_ns - transfer.queued_ns) * 1e-3);
@@ -57,16 +61,12 @@ double quantile(std::vector<double> values, double q) {
 
 std::string BusTally::table() const {
   std::vector<Kind> kinds = kinds_;
-  std::sort(kinds.begin(), kinds.end(), [](const Kind& a, const Kind& b) {
-    const std::uint32_t ia = a.message != nullptr ? a.message->id : 0x800;
-    const std::uint32_t ib = b.message != nullptr ? b.message->id : 0x800;
-    return ia < ib;
-  });
+  std::sort(kinds.begin(), kinds.end(), [](const Kind& a, const Kind& b) { return a.id < b.id; });
   std::string text = fmt::format("  {:<20} {:>8} {:>30} {:>6}\n", "message", "frames", "latency p50 / p99 / max (us)",
                                  "late");
   for (const Kind& k : kinds) {
     text += fmt::format("  {:<20} {:>8} {:>12.1f} / {:>6.1f} / {:>6.1f} {:>6}\n",
-                        k.message != nullptr ? k.message->name : "(not the protocol's)", k.latency_us.size(),
+                        k.name != nullptr ? k.name : "(not the protocol's)", k.latency_us.size(),
                         quantile(k.latency_us, 0.5), quantile(k.latency_us, 0.99),
                         k.latency_us.empty() ? 0.0 : *std::max_element(k.latency_us.begin(), k.latency_us.end()), k.late);
   }
@@ -81,32 +81,46 @@ cli::BusOptions bus_options(int segments, double rate_hz, bool streaming, const 
   options.rate_hz = rate_hz;
   options.streaming = streaming;
   options.rates = bus.rates;
-  options.bitrate = bus.bitrate;
+  options.layout = bus.layout;
   return options;
+}
+
+std::string rates_text(const cli::BusLine& line) {
+  return line.format == hal::CanFormat::fd_bit_rate_switch
+             ? fmt::format("{} bit/s, data {} bit/s", line.bitrate, line.data_bitrate)
+             : fmt::format("{} bit/s", line.bitrate);
 }
 
 }  // namespace
 
-std::string timed_bus_report(const sim::VirtualCanBus& bus, std::int64_t now_ns, const BusTally& tally, int segments,
-                             double rate_hz, bool streaming, const BusChoice& choice) {
-  const protocol::BusBudget budget = cli::bus_budget_of(bus_options(segments, rate_hz, streaming, choice));
-  const double measured = BusTally::measured_load(bus, now_ns);
-  return fmt::format("bus at {} bit/s: measured load {:.1f} % over {:.3f} s (the budget's worst case {:.1f} %, "
-                     "without stuffing {:.1f} %), {} frames on identifiers 0x{:03X} to 0x{:03X}, {} late for "
-                     "their cycle\n",
-                     choice.bitrate, 100.0 * measured, double(now_ns) * 1e-9, 100.0 * budget.load,
-                     100.0 * budget.unstuffed_load, tally.frames(), tally.lowest_id(), tally.highest_id(),
-                     tally.late()) +
-         tally.table();
+std::string timed_bus_report(const std::vector<TimedBus>& buses, std::int64_t now_ns, int segments, double rate_hz,
+                             bool streaming, const BusChoice& choice) {
+  const std::vector<cli::NamedBudget> budgets = cli::bus_budgets_of(bus_options(segments, rate_hz, streaming, choice));
+  std::string text;
+  for (std::size_t i = 0; i < buses.size() && i < budgets.size(); ++i) {
+    const cli::NamedBudget& planned = budgets[i];
+    const BusTally& tally = *buses[i].tally;
+    const double measured = BusTally::measured_load(*buses[i].bus, now_ns);
+    text += fmt::format("{}bus at {}{}: measured load {:.1f} % over {:.3f} s (the budget's worst case {:.1f} %, "
+                        "without stuffing {:.1f} %), {} frames on identifiers 0x{:03X} to 0x{:03X}, {} late for "
+                        "their cycle\n",
+                        planned.name.empty() ? "" : planned.name + (planned.name == "drives" ? "' " : "'s "),
+                        rates_text(planned.line),
+                        planned.line.format == hal::CanFormat::classical ? "" : " (CAN FD)", 100.0 * measured,
+                        double(now_ns) * 1e-9, 100.0 * planned.budget.load, 100.0 * planned.budget.unstuffed_load,
+                        tally.frames(), tally.lowest_id(), tally.highest_id(), tally.late()) +
+            tally.table();
+  }
+  return text;
 }
 
 void check_bus_budget(int segments, double rate_hz, bool streaming, const BusChoice& bus) {
-  if (bus.bitrate == 0) return;
-  const cli::BusOptions options = bus_options(segments, rate_hz, streaming, bus);
+  if (bus.layout.bus.bitrate == 0) return;
+  cli::BusOptions options = bus_options(segments, rate_hz, streaming, bus);
   cli::validate_bus_options(options);
-  const protocol::BusBudget budget = cli::bus_budget_of(options);
-  std::fputs(cli::format_bus_budget(budget, options).c_str(), stdout);
-  if (const std::string refusal = cli::bus_budget_refusal(budget, options); !refusal.empty()) {
+  const std::vector<cli::NamedBudget> budgets = cli::bus_budgets_of(options);
+  std::fputs(cli::format_bus_budgets(budgets, options).c_str(), stdout);
+  if (const std::string refusal = cli::bus_budget_refusal(budgets, options); !refusal.empty()) {
     throw cli::InputError(refusal);
   }
 }

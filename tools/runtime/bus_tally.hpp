@@ -39,7 +39,8 @@ class BusTally final : public sim::CanTransferObserver {
 
  private:
   struct Kind {
-    const firmware::protocol::MessageSpec* message = nullptr;
+    const char* name = nullptr;  // null: not the protocol's
+    std::uint32_t id = 0x800;    // the message's first, for the table's order
     std::vector<double> latency_us;
     long late = 0;
   };
@@ -57,10 +58,17 @@ class BusTally final : public sim::CanTransferObserver {
 
 struct BusChoice;
 
-// The run's bus: the measured load against the budget's worst case and the
-// load without stuffing (a check: measured within them), the frames and
-// those late, then the tally's table.
-std::string timed_bus_report(const sim::VirtualCanBus& bus, std::int64_t now_ns, const BusTally& tally, int segments,
-                             double rate_hz, bool streaming, const BusChoice& choice);
+// A timed bus of the run and what it carried.
+struct TimedBus {
+  const sim::VirtualCanBus* bus = nullptr;
+  const BusTally* tally = nullptr;
+};
+
+// Each of the run's buses (the host's first, as cli::bus_budgets_of): the
+// measured load against the budget's worst case and the load without
+// stuffing (a check: measured within them), the frames and those late,
+// then the tally's table.
+std::string timed_bus_report(const std::vector<TimedBus>& buses, std::int64_t now_ns, int segments, double rate_hz,
+                             bool streaming, const BusChoice& choice);
 
 }  // namespace cdcr::runtime_host

@@ -56,10 +56,16 @@ int main(int argc, char** argv) {
   app.add_option("--circle-radius", circle_radius_mm, "--circle radius, mm")->capture_default_str();
   app.add_option("--circle-speed", circle_speed_mm_s, "--circle tip speed, mm/s")->capture_default_str();
   BusChoice bus;
-  cdcr::cli::add_bitrate_option(app, bus.bitrate,
-                                "the bus's bit rate, bit/s: the bus budget (cdcr bus) is printed and a configuration "
-                                "above its limit refused; --sim times its bus at this rate (0: an untimed bus, "
-                                "frames delivered at once)");
+  cdcr::cli::add_bus_layout_options(app, bus.layout,
+                                    "the bus's bit rate, bit/s: the bus budget (cdcr bus) is printed and a "
+                                    "configuration above its limit refused; --sim times its bus at this rate (0: an "
+                                    "untimed bus, frames delivered at once)",
+                                    false);
+  app.add_flag("--drives-bus", bus.layout.drives_bus, "with --sim: the drives on a simulated bus of their own");
+  std::string drives_interface;
+  auto* drives_can_option =
+      app.add_option("--drives-can", drives_interface,
+                     "with --can: the drives' own SocketCAN interface (CABLE_FEEDBACK in, the setpoints out)");
   cdcr::cli::add_publish_rate_options(app, bus.rates);
   std::string id_base_text;
   cdcr::cli::add_id_base_option(app, id_base_text);
@@ -79,6 +85,13 @@ int main(int argc, char** argv) {
       throw CLI::ValidationError("--streaming needs --can (--sim --circle streams)");
     }
     bus.id_base = cdcr::cli::parse_id_base(id_base_text);
+    if (drives_can_option->count() > 0 && can_interface.empty()) throw CLI::ValidationError("--drives-can needs --can");
+    if (bus.layout.drives_bus && !run_sim) throw CLI::ValidationError("--drives-bus needs --sim (--can: --drives-can)");
+    if (!drives_interface.empty()) {
+      bus.layout.drives_bus = true;
+      bus.layout.drives_option = "--drives-can";
+    }
+    cdcr::cli::resolve_bus_layout(bus.layout, true);
     cdcr::cli::validate_publish_rates(bus.rates);
     if (spin_option->count() > 0 && can_interface.empty()) throw CLI::ValidationError("--spin needs --can");
     if (!replay_path.empty() && (image_path.empty() || out_path.empty())) {
@@ -95,7 +108,7 @@ int main(int argc, char** argv) {
   }
   try {
     if (!can_interface.empty()) {
-      return run_on_socketcan(image_path, can_interface, rate_hz, app.count("--seconds") > 0 ? seconds : 0.0,
+      return run_on_socketcan(image_path, can_interface, drives_interface, rate_hz, app.count("--seconds") > 0 ? seconds : 0.0,
                               flash_dir, spin, bus);
     }
     const SimulatedRobotChoice robot{ideal_robot, hysteresis};

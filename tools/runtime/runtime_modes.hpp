@@ -10,6 +10,8 @@
 #include <cdcr/firmware/protocol/messages.hpp>
 #include <cdcr/firmware/publish_rates.hpp>
 
+#include "cli/bus_command.hpp"
+
 namespace cdcr::runtime_host {
 
 // The bus and the runtime's publish rates (firmware/publish_rates.hpp). With
@@ -17,16 +19,21 @@ namespace cdcr::runtime_host {
 // run and a configuration above the limit is refused; --sim then times its
 // bus at that rate (0: the untimed, infinitely fast bus) and reports what it
 // carried.
+//
+// The layout (cli/bus_command.hpp): the format of each bus, and a second bus
+// for the drives (--sim --drives-bus; --can with --drives-can IFACE).
 struct BusChoice {
+  BusChoice() { layout.bus.bitrate = 0; }
   // Where the protocol's identifiers start (firmware/protocol/messages.hpp):
-  // the runtime, the simulated drives and host all send and read there.
+  // the runtime, the simulated drives and host all send and read there, on
+  // either bus.
   std::uint32_t id_base = firmware::protocol::kDefaultIdBase;
-  std::uint32_t bitrate = 0;
+  cli::BusLayout layout;
   firmware::PublishRates rates{};
   bool streaming = false;  // --can: plan for a target streamed every cycle (--circle streams)
 };
 
-// Prints the budget of `segments` at rate_hz on `bus` and throws
+// Prints the budget of every bus of `segments` at rate_hz on `bus` and throws
 // cli::InputError, one line, when it is above the limit; nothing without a
 // bit rate.
 void check_bus_budget(int segments, double rate_hz, bool streaming, const BusChoice& bus);
@@ -57,8 +64,10 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
 
 // --can: the runtime itself on a SocketCAN interface, in real time, until
 // `seconds` have passed (0: no limit) or SIGINT/SIGTERM.
-int run_on_socketcan(const std::string& image_path, const std::string& interface_name, double rate_hz,
-                     double seconds, const std::string& flash_dir, bool spin, const BusChoice& bus);
+// drives_interface: the drives' own bus (empty: they share interface_name).
+int run_on_socketcan(const std::string& image_path, const std::string& interface_name,
+                     const std::string& drives_interface, double rate_hz, double seconds, const std::string& flash_dir,
+                     bool spin, const BusChoice& bus);
 
 // The cycle rate every mode accepts: (0, 100000] Hz.
 void require_rate(double rate_hz);

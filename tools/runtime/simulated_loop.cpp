@@ -35,12 +35,26 @@ namespace sim = cdcr::sim;
 
 namespace {
 
-sim::SimulatedPlatform& with_image(sim::SimulatedPlatform& platform, const std::string& image_path) {
+// The board's buses as `choice` has them: CAN FD where asked for, timed at
+// its bit rates (untimed at 0), the image in the model region.
+sim::SimulatedPlatform& prepared(sim::SimulatedPlatform& platform, const std::string& image_path,
+                                 const BusChoice& choice) {
   if (!image_path.empty()) platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
+  const cli::BusLayout& layout = choice.layout;
+  const auto set_up = [&](sim::VirtualCanBus& bus, const cli::BusLine& line) {
+    bus.set_fd(line.format != cdcr::hal::CanFormat::classical);
+    if (line.bitrate > 0) bus.set_timing(platform.clock, {line.bitrate, line.data_bitrate});
+  };
+  set_up(platform.bus, layout.bus);
+  if (layout.drives_bus) set_up(platform.drives_bus, layout.drives);
   return platform;
 }
 
-fw::Runtime& booted(fw::Runtime& runtime) {
+fw::Runtime& booted(fw::Runtime& runtime, const BusChoice& choice) {
+  const cli::BusLayout& layout = choice.layout;
+  if (!runtime.set_can_formats(layout.bus.format, layout.drives_bus ? layout.drives.format : layout.bus.format)) {
+    throw std::runtime_error("the simulated buses refused the runtime's CAN formats");
+  }
   runtime.init();
   return runtime;
 }
@@ -55,28 +69,41 @@ sim::SimulatorConfig robot_config(const SimulatedRobotChoice& choice) {
 // the simulated robot whose cables it reads and moves.
 struct SimulatedLoop {
   SimulatedLoop(const std::string& image_path, const SimulatedRobotChoice& choice, const BusChoice& bus_choice)
-      : platform(protocol::id_offset(bus_choice.id_base)),
-        runtime(with_image(platform, image_path).hal, fw::Geometry::prototype()),
-        geometry(booted(runtime).geometry().cast<double>()),
+      : platform(protocol::id_offset(bus_choice.id_base), bus_choice.layout.drives_bus),
+        runtime(prepared(platform, image_path, bus_choice).hal, fw::Geometry::prototype()),
+        geometry(booted(runtime, bus_choice).geometry().cast<double>()),
         robot(geometry, robot_config(choice)),
         bus(bus_choice),
-        drives_can(platform.bus.node(1), protocol::id_offset(bus_choice.id_base)),
-        host_can(platform.bus.node(2), protocol::id_offset(bus_choice.id_base)) {
-    bus_tally.set_id_offset(protocol::id_offset(bus.id_base));
+        drives_node(drives_bus().node(1), protocol::id_offset(bus_choice.id_base)),
+        host_node(platform.bus.node(2), protocol::id_offset(bus_choice.id_base)),
+        homing_node(drives_bus().node(2), protocol::id_offset(bus_choice.id_base)),
+        drives_can(drives_node),
+        host_can(host_node),
+        homing_can(homing_node) {
+    const cli::BusLayout& layout = bus.layout;
+    drives_can.set_format(layout.drives_bus ? layout.drives.format : layout.bus.format);
+    homing_can.set_format(layout.drives_bus ? layout.drives.format : layout.bus.format);
+    host_can.set_format(layout.bus.format);
     runtime.set_publish_rates(bus.rates);
-    if (bus.bitrate > 0) {
-      platform.bus.set_timing(platform.clock, {bus.bitrate, 0});
-      platform.bus.set_observer(&bus_tally);
-    }
+    for (BusTally* tally : {&bus_tally, &drives_tally}) tally->set_id_offset(protocol::id_offset(bus.id_base));
+    if (platform.bus.timed()) platform.bus.set_observer(&bus_tally);
+    if (layout.drives_bus && platform.drives_bus.timed()) platform.drives_bus.set_observer(&drives_tally);
   }
 
-  // What the timed bus carried, against the budget's worst case (nothing
-  // on the untimed bus).
+  // The bus the drives are on: their own, or the host's.
+  sim::VirtualCanBus& drives_bus() { return bus.layout.drives_bus ? platform.drives_bus : platform.bus; }
+
+  void set_releases(std::int64_t first_release_ns, std::int64_t period_ns) {
+    for (BusTally* tally : {&bus_tally, &drives_tally}) tally->set_releases(first_release_ns, period_ns);
+  }
+
+  // What the timed buses carried, against the budget's worst case (nothing
+  // on an untimed bus).
   void print_bus_report(double rate_hz, bool streaming) const {
-    if (bus.bitrate == 0) return;
-    std::fputs(timed_bus_report(platform.bus, platform.clock.now_ns(), bus_tally, geometry.segment_count, rate_hz,
-                                streaming, bus)
-                   .c_str(),
+    if (!platform.bus.timed()) return;
+    std::vector<TimedBus> buses{{&platform.bus, &bus_tally}};
+    if (bus.layout.drives_bus) buses.push_back({&platform.drives_bus, &drives_tally});
+    std::fputs(timed_bus_report(buses, platform.clock.now_ns(), geometry.segment_count, rate_hz, streaming, bus).c_str(),
                stdout);
   }
 
@@ -85,10 +112,17 @@ struct SimulatedLoop {
   model::RobotGeometry<double> geometry;
   sim::SimulatedRobot robot;
   BusChoice bus;
-  // The drives' and the host's nodes, at the runtime's identifiers.
-  cdcr::hal::ShiftedCanBus drives_can;
-  cdcr::hal::ShiftedCanBus host_can;
+  // The drives' and the host's nodes, at the runtime's identifiers, in their
+  // buses' formats; the homing move's setpoints come from a node on the
+  // drives' bus.
+  cdcr::hal::ShiftedCanBus drives_node;
+  cdcr::hal::ShiftedCanBus host_node;
+  cdcr::hal::ShiftedCanBus homing_node;
+  cdcr::hal::FormattedCanBus drives_can;
+  cdcr::hal::FormattedCanBus host_can;
+  cdcr::hal::FormattedCanBus homing_can;
   BusTally bus_tally;
+  BusTally drives_tally;
 };
 
 // The simulated drives on the loop's bus, the host's node that sends the
@@ -106,7 +140,7 @@ struct DrivenLoop {
   }
 
   void start_timer() {
-    loop.bus_tally.set_releases(loop.platform.clock.now_ns() + period_ns, period_ns);
+    loop.set_releases(loop.platform.clock.now_ns() + period_ns, period_ns);
     loop.platform.timer.start(period_ns);
   }
 
@@ -131,7 +165,7 @@ struct DrivenLoop {
   // The lengths that bend the segments: the drives' through the friction,
   // which follows every step of the drives (the drives' own with it off).
   model::CableVector<double> effective_cables;
-  cdcr::hal::CanBus& host;
+  cdcr::hal::FormattedCanBus& host;
   std::int64_t period_ns;
   double dt_s;
 };
@@ -146,16 +180,25 @@ struct ErrorTally {
   }
 };
 
-void send_target(cdcr::hal::CanBus& host, const model::Vec3<double>& target_mm, std::uint8_t sequence) {
+// A target as the host sends it: one TARGET_FD on an FD bus, else its
+// classical frames.
+void send_target(cdcr::hal::FormattedCanBus& host, const model::Vec3<double>& target_mm, std::uint8_t sequence) {
+  model::Pose<double> target;
+  target.position_mm = target_mm;
   for (const cdcr::hal::CanFrame& frame :
-       sim::target_frames(target_mm, protocol::TargetMode::position, false, sequence)) {
+       host.fd() ? std::vector<cdcr::hal::CanFrame>{sim::target_fd_frame(target, protocol::TargetMode::position, false,
+                                                                          sequence)}
+                 : sim::target_frames(target_mm, protocol::TargetMode::position, false, sequence)) {
     host.send(frame);
   }
 }
 
-void send_pose_target(cdcr::hal::CanBus& host, const model::Pose<double>& target, std::uint8_t sequence,
+void send_pose_target(cdcr::hal::FormattedCanBus& host, const model::Pose<double>& target, std::uint8_t sequence,
                       bool tracking) {
-  for (const cdcr::hal::CanFrame& frame : sim::target_frames(target, protocol::TargetMode::pose, tracking, sequence)) {
+  for (const cdcr::hal::CanFrame& frame :
+       host.fd() ? std::vector<cdcr::hal::CanFrame>{sim::target_fd_frame(target, protocol::TargetMode::pose, tracking,
+                                                                          sequence)}
+                 : sim::target_frames(target, protocol::TargetMode::pose, tracking, sequence)) {
     host.send(frame);
   }
 }
@@ -170,7 +213,7 @@ void send_pose_target(cdcr::hal::CanBus& host, const model::Pose<double>& target
 // `cycle` runs one cycle of the loop (drives, friction, runtime).
 template <typename Cycle>
 void run_homing_move(const model::RobotGeometry<double>& geometry, const sim::SimulatedCableDrives& drives,
-                     cdcr::hal::CanBus& host, double rate_hz, Cycle&& cycle) {
+                     cdcr::hal::CanBus& homing, cdcr::hal::CanBus& host, double rate_hz, Cycle&& cycle) {
   model::CableVector<double> approach_mm, home_mm;
   if (const model::Status status = model::homing_waypoints(geometry, approach_mm, home_mm);
       status != model::Status::ok) {
@@ -186,7 +229,7 @@ void run_homing_move(const model::RobotGeometry<double>& geometry, const sim::Si
       if (!protocol::encode(setpoint, frame)) {
         throw std::runtime_error("the homing move: a cable length the CABLE_SETPOINT frame cannot carry");
       }
-      host.send(frame);
+      homing.send(frame);
     }
   };
   for (const model::CableVector<double>* stop : {&approach_mm, &home_mm}) {
@@ -251,7 +294,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   model::CableVector<double> start_cables;
   model::cables_from_joints(joints_at(0.5 * bend_rad, 0.0), geometry, start_cables);
   DrivenLoop driven(loop, start_cables, rate_hz);
-  cdcr::hal::CanBus& host = driven.host;
+  cdcr::hal::FormattedCanBus& host = driven.host;
   driven.start_timer();
 
   long cycles = 0, poses_missing = 0, cycles_since_pose = 0;
@@ -281,7 +324,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
   // where the drives stand to the circle's in half a second of streamed
   // targets, then half a second on the start to settle.
   // With the friction the robot first homes, and the ramp starts from home.
-  if (robot_choice.hysteresis) run_homing_move(geometry, driven.drives, host, rate_hz, cycle);
+  if (robot_choice.hysteresis) run_homing_move(geometry, driven.drives, loop.homing_can, host, rate_hz, cycle);
   const double ramp_from = robot_choice.hysteresis ? 0.0 : 0.5;
   std::uint8_t sequence = 0;
   const long ramp_cycles = std::lround(0.5 * rate_hz);
@@ -403,7 +446,7 @@ class RandomTargetRun {
 
   void run(double seconds) {
     if (two_sided_) {
-      run_homing_move(geometry_, driven_.drives, driven_.host, rate_hz_, [this] {
+      run_homing_move(geometry_, driven_.drives, loop_.homing_can, driven_.host, rate_hz_, [this] {
         runtime().run_cycle(driven_.advance_drives());
         driven_.drain_host();
       });

@@ -51,13 +51,15 @@ void print_cycle_statistics(const fw::Runtime& runtime, const cdcr::hal::CanErro
 
 // The runtime on a real bus: the same object the board runs, on the Linux
 // backends, until the duration ends or a signal asks it to stop.
-int run_on_socketcan(const std::string& image_path, const std::string& interface_name, double rate_hz,
-                     double seconds, const std::string& flash_dir, bool spin, const BusChoice& bus_choice) {
+int run_on_socketcan(const std::string& image_path, const std::string& interface_name,
+                     const std::string& drives_interface, double rate_hz, double seconds, const std::string& flash_dir,
+                     bool spin, const BusChoice& bus_choice) {
   require_rate(rate_hz);
   if (seconds != 0 && (!(seconds > 0) || !(seconds <= 86400))) {
     throw std::invalid_argument("--seconds must be in (0, 86400]");
   }
   static cdcr::linux_host::SocketCanBus bus;
+  static cdcr::linux_host::SocketCanBus drives_bus;
   static cdcr::linux_host::PosixMonotonicClock clock;
   static cdcr::linux_host::PosixPeriodicTimer timer{
       clock, spin ? cdcr::linux_host::ReleaseWait::spin : cdcr::linux_host::ReleaseWait::sleep};
@@ -65,7 +67,14 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   static cdcr::linux_host::StdioConsole console{stderr};
   std::string error;
   if (!image_path.empty() && !storage.map_file(image_path, error)) throw InputError(error);
-  if (!bus.open(interface_name, error)) throw InputError("CAN interface " + interface_name + ": " + error);
+  const cli::BusLayout& layout = bus_choice.layout;
+  if (!bus.open(interface_name, error, layout.bus.format != cdcr::hal::CanFormat::classical)) {
+    throw InputError("CAN interface " + interface_name + ": " + error);
+  }
+  const bool two_buses = !drives_interface.empty();
+  if (two_buses && !drives_bus.open(drives_interface, error, layout.drives.format != cdcr::hal::CanFormat::classical)) {
+    throw InputError("CAN interface " + drives_interface + " (--drives-can): " + error);
+  }
   // With a flash directory, models deployed over CAN (A/B slots) run in
   // preference to --image, which stays the fallback.
   static cdcr::linux_host::FileFlash flash;
@@ -78,8 +87,13 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   sigaction(SIGTERM, &action, nullptr);
 
   static cdcr::hal::ShiftedCanBus runtime_can(bus, protocol::id_offset(bus_choice.id_base));
-  static const cdcr::hal::Hal hal{clock, timer, runtime_can, storage, console, flash_dir.empty() ? nullptr : &flash};
+  static cdcr::hal::ShiftedCanBus runtime_drives_can(drives_bus, protocol::id_offset(bus_choice.id_base));
+  static const cdcr::hal::Hal hal{clock,   timer, runtime_can, storage, console, flash_dir.empty() ? nullptr : &flash,
+                                  two_buses ? &runtime_drives_can : nullptr};
   static fw::Runtime runtime(hal, fw::Geometry::prototype());
+  if (!runtime.set_can_formats(layout.bus.format, two_buses ? layout.drives.format : layout.bus.format)) {
+    throw InputError("the CAN interfaces do not take the formats asked for");
+  }
   runtime.init();
   runtime.set_publish_rates(bus_choice.rates);
   check_bus_budget(runtime.geometry().segment_count, rate_hz, bus_choice.streaming, bus_choice);
@@ -94,12 +108,17 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
     runtime.run_cycle(tick);
   }
   print_cycle_statistics(runtime, bus.error_counters(), rate_hz, double(clock.now_ns() - start_ns) * 1e-9);
+  if (two_buses) {
+    const cdcr::hal::CanErrorCounters can = drives_bus.error_counters();
+    std::printf("drives' bus %s: CAN tx dropped %u, rx overruns %u, bus errors %u\n", drives_interface.c_str(),
+                can.tx_dropped, can.rx_overruns, can.bus_errors);
+  }
   std::fflush(stdout);
   return 0;
 }
 #else
-int run_on_socketcan(const std::string&, const std::string&, double, double, const std::string&, bool,
-                     const BusChoice&) {
+int run_on_socketcan(const std::string&, const std::string&, const std::string&, double, double,
+                     const std::string&, bool, const BusChoice&) {
   throw InputError("--can needs a Linux host (SocketCAN)");
 }
 #endif

@@ -25,29 +25,42 @@ SimulatedCableDrives::SimulatedCableDrives(hal::CanBus& bus, const Cables& initi
     first += count;
   }
   if (first != cables_mm_.size()) throw std::invalid_argument("the drives' cables and the segments' counts disagree");
-  bus_.set_filters(&protocol::kCableSetpointFrames, 1);
+  static constexpr hal::CanFilter kSetpointFrames[] = {protocol::kCableSetpointFrames,
+                                                       protocol::kCableSetpointsFdFrames};
+  bus_.set_filters(kSetpointFrames, 2);
 }
 
 void SimulatedCableDrives::set_segment_silent(int segment, bool silent) {
   if (segment >= 0 && segment < firmware::kMaxSegments) segment_silent_[segment] = silent;
 }
 
+// A segment's setpoint, or false for a segment the robot lacks or a
+// four-cable segment's setpoint without its fourth length.
+bool SimulatedCableDrives::take(const protocol::CableSetpoint& setpoint) {
+  const int segments = static_cast<int>(segment_cables_.size());
+  if (setpoint.segment >= segments ||
+      (segment_cables_[static_cast<std::size_t>(setpoint.segment)] == 4 && std::isnan(setpoint.lengths_mm[3]))) {
+    return false;
+  }
+  const auto segment = static_cast<std::size_t>(setpoint.segment);
+  for (int k = 0; k < segment_cables_[segment]; ++k) setpoints_mm_[first_cable_[segment] + k] = setpoint.lengths_mm[k];
+  setpoint_frames_ += 1;
+  return true;
+}
+
 void SimulatedCableDrives::step(double dt_s) {
   const int segments = static_cast<int>(segment_cables_.size());
   hal::CanFrame frame;
   while (bus_.receive(frame) == hal::CanStatus::ok) {
-    if (!protocol::cable_setpoint::kMessage.carries(frame.id)) continue;
-    protocol::CableSetpoint setpoint;
-    if (protocol::decode(frame, setpoint) != protocol::DecodeStatus::ok || setpoint.segment >= segments ||
-        (segment_cables_[static_cast<std::size_t>(setpoint.segment)] == 4 && std::isnan(setpoint.lengths_mm[3]))) {
-      rejected_frames_ += 1;
-      continue;
+    if (protocol::cable_setpoint::kMessage.carries(frame.id)) {
+      protocol::CableSetpoint setpoint;
+      if (protocol::decode(frame, setpoint) != protocol::DecodeStatus::ok || !take(setpoint)) rejected_frames_ += 1;
+    } else if (protocol::cable_setpoints_fd::kMessage.carries(frame.id)) {
+      protocol::CableSetpointsFd setpoints;
+      bool taken = protocol::decode(frame, setpoints) == protocol::DecodeStatus::ok;
+      for (int k = 0; taken && k < setpoints.segment_count; ++k) taken = take(setpoints.segments[k]);
+      if (!taken) rejected_frames_ += 1;
     }
-    const auto segment = static_cast<std::size_t>(setpoint.segment);
-    for (int k = 0; k < segment_cables_[segment]; ++k) {
-      setpoints_mm_[first_cable_[segment] + k] = setpoint.lengths_mm[k];
-    }
-    setpoint_frames_ += 1;
   }
   const double max_step_mm = max_rate_mm_per_s_ * dt_s;
   for (Eigen::Index i = 0; i < cables_mm_.size(); ++i) {

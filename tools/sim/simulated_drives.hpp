@@ -1,11 +1,12 @@
 #pragma once
 // The cable drives as the runtime sees them over CAN: they take setpoint
-// frames, move each cable toward its setpoint at a limited rate, and report
+// frames (CABLE_SETPOINT, or CABLE_SETPOINTS_FD on an FD bus), move each cable toward its setpoint at a limited rate, and report
 // the achieved lengths every step, one feedback frame per segment.
 
 #include <vector>
 
 #include <cdcr/firmware/capacity.hpp>
+#include <cdcr/firmware/protocol/frames.hpp>
 #include <cdcr/hal/can_bus.hpp>
 #include <cdcr/model/geometry.hpp>
 #include <cdcr/model/types.hpp>
@@ -40,10 +41,13 @@ class SimulatedCableDrives {
 
   const Cables& cables_mm() const { return cables_mm_; }
   const Cables& setpoints_mm() const { return setpoints_mm_; }
+  // Segment setpoints taken: one a CABLE_SETPOINT frame, up to four a CABLE_SETPOINTS_FD.
   std::uint32_t setpoint_frames() const { return setpoint_frames_; }
   std::uint32_t rejected_frames() const { return rejected_frames_; }
 
  private:
+  bool take(const firmware::protocol::CableSetpoint& setpoint);
+
   hal::CanBus& bus_;
   Cables cables_mm_;
   Cables setpoints_mm_;

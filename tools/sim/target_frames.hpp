@@ -1,13 +1,15 @@
 #pragma once
 // The frames a host sends the runtime for one target, in the order it must
 // send them: TARGET_ORIENTATION (pose targets only), TARGET_POSITION_XY, then
-// TARGET_POSITION_Z, which commits the target.
+// TARGET_POSITION_Z, which commits the target; on a CAN FD bus one
+// TARGET_FD instead.
 
 #include <cstdint>
 #include <vector>
 
 #include <Eigen/Geometry>
 
+#include <cdcr/firmware/protocol/fd_frames.hpp>
 #include <cdcr/firmware/protocol/frames.hpp>
 #include <cdcr/hal/can_bus.hpp>
 #include <cdcr/model/se3.hpp>
@@ -41,6 +43,26 @@ inline std::vector<hal::CanFrame> target_frames(const model::Pose<double>& targe
     frames.push_back(frame);
   }
   return frames;
+}
+
+// The same target in one TARGET_FD frame, for a CAN FD bus: the parts the
+// classical frames carry (a position target's orientation part is 0).
+inline hal::CanFrame target_fd_frame(const model::Pose<double>& target, firmware::protocol::TargetMode mode,
+                                     bool tracking, std::uint8_t sequence) {
+  namespace protocol = firmware::protocol;
+  protocol::TargetFd message;
+  if (mode == protocol::TargetMode::pose) {
+    Eigen::Quaterniond q(target.rotation);
+    q.normalize();
+    message.orientation = {q.w(), q.x(), q.y(), q.z()};
+  } else {
+    message.orientation = {0, 0, 0, 0};
+  }
+  message.position_xy = {target.position_mm.x(), target.position_mm.y()};
+  message.position_z = {target.position_mm.z(), mode, tracking, sequence};
+  hal::CanFrame frame;
+  protocol::encode(message, frame);
+  return frame;
 }
 
 }  // namespace cdcr::sim

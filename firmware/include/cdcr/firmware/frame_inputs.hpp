@@ -1,6 +1,6 @@
 #pragma once
 // The bus's inputs to the runtime: cable feedback, the three frames of a
-// target, the payload. Each is decoded and handed to the runtime's direct
+// target (or its one TARGET_FD frame), the payload. Each is decoded and handed to the runtime's direct
 // calls (Runtime::set_*), which callers without a bus use as they are; a
 // frame that does not decode is rejected with its fault code.
 
@@ -22,6 +22,7 @@ class FrameInputs {
 
  private:
   void take_commit(const hal::CanFrame& frame, Runtime& runtime);
+  void take_fd_target(const hal::CanFrame& frame, Runtime& runtime);
 
   // The parts of a target received before its commit frame.
   bool has_pending_position_ = false;

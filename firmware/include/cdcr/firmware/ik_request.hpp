@@ -124,6 +124,7 @@ class IkRequest {
   Cables setpoints_mm_;
   Joints setpoint_joints_;
   hal::CanFrame setpoint_frames_[kMaxSegments] = {};
+  int setpoint_frame_count_ = 0;
 };
 
 }  // namespace cdcr::firmware

@@ -13,8 +13,8 @@
 // targets; the drives keep the last setpoint they received (holding position
 // is the drives' own behaviour on a silent bus), and STATUS keeps coming.
 //
-// Per cycle: take the inputs (up to kMaxRxFramesPerCycle frames, or by direct
-// call), move the hysteresis state and estimate the pose from the latest cable
+// Per cycle: take the inputs (up to kMaxRxFramesPerCycle frames from each
+// bus, or by direct call), move the hysteresis state and estimate the pose from the latest cable
 // lengths, let the scheduler share out the rest (variance slice, model update,
 // IK: cycle_scheduler.hpp), publish, and measure time and jitter on the HAL
 // clock. Frames go through protocol.hpp. The parts: kinematics.hpp,
@@ -35,6 +35,7 @@
 #include "cdcr/firmware/outbox.hpp"
 #include "cdcr/firmware/protocol.hpp"
 #include "cdcr/firmware/publish_rates.hpp"
+#include "cdcr/hal/formatted_can_bus.hpp"
 #include "cdcr/hal/hal.hpp"
 
 namespace cdcr::firmware {
@@ -90,6 +91,18 @@ class Runtime {
   // rates that are not valid().
   bool set_publish_rates(const PublishRates& rates);
   const PublishRates& publish_rates() const { return publish_rates_; }
+  // The format of the runtime's frames on the host's bus and the drives'
+  // (formatted_can_bus.hpp), classical until set; before init() only, and
+  // kept across it. On an FD bus the pose goes out as POSE_FD (the radii
+  // in it instead of POSE_UNCERTAINTY) and the setpoints as
+  // CABLE_SETPOINTS_FD; TARGET_FD is taken on any bus. Without a drives
+  // bus (Hal::drives_can) the two are one bus and must be equal. False,
+  // and nothing changed, for an FD format on a controller without FD, or
+  // after init().
+  bool set_can_formats(hal::CanFormat host, hal::CanFormat drives);
+  hal::CanFormat host_can_format() const { return host_bus_.format(); }
+  hal::CanFormat drives_can_format() const { return drives_bus_.format(); }
+  bool has_drives_bus() const { return hal_.drives_can != nullptr; }
   // HOMING: the homing move has just ended, the robot is at home
   // (hysteresis_tracker.hpp); without a hysteresis block, nothing.
   void set_homed() { hysteresis_.homed(model_.geometry); }
@@ -162,7 +175,10 @@ class Runtime {
   bool input_stale() const;
   void update_pose();
   void publish_pose();
+  void publish_fd_pose();
+  int receive_frames(hal::CanBus& bus, int frames);
   void publish_uncertainty();
+  protocol::PoseUncertainty uncertainty_frame() const;
   void publish_status();
   void enter(RuntimeState next);
 
@@ -173,6 +189,10 @@ class Runtime {
   FaultCode boot_fault_ = FaultCode::none;
   FaultDetail boot_fault_detail_;
   bool can_filters_accepted_ = false;
+  // The HAL's buses as the runtime sends on them (the drives' is the host's
+  // without a second bus).
+  hal::FormattedCanBus host_bus_;
+  hal::FormattedCanBus drives_bus_;
   Outbox outbox_;
 
   std::uint32_t cycle_ = 0;

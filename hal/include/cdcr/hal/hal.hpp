@@ -20,6 +20,9 @@ struct Hal {
   // Where model updates are written (A/B slots); none: the model is
   // model_storage's and cannot be updated over the bus.
   Flash* flash = nullptr;
+  // A second bus for the drives (their CABLE_FEEDBACK in, the setpoints
+  // out); none: the drives share `can` with the host.
+  CanBus* drives_can = nullptr;
 };
 
 }  // namespace cdcr::hal

@@ -126,4 +126,30 @@ inline bool encode(const CableSetpointsFd& f, hal::CanFrame& frame) {
   return true;
 }
 
+// The robot's segments of a CABLE_SETPOINTS_FD frame: the parts before
+// the first whose every length is not available.
+inline DecodeStatus decode(const hal::CanFrame& frame, CableSetpointsFd& f) {
+  const FdMessageSpec& message = cable_setpoints_fd::kMessage;
+  CableSetpointsFd out;
+  out.index = static_cast<int>(frame.id - message.id);
+  bool ended = false;
+  if (const DecodeStatus s = check_fd_frame(message, frame); s != DecodeStatus::ok) return s;
+  for (int k = 0; k < message.part_count; ++k) {
+    const hal::CanFrame part = part_frame(message, frame, k, out.index);
+    bool absent = true;
+    for (const SignalSpec* signal : cable_setpoint::kMessage.signals) {
+      absent = absent && read_raw(part, *signal) == kCableNotAvailableRaw;
+    }
+    if (absent) {
+      ended = true;
+      continue;
+    }
+    if (ended) return DecodeStatus::out_of_range;  // a segment after one the robot lacks
+    if (const DecodeStatus s = decode(part, out.segments[out.segment_count]); s != DecodeStatus::ok) return s;
+    ++out.segment_count;
+  }
+  f = out;
+  return DecodeStatus::ok;
+}
+
 }  // namespace cdcr::firmware::protocol
