@@ -138,10 +138,9 @@ void Runtime::run_cycle(const hal::TimerTick& tick, CycleInputs* inputs) {
 }
 
 // A bus's frames of this cycle, after `frames` already counted against its bound.
-int Runtime::receive_frames(hal::CanBus& bus, int frames) {
+void Runtime::receive_frames(hal::CanBus& bus, int frames) {
   hal::CanFrame frame;
   for (; frames < kMaxRxFramesPerCycle && bus.receive(frame) == hal::CanStatus::ok; ++frames) handle_frame(frame);
-  return frames;
 }
 
 // Between two cycles' work: the request being solved was for the old

@@ -20,7 +20,6 @@ class Outbox {
 
   void send(const hal::CanFrame& frame) { send_on(host_, frame); }
   void send_to_drives(const hal::CanFrame& frame) { send_on(drives_, frame); }
-  bool host_fd() const { return host_.fd(); }
   bool drives_fd() const { return drives_.fd(); }
 
   void record_event(FaultCode code, FaultDetail detail = FaultDetail()) {

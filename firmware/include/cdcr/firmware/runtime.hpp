@@ -176,7 +176,7 @@ class Runtime {
   void update_pose();
   void publish_pose();
   void publish_fd_pose();
-  int receive_frames(hal::CanBus& bus, int frames);
+  void receive_frames(hal::CanBus& bus, int frames);
   void publish_uncertainty();
   protocol::PoseUncertainty uncertainty_frame() const;
   void publish_status();
