@@ -3,8 +3,10 @@
 // decode exactly the frames the runtime packs. The build runs it; nobody
 // edits its output.
 //
-// Usage: cdcr_write_dbc <out.dbc> [--id-base BASE]
+// Usage: cdcr_write_dbc <out.dbc> [--fd] [--id-base BASE]
 //
+// --fd writes the database of a CAN FD bus: every message as an FD frame,
+// and the FD messages (POSE_FD, TARGET_FD, CABLE_SETPOINTS_FD) after them.
 // BASE (decimal or 0x-hexadecimal; default 0x100) moves every identifier
 // with the protocol's window (messages.hpp, kDefaultIdBase): the DBC of a
 // runtime started with that base. The file is written to a temporary name
@@ -18,6 +20,7 @@
 #include <sstream>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include "cdcr/firmware/protocol/message_codec.hpp"
 #include "cdcr/firmware/protocol/messages.hpp"
@@ -76,63 +79,148 @@ void check_notes(const MessageNotes& notes) {
   }
 }
 
-void write_signal(std::ostream& out, const SignalSpec& signal, const char* receiver) {
-  out << " SG_ " << signal.name << " : " << int(signal.start_bit) << '|' << int(signal.length_bits) << '@'
-      << kDbcIntelByteOrder << (signal.is_signed ? '-' : '+') << " (" << dbc_number(signal.factor) << ','
-      << dbc_number(signal.offset) << ") [" << dbc_number(signal.minimum) << '|' << dbc_number(signal.maximum)
-      << "] " << quoted(signal.unit, signal.name) << ' ' << receiver << '\n';
+// One message as the DBC lists it: a classical message at one of its
+// identifiers, or an FD message whose signals are its parts' signals moved
+// to their parts' bytes.
+struct DbcSignal {
+  const SignalSpec* spec;
+  std::string name;
+  int start_bit;
+  const char* note;  // "" without a CM_ SG_
+};
+
+struct DbcMessage {
+  std::uint32_t id;
+  std::string name;
+  int bytes;
+  const char* sender;
+  const char* receiver;
+  std::string comment;
+  std::vector<DbcSignal> signals;
+};
+
+const char* note_of(const MessageNotes& notes, const SignalSpec* signal) {
+  for (const SignalNote& note : notes.signals) {
+    if (note.signal == signal) return note.text;
+  }
+  return "";
 }
 
-void write_dbc(std::ostream& out, std::uint32_t base) {
-  const std::uint32_t shift = id_offset(base);
-  const auto on_bus = [shift](std::uint32_t id) { return hal::ShiftedCanBus::shifted(id, shift); };
-  out << "VERSION " << quoted(kDbcVersion, "VERSION") << "\n\n";
-  out << "NS_ :\n\nBS_:\n\nBU_:";
-  for (const char* node : kDbcNodes) out << ' ' << node;
-  out << "\n\n";
+const MessageNotes& notes_of(const MessageSpec* message) {
+  for (const MessageNotes* notes : kMessageNotes) {
+    if (notes->message == message) return *notes;
+  }
+  throw std::runtime_error(std::string(message->name) + ": a part with no notes in kMessageNotes");
+}
 
+std::vector<DbcMessage> classical_messages() {
+  std::vector<DbcMessage> messages;
   for (const MessageNotes* notes : kMessageNotes) {
     check_notes(*notes);
     const MessageSpec* message = notes->message;
     for (int i = 0; i < message->id_count; ++i) {
-      out << "BO_ " << on_bus(message->id + i) << ' ' << frame_name(*message, i) << ": " << int(message->dlc) << ' '
-          << message->sender << '\n';
-      for (const SignalSpec* signal : message->signals) write_signal(out, *signal, notes->receiver);
-      out << '\n';
+      DbcMessage out{message->id + std::uint32_t(i), frame_name(*message, i), message->dlc, message->sender,
+                     notes->receiver,  with_segment(notes->comment, i),   {}};
+      for (const SignalSpec* signal : message->signals) {
+        out.signals.push_back({signal, signal->name, signal->start_bit, note_of(*notes, signal)});
+      }
+      messages.push_back(std::move(out));
     }
+  }
+  return messages;
+}
+
+// Part k's signals are named after its message (POSE_UNCERTAINTY_FLAGS), a
+// per-segment part's after its place in the frame (CABLE_SETPOINT_2_L1: the
+// frame's third segment), and sit 64 k bits further.
+std::vector<DbcMessage> fd_messages() {
+  std::vector<DbcMessage> messages;
+  for (const FdMessageNotes* notes : kFdMessageNotes) {
+    const FdMessageSpec* message = notes->message;
+    for (int i = 0; i < message->id_count; ++i) {
+      DbcMessage out{message->id + std::uint32_t(i),
+                     message->id_count == 1 ? message->name : message->name + std::string("_") + std::to_string(i),
+                     message->length, message->sender, notes->receiver, notes->comment, {}};
+      for (int k = 0; k < message->part_count; ++k) {
+        const MessagePart& part = message->parts[k];
+        const MessageNotes& part_notes = notes_of(part.message);
+        const std::string prefix = std::string(part.message->name) + "_" +
+                                   (part.message->id_count > 1 ? std::to_string(k) + "_" : std::string());
+        for (const SignalSpec* signal : part.message->signals) {
+          out.signals.push_back({signal, prefix + signal->name, signal->start_bit + 8 * kPartBytes * k,
+                                 note_of(part_notes, signal)});
+        }
+      }
+      messages.push_back(std::move(out));
+    }
+  }
+  return messages;
+}
+
+void write_signal(std::ostream& out, const DbcSignal& signal, const char* receiver) {
+  const SignalSpec& spec = *signal.spec;
+  out << " SG_ " << signal.name << " : " << signal.start_bit << '|' << int(spec.length_bits) << '@'
+      << kDbcIntelByteOrder << (spec.is_signed ? '-' : '+') << " (" << dbc_number(spec.factor) << ','
+      << dbc_number(spec.offset) << ") [" << dbc_number(spec.minimum) << '|' << dbc_number(spec.maximum) << "] "
+      << quoted(spec.unit, signal.name) << ' ' << receiver << '\n';
+}
+
+// The classical database, or with `fd` that of a CAN FD bus: every message
+// an FD frame (the runtime sends every frame of such a bus as one), and the
+// FD messages after the classical ones.
+void write_dbc(std::ostream& out, std::uint32_t base, bool fd) {
+  const std::uint32_t shift = id_offset(base);
+  const auto on_bus = [shift](std::uint32_t id) { return hal::ShiftedCanBus::shifted(id, shift); };
+  std::vector<DbcMessage> messages = classical_messages();
+  if (fd) {
+    for (DbcMessage& message : fd_messages()) messages.push_back(std::move(message));
+  }
+
+  out << "VERSION " << quoted(kDbcVersion, "VERSION") << "\n\n";
+  out << "NS_ :\n\nBS_:\n\nBU_:";
+  for (const char* node : kDbcNodes) out << ' ' << node;
+  out << "\n\n";
+  for (const DbcMessage& message : messages) {
+    out << "BO_ " << on_bus(message.id) << ' ' << message.name << ": " << message.bytes << ' ' << message.sender
+        << '\n';
+    for (const DbcSignal& signal : message.signals) write_signal(out, signal, message.receiver);
+    out << '\n';
   }
 
   out << "CM_ " << quoted(kDbcComment, "the database comment") << ";\n";
-  for (const MessageNotes* notes : kMessageNotes) {
-    const MessageSpec* message = notes->message;
-    for (int i = 0; i < message->id_count; ++i) {
-      const std::uint32_t id = on_bus(message->id + i);
-      const std::string name = frame_name(*message, i);
-      if (*notes->comment != '\0') {
-        out << "CM_ BO_ " << id << ' ' << quoted(with_segment(notes->comment, i), name) << ";\n";
-      }
-      // In the signals' order, whatever the order of the notes.
-      for (const SignalSpec* signal : message->signals) {
-        for (const SignalNote& note : notes->signals) {
-          if (note.signal != signal) continue;
-          out << "CM_ SG_ " << id << ' ' << signal->name << ' ' << quoted(note.text, name + "." + signal->name)
-              << ";\n";
-        }
-      }
+  for (const DbcMessage& message : messages) {
+    if (!message.comment.empty()) {
+      out << "CM_ BO_ " << on_bus(message.id) << ' ' << quoted(message.comment, message.name) << ";\n";
+    }
+    for (const DbcSignal& signal : message.signals) {
+      if (*signal.note == '\0') continue;
+      out << "CM_ SG_ " << on_bus(message.id) << ' ' << signal.name << ' '
+          << quoted(signal.note, message.name + "." + signal.name) << ";\n";
     }
   }
 
-  for (const MessageSpec* message : kMessages) {
-    for (int i = 0; i < message->id_count; ++i) {
-      for (const SignalSpec* signal : message->signals) {
-        if (signal->values.count == 0) continue;
-        out << "VAL_ " << on_bus(message->id + i) << ' ' << signal->name;
-        for (int k = 0; k < signal->values.count; ++k) {
-          out << ' ' << signal->values.entries[k].value << ' '
-              << quoted(signal->values.entries[k].name, signal->name);
-        }
-        out << " ;\n";
+  if (fd) {
+    // Vector's attributes for an FD database, as CANdb++, cantools and
+    // canmatrix read them: 14 is StandardCAN_FD.
+    out << "BA_DEF_  \"BusType\" STRING ;\n";
+    out << "BA_DEF_ BO_  \"VFrameFormat\" ENUM  \"StandardCAN\",\"ExtendedCAN\",\"reserved\",\"J1939PG\","
+           "\"reserved\",\"reserved\",\"reserved\",\"reserved\",\"reserved\",\"reserved\",\"reserved\",\"reserved\","
+           "\"reserved\",\"reserved\",\"StandardCAN_FD\",\"ExtendedCAN_FD\";\n";
+    out << "BA_DEF_DEF_  \"BusType\" \"CAN FD\";\n";
+    out << "BA_DEF_DEF_  \"VFrameFormat\" \"StandardCAN_FD\";\n";
+    out << "BA_ \"BusType\" \"CAN FD\";\n";
+    for (const DbcMessage& message : messages) out << "BA_ \"VFrameFormat\" BO_ " << on_bus(message.id) << " 14;\n";
+  }
+
+  for (const DbcMessage& message : messages) {
+    for (const DbcSignal& signal : message.signals) {
+      const SignalSpec& spec = *signal.spec;
+      if (spec.values.count == 0) continue;
+      out << "VAL_ " << on_bus(message.id) << ' ' << signal.name;
+      for (int k = 0; k < spec.values.count; ++k) {
+        out << ' ' << spec.values.entries[k].value << ' ' << quoted(spec.values.entries[k].name, signal.name);
       }
+      out << " ;\n";
     }
   }
 }
@@ -142,27 +230,37 @@ void write_dbc(std::ostream& out, std::uint32_t base) {
 
 int main(int argc, char** argv) {
   using cdcr::firmware::protocol::is_valid_id_base;
+  const char* usage = "usage: cdcr_write_dbc <out.dbc> [--fd] [--id-base BASE]\n";
   std::uint32_t base = cdcr::firmware::protocol::kDefaultIdBase;
-  const bool with_base = argc == 4 && std::string(argv[2]) == "--id-base";
-  if (argc != 2 && !with_base) {
-    std::cerr << "usage: cdcr_write_dbc <out.dbc> [--id-base BASE]\n";
+  bool fd = false;
+  if (argc < 2) {
+    std::cerr << usage;
     return 2;
   }
-  if (with_base) {
-    char* end = nullptr;
-    const unsigned long value = std::strtoul(argv[3], &end, 0);
-    if (end == argv[3] || *end != '\0' || value > 0x7FF || !is_valid_id_base(static_cast<std::uint32_t>(value))) {
-      std::cerr << "cdcr_write_dbc: error: --id-base must be a multiple of 8 from 0 to 0x780, got '" << argv[3]
-                << "'\n";
+  for (int i = 2; i < argc; ++i) {
+    const std::string option = argv[i];
+    if (option == "--fd") {
+      fd = true;
+    } else if (option == "--id-base" && i + 1 < argc) {
+      const char* text = argv[++i];
+      char* end = nullptr;
+      const unsigned long value = std::strtoul(text, &end, 0);
+      if (end == text || *end != '\0' || value > 0x7FF || !is_valid_id_base(static_cast<std::uint32_t>(value))) {
+        std::cerr << "cdcr_write_dbc: error: --id-base must be a multiple of 8 from 0 to 0x780, got '" << text
+                  << "'\n";
+        return 2;
+      }
+      base = static_cast<std::uint32_t>(value);
+    } else {
+      std::cerr << usage;
       return 2;
     }
-    base = static_cast<std::uint32_t>(value);
   }
   const std::string path = argv[1];
   const std::string temporary = path + ".tmp";
   try {
     std::ostringstream text;
-    cdcr::firmware::protocol::write_dbc(text, base);
+    cdcr::firmware::protocol::write_dbc(text, base, fd);
     std::ofstream out(temporary, std::ios::binary);
     out << text.str();
     out.close();

@@ -405,6 +405,161 @@ TEST(GoldenFrames, UpdateReport) {
   EXPECT_EQ(report.active_sequence, 0x7E);
 }
 
+// CAN FD frames: each part laid out as its classical message in its own 8
+// bytes (the bytes after the part's DLC 0), the frame flagged FD.
+hal::CanFrame fd_frame_of(std::uint32_t id, const Bytes& bytes) {
+  hal::CanFrame frame = frame_of(id, bytes);
+  frame.flags = hal::kCanFdFrame;
+  return frame;
+}
+
+Bytes joined(std::initializer_list<Bytes> parts) {
+  Bytes bytes;
+  for (const Bytes& part : parts) {
+    Bytes padded = part;
+    padded.resize(8, 0x00);
+    bytes.insert(bytes.end(), padded.begin(), padded.end());
+  }
+  return bytes;
+}
+
+template <typename Message>
+void expect_fd_encodes_to(const Message& message, std::uint32_t id, const Bytes& bytes) {
+  expect_encodes_to(message, id, bytes);
+  hal::CanFrame frame;
+  encode(message, frame);
+  EXPECT_EQ(frame.flags, hal::kCanFdFrame);
+}
+
+template <typename Message>
+Message fd_decoded(std::uint32_t id, const Bytes& bytes) {
+  SCOPED_TRACE("decoding golden FD frame " + golden_name(id, bytes));
+  Message message;
+  EXPECT_STREQ(to_string(decode(fd_frame_of(id, bytes), message)), to_string(DecodeStatus::ok));
+  // The same bytes as a classical frame, or a byte cut off, are refused.
+  EXPECT_STREQ(to_string(decode(frame_of(id, bytes), message)), to_string(DecodeStatus::wrong_dlc));
+  Bytes shorter(bytes.begin(), bytes.end() - 8);
+  EXPECT_STREQ(to_string(decode(fd_frame_of(id, shorter), message)), to_string(DecodeStatus::wrong_dlc));
+  return message;
+}
+
+// 0x134, 32 bytes: POSE_POSITION_XY, POSE_POSITION_Z, POSE_ORIENTATION,
+// POSE_UNCERTAINTY in bytes 0, 8, 16, 24; FLAGS bit 2 says the last holds radii.
+TEST(GoldenFrames, PoseFd) {
+  // The golden parts above; FLAGS 0x07 (compensated, extrapolating, radii).
+  const Bytes with_radii = joined({{0x13, 0x68, 0xF9, 0xFF, 0x66, 0x56, 0x01, 0x00},
+                                   {0x25, 0x49, 0x00, 0x00, 0x07, 0x81},
+                                   {0x66, 0x66, 0xCD, 0xCC, 0x99, 0x19, 0x33, 0x33},
+                                   {0xC4, 0x09, 0x39, 0x30, 0x46, 0x02, 0xEE}});
+  PoseFd sent{{-4321.09, 876.54}, {187.25, true, 0x81}, {0.8, -0.4, 0.2, 0.4}, {}};
+  sent.position_z.extrapolating = true;
+  sent.position_z.radii = true;
+  sent.uncertainty.r95_position_mm = 2.5;
+  sent.uncertainty.r95_orientation_deg = 12.345;
+  sent.uncertainty.latent_share = 0.35;
+  sent.uncertainty.outside_range = true;
+  sent.uncertainty.sequence = 0xEE;
+  expect_fd_encodes_to(sent, 0x134, with_radii);
+  auto pose = fd_decoded<PoseFd>(0x134, with_radii);
+  expect_physical(pose.position_xy.x_mm, -4321.09);
+  expect_physical(pose.position_xy.y_mm, 876.54);
+  expect_physical(pose.position_z.z_mm, 187.25);
+  EXPECT_TRUE(pose.position_z.compensated);
+  EXPECT_TRUE(pose.position_z.extrapolating);
+  EXPECT_TRUE(pose.position_z.radii);
+  EXPECT_EQ(pose.position_z.sequence, 0x81);
+  expect_physical(pose.orientation.qw, 26214.0 / 32767);
+  expect_physical(pose.orientation.qz, 13107.0 / 32767);
+  expect_physical(pose.uncertainty.r95_position_mm, 2.5);
+  expect_physical(pose.uncertainty.r95_orientation_deg, 12.345);
+  EXPECT_TRUE(pose.uncertainty.outside_range);
+  EXPECT_EQ(pose.uncertainty.sequence, 0xEE);
+
+  // Without radii: FLAGS 0x01 and the uncertainty part 0, whatever it held.
+  const Bytes without_radii = joined({{0x13, 0x68, 0xF9, 0xFF, 0x66, 0x56, 0x01, 0x00},
+                                      {0x25, 0x49, 0x00, 0x00, 0x01, 0x81},
+                                      {0x66, 0x66, 0xCD, 0xCC, 0x99, 0x19, 0x33, 0x33},
+                                      {}});
+  sent.position_z.extrapolating = false;
+  sent.position_z.radii = false;
+  expect_fd_encodes_to(sent, 0x134, without_radii);
+  pose = fd_decoded<PoseFd>(0x134, without_radii);
+  EXPECT_FALSE(pose.position_z.radii);
+  EXPECT_EQ(pose.uncertainty.r95_position_mm, 0.0);
+
+  // A reserved byte of a part set: refused.
+  Bytes reserved = with_radii;
+  reserved[8 + 6] = 0x01;  // POSE_POSITION_Z has 6 bytes
+  PoseFd refused;
+  EXPECT_EQ(decode(fd_frame_of(0x134, reserved), refused), DecodeStatus::reserved_bits_set);
+}
+
+// 0x123, 24 bytes: TARGET_ORIENTATION, TARGET_POSITION_XY, TARGET_POSITION_Z.
+TEST(GoldenFrames, TargetFd) {
+  const Bytes bytes = joined({{0xCD, 0x0C, 0x99, 0x59, 0x33, 0xF3, 0x67, 0xA6},
+                              {0x4E, 0x61, 0xBC, 0x00, 0xC1, 0x4B, 0x69, 0xFF},
+                              {0x26, 0x9E, 0xFF, 0xFF, 0x05, 0x5A}});
+  TargetFd sent{{0.1, 0.7, -0.1, -0.7}, {123456.78, -98765.43}, {-250.5, TargetMode::pose, false, 0x5A}};
+  sent.position_z.refuse_extrapolating = true;
+  expect_fd_encodes_to(sent, 0x123, bytes);
+  const auto target = fd_decoded<TargetFd>(0x123, bytes);
+  expect_physical(target.orientation.qx, 22937.0 / 32767);
+  expect_physical(target.position_xy.x_mm, 123456.78);
+  expect_physical(target.position_xy.y_mm, -98765.43);
+  expect_physical(target.position_z.z_mm, -250.5);
+  EXPECT_EQ(target.position_z.mode, TargetMode::pose);
+  EXPECT_TRUE(target.position_z.refuse_extrapolating);
+  EXPECT_EQ(target.position_z.sequence, 0x5A);
+}
+
+// 0x118 + g, 32 bytes: CABLE_SETPOINT of segments 4g .. 4g + 3; a segment
+// the robot lacks has every length 65535.
+TEST(GoldenFrames, CableSetpointsFd) {
+  // A six-segment robot's second frame, 0x119: segments 4 and 5, then two absent.
+  const Bytes bytes = joined({{0x10, 0x27, 0x39, 0x30, 0x01, 0x00, 0xFE, 0xFF},
+                              {0x32, 0x00, 0xE4, 0x57, 0x31, 0x75, 0x92, 0x10},
+                              {0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF},
+                              {0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF, 0xFF}});
+  CableSetpointsFd sent;
+  sent.index = 1;
+  sent.segment_count = 2;
+  sent.segments[0] = CableSetpoint{4, {100.0, 123.45, 0.01, 655.34}};
+  sent.segments[1] = CableSetpoint{5, {0.5, 225.0, 300.01, 42.42}};
+  expect_fd_encodes_to(sent, 0x119, bytes);
+  const auto setpoints = fd_decoded<CableSetpointsFd>(0x119, bytes);
+  EXPECT_EQ(setpoints.index, 1);
+  ASSERT_EQ(setpoints.segment_count, 2);
+  EXPECT_EQ(setpoints.segments[0].segment, 4);
+  EXPECT_EQ(setpoints.segments[1].segment, 5);
+  expect_physical(setpoints.segments[0].lengths_mm[1], 123.45);
+  expect_physical(setpoints.segments[1].lengths_mm[3], 42.42);
+}
+
+bool passes(const hal::CanFilter& filter, std::uint32_t id) { return (id & filter.mask) == (filter.id & filter.mask); }
+
+// The FD frames' identifiers: in the frame groups the runtime's filters
+// pass (the host's targets, the pose, the drives' setpoints), and every FD
+// message has a golden frame above.
+TEST(GoldenFrames, FdMessagesSitInTheirFrameGroups) {
+  EXPECT_TRUE(passes(kTargetFrames, 0x123));
+  EXPECT_TRUE(passes(kPoseFrames, 0x134));
+  EXPECT_TRUE(passes(kCableSetpointsFdFrames, 0x118));
+  EXPECT_TRUE(passes(kCableSetpointsFdFrames, 0x119));
+  EXPECT_FALSE(passes(kCableSetpointsFdFrames, 0x110));  // CABLE_SETPOINT_0
+  EXPECT_FALSE(passes(kCableFeedbackFrames, 0x118));
+  for (const FdMessageSpec* message : kFdMessages) {
+    SCOPED_TRACE(message->name);
+    EXPECT_TRUE(passes(message->group, message->id));
+    EXPECT_TRUE(passes(message->group, message->id + message->id_count - 1u));
+  }
+  constexpr std::uint32_t kGoldenFdIds[] = {0x119, 0x123, 0x134};
+  for (const FdMessageSpec* message : kFdMessages) {
+    const bool covered = std::any_of(std::begin(kGoldenFdIds), std::end(kGoldenFdIds),
+                                     [&](std::uint32_t id) { return message->carries(id); });
+    EXPECT_TRUE(covered) << message->name << " has no golden frame";
+  }
+}
+
 // A message added to the table needs its golden frame above.
 TEST(GoldenFrames, EveryMessageOfTheTableHasOne) {
   constexpr std::uint32_t kGoldenIds[] = {0x102, 0x117, 0x120, 0x121, 0x122, 0x130, 0x131, 0x132, 0x133,
@@ -435,6 +590,7 @@ class RecordingBus final : public hal::CanBus {
     return true;
   }
   hal::CanErrorCounters error_counters() const override { return {}; }
+  bool fd_capable() const override { return true; }
 
   std::vector<hal::CanFrame> sent, incoming;
   std::vector<hal::CanFilter> filters;
@@ -477,6 +633,15 @@ TEST(GoldenFrames, AtIdentifierBase0x300EveryFrameMovesWithTheWindow) {
   EXPECT_EQ(wire.filters[0].mask, 0x7F8u);
   EXPECT_EQ(wire.filters[1].id, 0x320u);
   EXPECT_EQ(wire.filters[2].id, 0x370u);
+
+  // An FD frame moves with the window too, and keeps its flags: POSE_FD
+  // 0x134 -> 0x334.
+  PoseFd pose;
+  encode(pose, frame);
+  ASSERT_EQ(bus.send(frame), hal::CanStatus::ok);
+  EXPECT_EQ(wire.sent.back().id, 0x334u);
+  EXPECT_EQ(wire.sent.back().flags, hal::kCanFdFrame);
+  EXPECT_EQ(wire.sent.back().dlc, 32);
 }
 
 }  // namespace

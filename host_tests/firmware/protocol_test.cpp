@@ -50,6 +50,8 @@ struct Dbc {
   std::map<std::uint32_t, DbcMessage> messages;
   std::map<std::pair<std::uint32_t, std::string>, ValueMap> value_tables;      // VAL_
   std::map<std::pair<std::uint32_t, std::string>, std::string> signal_notes;  // CM_ SG_
+  std::map<std::uint32_t, int> frame_formats;                                  // BA_ "VFrameFormat"
+  std::string bus_type;                                                        // BA_ "BusType"
 };
 
 ValueMap parse_values(const std::string& text) {
@@ -70,6 +72,8 @@ Dbc read_dbc(const std::string& path) {
   const std::regex nodes(R"re(^BU_:((?: \w+)*)\s*$)re");
   const std::regex value_table(R"re(^VAL_ (\d+) (\w+) ((?:\d+ "[^"]*" )*);\s*$)re");
   const std::regex signal_note(R"re(^CM_ SG_ (\d+) (\w+) "([^"]*)";\s*$)re");
+  const std::regex frame_format(R"re(^BA_ "VFrameFormat" BO_ (\d+) (\d+);\s*$)re");
+  const std::regex bus_type(R"re(^BA_ "BusType" "([^"]*)";\s*$)re");
   Dbc dbc;
   DbcMessage* current = nullptr;
   std::string line;
@@ -97,11 +101,16 @@ Dbc read_dbc(const std::string& path) {
       dbc.value_tables[{static_cast<std::uint32_t>(std::stoul(m[1])), m[2]}] = parse_values(m[3]);
     } else if (std::regex_match(line, m, signal_note)) {
       dbc.signal_notes[{static_cast<std::uint32_t>(std::stoul(m[1])), m[2]}] = m[3];
+    } else if (std::regex_match(line, m, frame_format)) {
+      dbc.frame_formats[static_cast<std::uint32_t>(std::stoul(m[1]))] = std::stoi(m[2]);
+    } else if (std::regex_match(line, m, bus_type)) {
+      dbc.bus_type = m[1];
     } else {
       EXPECT_EQ(line.rfind(" SG_", 0), std::string::npos) << "unparsed signal line: " << line;
       EXPECT_EQ(line.rfind("BO_ ", 0), std::string::npos) << "unparsed message line: " << line;
       EXPECT_EQ(line.rfind("VAL_ ", 0), std::string::npos) << "unparsed value table: " << line;
       EXPECT_EQ(line.rfind("CM_ SG_", 0), std::string::npos) << "unparsed signal comment: " << line;
+      EXPECT_EQ(line.rfind("BA_ ", 0), std::string::npos) << "unparsed attribute: " << line;
     }
   }
   return dbc;
@@ -261,6 +270,97 @@ TEST(DbcAgreesWithTheCodec, SendersAndReceiversAreDeclaredNodes) {
       EXPECT_GE(count, 1) << name << " has no receiver";
     }
   }
+}
+
+void expect_signal(const DbcSignal& dbc_signal, const SignalSpec& spec, int start_bit) {
+  EXPECT_EQ(dbc_signal.start_bit, start_bit);
+  EXPECT_EQ(dbc_signal.length_bits, spec.length_bits);
+  EXPECT_EQ(dbc_signal.byte_order, kDbcIntelByteOrder);
+  EXPECT_EQ(dbc_signal.is_signed, spec.is_signed);
+  EXPECT_EQ(dbc_signal.factor, spec.factor);
+  EXPECT_EQ(dbc_signal.offset, spec.offset);
+  EXPECT_EQ(dbc_signal.minimum, spec.minimum);
+  EXPECT_EQ(dbc_signal.maximum, spec.maximum);
+  EXPECT_EQ(dbc_signal.unit, spec.unit);
+}
+
+const Dbc& fd_dbc() {
+  static const Dbc parsed = read_dbc(CDCR_FD_DBC_PATH);
+  return parsed;
+}
+
+// The classical DBC says nothing of frame formats: a reader takes its
+// frames as classical ones.
+TEST(FdDbc, TheClassicalDbcHasNoFdAttributes) {
+  EXPECT_TRUE(dbc().frame_formats.empty());
+  EXPECT_TRUE(dbc().bus_type.empty());
+}
+
+// The FD bus's DBC: the classical DBC's messages, each an FD frame
+// (VFrameFormat 14, StandardCAN_FD), then the FD messages.
+TEST(FdDbc, HoldsEveryClassicalMessageAsAnFdFrame) {
+  EXPECT_EQ(fd_dbc().bus_type, "CAN FD");
+  for (const auto& [id, message] : dbc().messages) {
+    SCOPED_TRACE(message.name);
+    ASSERT_EQ(fd_dbc().messages.count(id), 1u);
+    const DbcMessage& fd = fd_dbc().messages.at(id);
+    EXPECT_EQ(fd.name, message.name);
+    EXPECT_EQ(fd.dlc, message.dlc);
+    EXPECT_EQ(fd.sender, message.sender);
+    ASSERT_EQ(fd.signals.size(), message.signals.size());
+    for (const auto& [name, signal] : message.signals) {
+      ASSERT_EQ(fd.signals.count(name), 1u) << name;
+      EXPECT_EQ(fd.signals.at(name).start_bit, signal.start_bit) << name;
+    }
+  }
+  for (const auto& [id, message] : fd_dbc().messages) {
+    EXPECT_EQ(fd_dbc().frame_formats.count(id) ? fd_dbc().frame_formats.at(id) : -1, 14) << message.name;
+  }
+  EXPECT_EQ(fd_dbc().frame_formats.size(), fd_dbc().messages.size());
+}
+
+// Each FD message at each of its identifiers, its length, its sender, and
+// part k's signals 64 k bits into the frame under the part's name
+// (<MESSAGE>_<SIGNAL>, a per-segment part <MESSAGE>_<k>_<SIGNAL>), with
+// the part's value tables.
+TEST(FdDbc, DescribesEachFdMessageAsItsPartsAtTheirBytes) {
+  std::size_t fd_frames = 0;
+  for (const FdMessageSpec* spec : kFdMessages) {
+    for (int i = 0; i < spec->id_count; ++i) {
+      ++fd_frames;
+      const std::string name = spec->id_count == 1 ? spec->name : spec->name + std::string("_") + std::to_string(i);
+      SCOPED_TRACE(name);
+      const std::uint32_t id = spec->id + std::uint32_t(i);
+      ASSERT_EQ(fd_dbc().messages.count(id), 1u);
+      const DbcMessage& message = fd_dbc().messages.at(id);
+      EXPECT_EQ(message.name, name);
+      EXPECT_EQ(message.dlc, spec->length);
+      EXPECT_EQ(message.sender, spec->sender);
+      std::size_t signals = 0;
+      for (int k = 0; k < spec->part_count; ++k) {
+        const MessageSpec& part = *spec->parts[k].message;
+        const std::string prefix =
+            std::string(part.name) + "_" + (part.id_count > 1 ? std::to_string(k) + "_" : std::string());
+        for (const SignalSpec* s : part.signals) {
+          ++signals;
+          SCOPED_TRACE(prefix + s->name);
+          const auto found = message.signals.find(prefix + s->name);
+          if (found == message.signals.end()) {
+            ADD_FAILURE() << "signal not in the FD DBC";
+            continue;
+          }
+          expect_signal(found->second, *s, s->start_bit + 64 * k);
+          if (s->values.count > 0) {
+            const auto table = fd_dbc().value_tables.find({id, prefix + s->name});
+            ASSERT_NE(table, fd_dbc().value_tables.end()) << "no VAL_";
+            EXPECT_EQ(table->second, codec_values(*s));
+          }
+        }
+      }
+      EXPECT_EQ(message.signals.size(), signals);
+    }
+  }
+  EXPECT_EQ(fd_dbc().messages.size(), dbc().messages.size() + fd_frames);
 }
 
 // The FAULT_DETAIL comment says, for every fault code that carries a
