@@ -17,8 +17,9 @@ declare -A package_groups=(
   [fuzz]="clang libclang-rt-14-dev llvm-14"
   # Real SocketCAN tests (ctest -L socketcan): the host kernel may lack AF_CAN,
   # so they boot a User-Mode Linux kernel that has can, can-raw and vcan as
-  # modules, and drive the bus with can-utils.
-  [uml]="user-mode-linux kmod iproute2 can-utils"
+  # modules, and drive the bus with can-utils; the CAN FD test's client is
+  # python-can with the DBC read by canmatrix.
+  [uml]="user-mode-linux kmod iproute2 can-utils python3-can python3-canmatrix"
   # Cortex-M cross builds and their tests on QEMU's MPS2 boards (ctest -L qemu).
   [cross]="gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm"
 )

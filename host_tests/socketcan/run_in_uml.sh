@@ -1,12 +1,13 @@
 #!/usr/bin/env bash
 # Boots User-Mode Linux on the host's own root filesystem (hostfs) and runs
 # the bus test inside it, so it needs no CAN support in the host kernel.
-#   run_in_uml.sh <linux.uml> <runtime> <checker> <work dir> [driver [cdcr]]
-#   driver: the script the guest runs (bus_test.sh), cdcr: the CLI (deploy_test.sh)
+#   run_in_uml.sh <linux.uml> <runtime> <checker> <work dir> [driver [cdcr [extra]]]
+#   driver: the script the guest runs (bus_test.sh), cdcr: the CLI (deploy_test.sh),
+#   extra: a file the driver reads (fd_bus_test.sh: the FD DBC)
 #   CDCR_UML_TIMEOUT: seconds the whole guest may run (default 600)
 #   CDCR_WAIT_SECONDS: passed to the driver (bus_test.sh)
 set -uo pipefail
-uml=$1 runtime=$2 checker=$3 work=$4 driver=${5:-bus_test.sh} cli=${6:-}
+uml=$1 runtime=$2 checker=$3 work=$4 driver=${5:-bus_test.sh} cli=${6:-} extra=${7:-}
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 mkdir -p "$work"
 console=$work/console.log
@@ -49,7 +50,7 @@ for ((boot = 1; boot <= boots; boot++)); do
   # UML aborts without HOME.
   HOME=${HOME:-$work} TMPDIR=$uml_tmp setsid -w "$uml" mem=512M root=/dev/root rootfstype=hostfs rootflags=/ rw \
     init="$here/uml_init.sh" con0=null,fd:1 con=null quiet \
-    CDCR_TEST_DRIVER="$here/$driver" CDCR_CLI="$cli" CDCR_RUNTIME="$runtime" CDCR_CHECK="$checker" CDCR_WORK_DIR="$work" \
+    CDCR_TEST_DRIVER="$here/$driver" CDCR_CLI="$cli" CDCR_EXTRA="$extra" CDCR_RUNTIME="$runtime" CDCR_CHECK="$checker" CDCR_WORK_DIR="$work" \
     CDCR_WAIT_SECONDS="${CDCR_WAIT_SECONDS:-60}" \
     </dev/null >"$console" 2>&1 &
   guest_pid=$!

@@ -5,6 +5,8 @@
 //   socketcan_check image <out.img>
 //   socketcan_check frames <image>            shell assignments for the driver
 //   socketcan_check check <image> <candump log>
+//   socketcan_check fd-values <image>         the FD test's physical values (fd_client.py)
+//   socketcan_check fd-check <image> <summary>  fd_client.py's poses and setpoints
 //
 // The log is cut into phases by marker frames (id 0x7F0, one byte: the phase
 // number) that the driver sends between the steps of the test.
@@ -494,6 +496,75 @@ int check(const Model& m, const std::string& log_path) {
   return c.failures() == 0 ? 0 : 1;
 }
 
+// The FD test's client encodes from physical values with the DBC: the
+// feedback lengths and the target as on the bus (0.01 mm).
+int print_fd_values(const Model& m) {
+  const model::CableVector<double> cables = feedback_cables(m);
+  std::printf("SEGMENTS=%d\n", m.geometry.segment_count);
+  for (int s = 0; s < m.geometry.segment_count; ++s) {
+    std::printf("FEEDBACK_MM_%d=%.2f %.2f %.2f %.2f\n", s, cables[4 * s], cables[4 * s + 1], cables[4 * s + 2],
+                cables[4 * s + 3]);
+  }
+  const model::Vec3<double> target = target_position_mm(m);
+  std::printf("TARGET_MM=%.2f %.2f %.2f\n", target.x(), target.y(), target.z());
+  return 0;
+}
+
+// fd_client.py's summary: "pose x y z qw qx qy qz" per compensated POSE_FD,
+// then "setpoints" with every cable's last commanded length. Every pose
+// must be compensated_forward of the feedback, and the setpoints must reach
+// the streamed target.
+int check_fd(const Model& m, const std::string& summary_path) {
+  std::ifstream in(summary_path);
+  if (!in) {
+    std::fprintf(stderr, "cannot open %s\n", summary_path.c_str());
+    return 1;
+  }
+  Checker c(m);
+  model::ForwardResult<double> expected;
+  model::compensated_forward(feedback_cables(m), m.geometry, m.correction, expected);
+  const Eigen::Quaterniond reference(expected.compensated.rotation);
+  double worst_mm = 0, worst_rad = 0;
+  int poses = 0;
+  std::vector<double> setpoints;
+  std::string line;
+  while (std::getline(in, line)) {
+    std::istringstream fields(line);
+    std::string kind;
+    fields >> kind;
+    std::vector<double> numbers;
+    for (double v; fields >> v;) numbers.push_back(v);
+    if (kind == "pose" && numbers.size() == 7) {
+      const model::Vec3<double> position(numbers[0], numbers[1], numbers[2]);
+      Eigen::Quaterniond q(numbers[3], numbers[4], numbers[5], numbers[6]);
+      q.normalize();
+      worst_mm = std::max(worst_mm, (position - expected.compensated.position_mm).norm());
+      worst_rad = std::max(worst_rad, q.angularDistance(reference));
+      ++poses;
+    } else if (kind == "setpoints") {
+      setpoints = numbers;
+    } else {
+      c.expect(false, "summary line: " + line);
+    }
+  }
+  std::printf("fd: %d poses, worst position %.4f mm, worst orientation %.2e rad\n", poses, worst_mm, worst_rad);
+  c.expect(poses > 0 && worst_mm <= kPoseToleranceMm && worst_rad <= kOrientationToleranceRad,
+           "fd: POSE_FD poses match compensated_forward within quantisation");
+  const bool complete = setpoints.size() == std::size_t(4 * m.geometry.segment_count);
+  c.expect(complete, "fd: the setpoints of every segment");
+  if (complete) {
+    model::CableVector<double> lengths(setpoints.size());
+    for (std::size_t i = 0; i < setpoints.size(); ++i) lengths[Eigen::Index(i)] = setpoints[i];
+    model::ForwardResult<double> reached;
+    const model::Status s = model::compensated_forward(lengths, m.geometry, m.correction, reached);
+    const double error_mm = (reached.compensated.position_mm - target_position_mm(m)).norm();
+    std::printf("fd: setpoints reach the target within %.4f mm\n", error_mm);
+    c.expect(s == model::Status::ok && error_mm <= kSetpointReachToleranceMm, "fd: setpoints reach the target");
+  }
+  std::printf("%d check(s) failed\n", c.failures());
+  return c.failures() == 0 ? 0 : 1;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -503,13 +574,19 @@ int main(int argc, char** argv) {
     return write_image(argv[2], std::atoi(argv[3]), static_cast<std::uint32_t>(std::strtoul(argv[4], nullptr, 10)));
   }
   Model m;
-  if ((command == "frames" && argc == 3) || (command == "check" && argc == 4)) {
+  const bool with_image = ((command == "frames" || command == "fd-values") && argc == 3) ||
+                          ((command == "check" || command == "fd-check") && argc == 4);
+  if (with_image) {
     if (!load_model(argv[2], m)) {
       std::fprintf(stderr, "socketcan_check: %s: not a usable model image\n", argv[2]);
       return 1;
     }
-    return command == "frames" ? print_frames(m) : check(m, argv[3]);
+    if (command == "frames") return print_frames(m);
+    if (command == "fd-values") return print_fd_values(m);
+    return command == "check" ? check(m, argv[3]) : check_fd(m, argv[3]);
   }
-  std::fprintf(stderr, "usage: socketcan_check image <out> [points seed] | frames <image> | check <image> <candump log>\n");
+  std::fprintf(stderr,
+               "usage: socketcan_check image <out> [points seed] | frames <image> | check <image> <candump log> | "
+               "fd-values <image> | fd-check <image> <summary>\n");
   return 2;
 }
