@@ -2,9 +2,11 @@
 // The Cortex-R5F of QEMU's xlnx-zcu102 as the runtime sees it: the cycle
 // counter as clock and timer, can0 through the Xilinx CAN driver at
 // 1 Mbit/s, the model image in .cdcr_model, and the console on uart0; and,
-// around the runtime, the cycle loop's watchdog on TTC0.
+// around the runtime, the cycle loop's watchdog on TTC0. The deployable
+// program puts the drives on can1 (DrivesBus), a bus of their own.
 
 #include <cdcr/firmware/capacity.hpp>
+#include <cdcr/firmware/protocol/bus_budget.hpp>
 #include <cdcr/hal/hal.hpp>
 #include <cdcr/zynqmp/can_bit_timing.hpp>
 #include <cdcr/zynqmp/console.hpp>
@@ -16,6 +18,8 @@
 #include <cdcr/zynqmp/zcu102.hpp>
 
 namespace cdcr::boards::zcu102_r5f {
+
+namespace protocol = firmware::protocol;
 
 inline constexpr std::int64_t kCyclePeriodNs = 1'000'000;  // 1 kHz
 inline constexpr std::uint32_t kCanBitrate = 1'000'000;
@@ -59,6 +63,55 @@ inline constexpr std::int64_t kWatchdogTimeoutNs = 5 * kCyclePeriodNs;
   zynqmp::exit(zynqmp::ExitCode::watchdog_expired);
 }
 
+// The deployable program's buses: the host's traffic on can0, the drives'
+// (CABLE_FEEDBACK in, the setpoints out) on can1, both classical (the
+// ZynqMP's controllers have no CAN FD) at kCanBitrate; the runtime's
+// publish rates at their defaults, estimating at 1 kHz. QEMU's controllers
+// move frames in no time, so the load is the computed worst case only
+// (protocol/bus_budget.hpp), which the board states at start-up.
+inline constexpr int kBudgetSegments = 4;
+inline protocol::BusTraffic board_traffic() {
+  protocol::BusTraffic traffic;
+  traffic.segments = kBudgetSegments;
+  traffic.cycle_hz = static_cast<std::uint32_t>(1'000'000'000 / kCyclePeriodNs);
+  return traffic;
+}
+inline protocol::BusSetup board_bus(protocol::BusRole role) {
+  protocol::BusSetup bus;
+  bus.rates.nominal = kCanBitrate;
+  bus.role = role;
+  return bus;
+}
+
+// Prints one bus's computed worst-case load; false if it is above the limit.
+inline bool state_bus_budget(const char* name, protocol::BusRole role) {
+  const protocol::BusBudget budget = protocol::bus_budget(board_traffic(), board_bus(role));
+  zynqmp::console_write(name);
+  zynqmp::console_write(": worst case ");
+  zynqmp::console_write_fixed(100.0 * budget.load, 1);
+  zynqmp::console_write(" % of 1 Mbit/s (");
+  zynqmp::console_write_fixed(budget.frames_per_s, 0);
+  zynqmp::console_write(budget.fits() ? " frames/s), fits\n" : " frames/s), above the limit\n");
+  return budget.fits();
+}
+
+// The budget of both buses, computed, not measured: the board refuses to
+// run a configuration whose worst case does not fit.
+inline bool state_bus_budgets() {
+  zynqmp::console_write("bus budget, computed (QEMU's CAN has no bit timing): 4 segments at 1 kHz, limit ");
+  zynqmp::console_write_fixed(100.0 * firmware::kMaxBusLoad, 0);
+  zynqmp::console_write(" %\n");
+  const bool host = state_bus_budget("  can0, the host's bus", protocol::BusRole::host);
+  const bool drives = state_bus_budget("  can1, the drives' bus", protocol::BusRole::drives);
+  return host && drives;
+}
+
+// can1 for the drives, beside the Board's can0.
+struct DrivesBus {
+  zynqmp::XilinxCan<kCanRxQueueDepth> can{zynqmp::kCan1Base};
+  bool start() { return can.start(kCanTiming); }
+};
+
 struct Board {
   zynqmp::CycleCounterTimer timer{zynqmp::kQemuCycleCounterHz};
   zynqmp::XilinxCan<kCanRxQueueDepth> can{zynqmp::kCan0Base};
@@ -69,6 +122,10 @@ struct Board {
   // Brings can0 onto the bus; false if the controller does not come up.
   bool start_can() { return can.start(kCanTiming); }
   hal::Hal hal() { return hal::Hal{timer, timer, can, model_storage, console}; }
+  // With the drives on a bus of their own.
+  hal::Hal hal(DrivesBus& drives) {
+    return hal::Hal{timer, timer, can, model_storage, console, nullptr, &drives.can};
+  }
 
   // The 1 kHz releases and the watchdog, started together.
   void start_cycles() {
