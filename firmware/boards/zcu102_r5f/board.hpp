@@ -122,9 +122,10 @@ struct Board {
   // Brings can0 onto the bus; false if the controller does not come up.
   bool start_can() { return can.start(kCanTiming); }
   hal::Hal hal() { return hal::Hal{timer, timer, can, model_storage, console}; }
-  // With the drives on a bus of their own.
-  hal::Hal hal(DrivesBus& drives) {
-    return hal::Hal{timer, timer, can, model_storage, console, nullptr, &drives.can};
+  // With the drives on a bus of their own: `host` and `drives` are can0
+  // and a DrivesBus's can1, or buses over them (hal::ShiftedCanBus).
+  hal::Hal hal(hal::CanBus& host, hal::CanBus& drives) {
+    return hal::Hal{timer, timer, host, model_storage, console, nullptr, &drives};
   }
 
   // The 1 kHz releases and the watchdog, started together.
