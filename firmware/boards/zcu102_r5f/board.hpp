@@ -65,15 +65,16 @@ inline constexpr std::int64_t kWatchdogTimeoutNs = 5 * kCyclePeriodNs;
 
 // The deployable program's buses: the host's traffic on can0, the drives'
 // (CABLE_FEEDBACK in, the setpoints out) on can1, both classical (the
-// ZynqMP's controllers have no CAN FD) at kCanBitrate; the runtime's
-// publish rates at their defaults, estimating at 1 kHz. QEMU's controllers
-// move frames in no time, so the load is the computed worst case only
-// (protocol/bus_budget.hpp), which the board states at start-up.
-inline constexpr int kBudgetSegments = 4;
-inline protocol::BusTraffic board_traffic() {
+// ZynqMP's controllers have no CAN FD) at kCanBitrate, estimating at the
+// board's cycle rate. QEMU's controllers move frames in no time, so the load
+// is the computed worst case only (protocol/bus_budget.hpp), which the board
+// states at start-up for the robot the runtime loaded (the image's segments,
+// or the fallback geometry's) and the runtime's publish rates.
+inline protocol::BusTraffic board_traffic(int segments, const firmware::PublishRates& rates) {
   protocol::BusTraffic traffic;
-  traffic.segments = kBudgetSegments;
+  traffic.segments = segments;
   traffic.cycle_hz = static_cast<std::uint32_t>(1'000'000'000 / kCyclePeriodNs);
+  traffic.rates = rates;
   return traffic;
 }
 inline protocol::BusSetup board_bus(protocol::BusRole role) {
@@ -84,8 +85,9 @@ inline protocol::BusSetup board_bus(protocol::BusRole role) {
 }
 
 // Prints one bus's computed worst-case load; false if it is above the limit.
-inline bool state_bus_budget(const char* name, protocol::BusRole role) {
-  const protocol::BusBudget budget = protocol::bus_budget(board_traffic(), board_bus(role));
+inline bool state_bus_budget(const char* name, const protocol::BusTraffic& traffic,
+                             protocol::BusRole role) {
+  const protocol::BusBudget budget = protocol::bus_budget(traffic, board_bus(role));
   zynqmp::console_write(name);
   zynqmp::console_write(": worst case ");
   zynqmp::console_write_fixed(100.0 * budget.load, 1);
@@ -97,12 +99,17 @@ inline bool state_bus_budget(const char* name, protocol::BusRole role) {
 
 // The budget of both buses, computed, not measured: the board refuses to
 // run a configuration whose worst case does not fit.
-inline bool state_bus_budgets() {
-  zynqmp::console_write("bus budget, computed (QEMU's CAN has no bit timing): 4 segments at 1 kHz, limit ");
+inline bool state_bus_budgets(int segments, const firmware::PublishRates& rates) {
+  const protocol::BusTraffic traffic = board_traffic(segments, rates);
+  zynqmp::console_write("bus budget, computed (QEMU's CAN has no bit timing): ");
+  zynqmp::console_write_int(segments);
+  zynqmp::console_write(" segments at ");
+  zynqmp::console_write_int(static_cast<std::int32_t>(traffic.cycle_hz));
+  zynqmp::console_write(" Hz, limit ");
   zynqmp::console_write_fixed(100.0 * firmware::kMaxBusLoad, 0);
   zynqmp::console_write(" %\n");
-  const bool host = state_bus_budget("  can0, the host's bus", protocol::BusRole::host);
-  const bool drives = state_bus_budget("  can1, the drives' bus", protocol::BusRole::drives);
+  const bool host = state_bus_budget("  can0, the host's bus", traffic, protocol::BusRole::host);
+  const bool drives = state_bus_budget("  can1, the drives' bus", traffic, protocol::BusRole::drives);
   return host && drives;
 }
 

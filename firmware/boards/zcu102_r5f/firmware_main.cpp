@@ -33,15 +33,18 @@ cdcr::firmware::Runtime runtime(board.hal(host_bus, drives_bus), cdcr::firmware:
 }  // namespace
 
 int main() {
-  if (!cdcr::boards::zcu102_r5f::state_bus_budgets()) {
-    board.console.write_line("the buses do not fit this configuration: not starting");
-    cdcr::zynqmp::exit(cdcr::zynqmp::ExitCode::failure);
-  }
   // A controller that does not come up leaves the runtime without that bus:
   // it runs on and reports stale input, as with drives that never speak.
   if (!board.start_can()) board.console.write_line("can0 did not start");
   if (!drives.start()) board.console.write_line("can1 did not start");
   runtime.init();
+  // The budget of the robot init loaded (the image's, or the fallback's),
+  // before the first cycle puts a frame on either bus.
+  if (!cdcr::boards::zcu102_r5f::state_bus_budgets(runtime.geometry().segment_count,
+                                                   runtime.publish_rates())) {
+    board.console.write_line("the buses do not fit this configuration: not starting");
+    cdcr::zynqmp::exit(cdcr::zynqmp::ExitCode::failure);
+  }
   board.start_cycles();
   for (;;) board.run_guarded([](const cdcr::hal::TimerTick& tick) { runtime.run_cycle(tick); });
 }
