@@ -177,6 +177,7 @@ namespace protocol = cdcr::firmware::protocol;
 
 static_assert(int(CDCR_STATE_FAULT) == int(firmware::RuntimeState::fault), "states as in fault.hpp");
 static_assert(int(CDCR_FAULT_HOMING_MALFORMED) == int(firmware::FaultCode::homing_malformed), "faults as fault.hpp");
+static_assert(int(CDCR_FAULT_DRIVE_REFUSED) == int(firmware::FaultCode::drive_refused), "faults as fault.hpp");
 static_assert(int(CDCR_IK_IN_PROGRESS) == int(protocol::IkOutcome::in_progress), "outcomes as in messages.hpp");
 static_assert(int(CDCR_IK_REFUSED_EXTRAPOLATING) == int(protocol::IkOutcome::refused_extrapolating), "outcomes");
 static_assert(int(CDCR_TARGET_POSE) == int(protocol::TargetMode::pose), "modes as in messages.hpp");

@@ -308,6 +308,16 @@ bool IkRequest::set_setpoints(const Joints& joints) {
 }
 
 void IkRequest::publish_setpoints() {
+  if (drives_ != nullptr) {
+    double setpoints_mm[model::kMaxCables];
+    const int cables = model_.geometry.cable_count();
+    for (int k = 0; k < cables; ++k) setpoints_mm[k] = double(setpoints_mm_[k]);
+    // Drives that do not take them (not ready, a length beyond a drive's
+    // range) say so in their health, which the runtime reports.
+    drives_->command(setpoints_mm, cables);
+    setpoints_published_ += 1;
+    return;
+  }
   for (int k = 0; k < setpoint_frame_count_; ++k) outbox_.send_to_drives(setpoint_frames_[k]);
   setpoints_published_ += 1;
 }

@@ -29,6 +29,7 @@ Runtime::Runtime(const hal::Hal& hal, const Geometry& fallback_geometry)
       outbox_(host_bus_, drives_bus_),
       update_(hal.flash, host_bus_) {
   model_.geometry = fallback_geometry;
+  ik_.set_drives(hal.drives);
 }
 
 RuntimeState Runtime::init() {
@@ -42,7 +43,12 @@ RuntimeState Runtime::init() {
   const hal::CanFilter* host_filters = kFilters;
   std::size_t host_filter_count = sizeof(kFilters) / sizeof(kFilters[0]) - (update_.enabled() ? 0 : 1);
   can_filters_accepted_ = true;
-  if (has_drives_bus()) {
+  if (hal_.drives != nullptr) {
+    // The drives' buses are the backend's; CABLE_FEEDBACK is not taken.
+    ++host_filters;
+    --host_filter_count;
+    can_filters_accepted_ = hal_.drives->start();
+  } else if (has_drives_bus()) {
     ++host_filters;
     --host_filter_count;
     can_filters_accepted_ = drives_bus_.set_filters(kFilters, 1);
@@ -89,6 +95,13 @@ RuntimeState Runtime::init() {
 }
 
 FaultCode Runtime::active_fault() const {
+  if (state_ == RuntimeState::fault && drives_failed()) {
+    switch (drives_health_.condition) {
+      case hal::DrivesCondition::silent: return FaultCode::drive_silent;
+      case hal::DrivesCondition::refused: return FaultCode::drive_refused;
+      default: return FaultCode::drive_fault;
+    }
+  }
   if (state_ == RuntimeState::fault) return FaultCode::cable_input_stale;
   if (outbox_.unreported_event() != FaultCode::none) return outbox_.unreported_event();
   if (boot_fault_ != FaultCode::none) return boot_fault_;
@@ -98,6 +111,7 @@ FaultCode Runtime::active_fault() const {
 FaultDetail Runtime::active_fault_detail() const {
   const FaultCode fault = active_fault();
   if (fault == FaultCode::none) return FaultDetail();
+  if (detail_kind(fault) == FaultDetailKind::drive_node) return FaultDetail::drive(drives_health_.drive);
   if (fault == outbox_.unreported_event()) return outbox_.last_event_detail();
   if (fault == boot_fault_) return boot_fault_detail_;
   return FaultDetail();
@@ -117,7 +131,11 @@ void Runtime::run_cycle(const hal::TimerTick& tick, CycleInputs* inputs) {
 
   const int delivered = inputs != nullptr ? inputs->deliver(*this) : 0;
   receive_frames(host_bus_, delivered);
-  if (has_drives_bus()) receive_frames(drives_bus_, 0);
+  if (hal_.drives != nullptr) {
+    receive_drive_lengths();
+  } else if (has_drives_bus()) {
+    receive_frames(drives_bus_, 0);
+  }
 
   if (state_ != RuntimeState::boot) update_pose();
   fresh_cables_ = false;
@@ -133,6 +151,8 @@ void Runtime::run_cycle(const hal::TimerTick& tick, CycleInputs* inputs) {
   if (ik_.running() && !plan.update_turn && (state_ == RuntimeState::run || state_ == RuntimeState::degraded)) {
     ik_units_last_cycle_ = ik_.continue_slice(scheduler_.ik_units());
   }
+  // The drives' frames of this cycle (their setpoints, their SYNC) last.
+  if (hal_.drives != nullptr) hal_.drives->transmit();
 
   statistics_.record_cycle(tick, start_ns, hal_.clock.now_ns(), hal_.timer.period_ns());
 }
@@ -141,6 +161,43 @@ void Runtime::run_cycle(const hal::TimerTick& tick, CycleInputs* inputs) {
 void Runtime::receive_frames(hal::CanBus& bus, int frames) {
   hal::CanFrame frame;
   for (; frames < kMaxRxFramesPerCycle && bus.receive(frame) == hal::CanStatus::ok; ++frames) handle_frame(frame);
+}
+
+// The drives' lengths of this cycle, and their health: a failure takes the
+// runtime to FAULT, named on the console once.
+void Runtime::receive_drive_lengths() {
+  hal::Drives& drives = *hal_.drives;
+  drives.receive();
+  const bool was_failed = drives_failed();
+  drives_health_ = drives.health();
+  if (drives_failed()) {
+    if (!was_failed) {
+      ConsoleLine line;
+      line << "fault: " << drives.describe(drives_health_.kind) << ", drive " << unsigned(drives_health_.drive)
+           << " (cable " << int(drives_health_.cable) << "), detail " << unsigned(drives_health_.detail);
+      hal_.console.write_line(line.c_str());
+    }
+    if (state_ != RuntimeState::fault && state_ != RuntimeState::boot) {
+      enter(RuntimeState::fault);
+      if (ik_.running()) ik_.end(protocol::IkOutcome::aborted_fault);
+    }
+    return;
+  }
+  const int cables = model_.geometry.cable_count();
+  double lengths_mm[model::kMaxCables];
+  if (!drives.lengths(lengths_mm, cables)) return;
+  for (int s = 0; s < model_.geometry.segment_count; ++s) {
+    Scalar segment_mm[4] = {};
+    const int first = model_.geometry.first_cable(s);
+    for (int k = 0; k < model_.geometry.segments[s].cables.count; ++k) segment_mm[k] = Scalar(lengths_mm[first + k]);
+    set_cable_lengths(s, segment_mm);
+  }
+}
+
+bool Runtime::recover_drives() {
+  if (hal_.drives == nullptr || !hal_.drives->recover()) return false;
+  drives_health_ = hal_.drives->health();
+  return true;
 }
 
 // Between two cycles' work: the request being solved was for the old
@@ -159,6 +216,11 @@ void Runtime::handle_frame(const hal::CanFrame& frame) {
   // brings tens of them and would test each against every input first.
   if (ModelUpdate::carries(frame.id)) {
     update_.handle_frame(frame, cycle_);
+    return;
+  }
+  // With a Drives backend a CABLE_FEEDBACK frame is no drive's.
+  if (hal_.drives != nullptr &&
+      (frame.id & protocol::kCableFeedbackFrames.mask) == protocol::kCableFeedbackFrames.id) {
     return;
   }
   if (frame_inputs_.take(frame, *this)) return;
@@ -249,7 +311,7 @@ void Runtime::update_pose() {
       model_.correction.set_cable_residuals(estimate.cable_residuals);
       has_pose_ = true;
       last_valid_cycle_ = cycle_;
-      if (state_ == RuntimeState::fault) enter(mode());
+      if (state_ == RuntimeState::fault && !drives_failed()) enter(mode());
       const bool pose_due = pose_wait_ == 0;
       if (pose_due) {
         publish_pose();

@@ -1,6 +1,5 @@
-// The CiA 402 drive manager against drives written here to CiA 301 and
-// 402-2 as a device would follow them (NMT, expedited SDO server, PDOs on
-// SYNC, heartbeat, EMCY, the power state machine), on the simulated bus:
+// The CiA 402 drive manager against drives written to CiA 301 and 402-2 as
+// a device would follow them (cia402_test_drive.hpp), on the simulated bus:
 // boot to Operation enabled, the setpoints reached within the speed limit,
 // and each fault the manager must name. The drives on the npm `canopen`
 // stack (host_tests/canopen) check the same against a stack this project did
@@ -18,141 +17,10 @@
 #include <cdcr/firmware/canopen/drive_manager.hpp>
 #include <cdcr/sim/virtual_can.hpp>
 
+#include "cia402_test_drive.hpp"
+
 namespace cdcr::firmware::canopen {
 namespace {
-
-struct TestDrive {
-  NodeId node = 0;
-  NmtState nmt = NmtState::boot_up;
-  bool powered = true;          // answers at all
-  bool heartbeat_on = true;     // produces its heartbeat
-  bool answers_sync = true;     // sends its TPDO on SYNC
-  bool repeat_tpdo = false;     // sends each TPDO twice
-  std::set<std::uint16_t> refused;  // objects whose writes it aborts (value range)
-  std::map<std::uint32_t, std::uint32_t> objects;  // (index << 8 | subindex) -> value
-  std::vector<std::uint32_t> written;             // in order
-  std::uint16_t statusword = 0x0250;              // switch on disabled
-  std::uint16_t controlword = 0;
-  std::uint16_t pending_controlword = 0;
-  std::int32_t pending_target = 0;
-  bool has_pending = false;
-  double position = 0;
-  std::int32_t target = 0;
-  std::uint32_t ms = 0;
-
-  std::uint16_t heartbeat_ms() const {
-    auto it = objects.find(0x101700);
-    return it == objects.end() ? 0 : std::uint16_t(it->second);
-  }
-  void step_power_state(std::uint16_t cw) {
-    const bool fault_reset = (cw & 0x80) && !(controlword & 0x80);
-    controlword = cw;
-    switch (statusword) {
-      case 0x0218:  // fault
-        if (fault_reset) statusword = 0x0250;
-        return;
-      case 0x0250:
-        if ((cw & 0x87) == 0x06) statusword = 0x0231;
-        return;
-      case 0x0231:
-        if ((cw & 0x8F) == 0x07) statusword = 0x0233;
-        if ((cw & 0x8F) == 0x0F) statusword = 0x0237;
-        if ((cw & 0x02) == 0) statusword = 0x0250;
-        return;
-      case 0x0233:
-        if ((cw & 0x8F) == 0x0F) statusword = 0x0237;
-        if ((cw & 0x8F) == 0x06) statusword = 0x0231;
-        if ((cw & 0x02) == 0) statusword = 0x0250;
-        return;
-      case 0x0237:
-        if ((cw & 0x86) == 0x02) statusword = 0x0217;  // quick stop
-        else if ((cw & 0x8F) == 0x07) statusword = 0x0233;
-        else if ((cw & 0x8F) == 0x06) statusword = 0x0231;
-        else if ((cw & 0x02) == 0) statusword = 0x0250;
-        return;
-      case 0x0217:
-        if ((cw & 0x02) == 0) statusword = 0x0250;
-        return;
-    }
-  }
-  void fault(hal::CanBus& bus, std::uint16_t error_code) {
-    statusword = 0x0218;
-    Emergency emergency;
-    emergency.node = node;
-    emergency.error_code = error_code;
-    emergency.error_register = 0x03;
-    bus.send(emergency_frame(emergency));
-  }
-
-  void take(const hal::CanFrame& frame, hal::CanBus& bus) {
-    if (!powered) return;
-    if (frame.id == kNmtId && frame.dlc == 2 && (frame.data[1] == 0 || frame.data[1] == node)) {
-      switch (frame.data[0]) {
-        case 0x82:
-        case 0x81:
-          objects.erase(0x101700);
-          nmt = NmtState::pre_operational;
-          bus.send(heartbeat_frame({node, NmtState::boot_up}));
-          break;
-        case 0x01: nmt = NmtState::operational; break;
-        case 0x02: nmt = NmtState::stopped; break;
-        case 0x80: nmt = NmtState::pre_operational; break;
-      }
-      return;
-    }
-    if (frame.id == kSdoClientBase + node && nmt != NmtState::stopped) {
-      const std::uint16_t index = std::uint16_t(frame.data[1] | (frame.data[2] << 8));
-      const std::uint8_t sub = frame.data[3];
-      hal::CanFrame reply;
-      reply.id = kSdoServerBase + node;
-      reply.dlc = 8;
-      reply.data[1] = frame.data[1];
-      reply.data[2] = frame.data[2];
-      reply.data[3] = sub;
-      if ((frame.data[0] & 0xE3) == 0x23 && !refused.count(index)) {
-        const int size = 4 - ((frame.data[0] >> 2) & 3);
-        std::uint32_t value = 0;
-        for (int i = 0; i < size; ++i) value |= std::uint32_t(frame.data[4 + i]) << (8 * i);
-        objects[(std::uint32_t(index) << 8) | sub] = value;
-        written.push_back((std::uint32_t(index) << 8) | sub);
-        reply.data[0] = 0x60;
-      } else {
-        reply.data[0] = 0x80;
-        const std::uint32_t code = sdo::kAbortValueRange;
-        for (int i = 0; i < 4; ++i) reply.data[4 + i] = std::uint8_t(code >> (8 * i));
-      }
-      bus.send(reply);
-      return;
-    }
-    if (nmt != NmtState::operational) return;
-    DriveCommand command;
-    if (decode_rpdo(frame, command) && command.node == node) {
-      pending_controlword = command.controlword;
-      pending_target = command.target_position;
-      has_pending = true;
-      return;
-    }
-    if (frame.id == kSyncId && frame.dlc == 0) {
-      if (has_pending) {
-        step_power_state(pending_controlword);
-        if (statusword == 0x0237) target = pending_target;
-        has_pending = false;
-      }
-      // A first-order position loop: half the way each cycle.
-      if (statusword == 0x0237) position += 0.5 * (double(target) - position);
-      if (!answers_sync) return;
-      const hal::CanFrame tpdo = tpdo_frame({node, statusword, std::int32_t(position)});
-      bus.send(tpdo);
-      if (repeat_tpdo) bus.send(tpdo);
-    }
-  }
-  // One millisecond of the drive's own time.
-  void tick(hal::CanBus& bus) {
-    ++ms;
-    const std::uint16_t period = heartbeat_ms();
-    if (powered && heartbeat_on && period > 0 && ms % period == 0) bus.send(heartbeat_frame({node, nmt}));
-  }
-};
 
 class DriveManagerTest : public ::testing::Test {
  protected:
@@ -161,7 +29,8 @@ class DriveManagerTest : public ::testing::Test {
   void SetUp() override {
     config_.drive_count = kDrives;
     for (int i = 0; i < kDrives; ++i) {
-      config_.drives[i].node = NodeId(i + 1);
+      config_.drives[i].bus = 0;
+    config_.drives[i].node = NodeId(i + 1);
       config_.drives[i].counts_per_mm = (i % 2) ? -1000.0 : 1000.0;  // every other drive wound the other way
       config_.drives[i].offset_mm = 100.0;
       drives_[i].node = NodeId(i + 1);
@@ -174,7 +43,7 @@ class DriveManagerTest : public ::testing::Test {
   // answer; their own time advances.
   void cycle(DriveManager& manager) {
     take_frames(manager);
-    manager.run_cycle(bus_.node(0));
+    manager.run_cycle(buses_);
     hal::CanFrame frame;
     while (bus_.node(1).receive(frame) == hal::CanStatus::ok)
       for (auto& drive : drives_) drive.take(frame, bus_.node(1));
@@ -183,7 +52,7 @@ class DriveManagerTest : public ::testing::Test {
   // The cycle's start: what the drives sent since the last SYNC.
   void take_frames(DriveManager& manager) {
     hal::CanFrame frame;
-    while (bus_.node(0).receive(frame) == hal::CanStatus::ok) manager.take(frame);
+    while (bus_.node(0).receive(frame) == hal::CanStatus::ok) manager.take(frame, 0);
   }
   int run_until(DriveManager& manager, DrivePhase phase, int limit) {
     for (int n = 1; n <= limit; ++n) {
@@ -195,6 +64,7 @@ class DriveManagerTest : public ::testing::Test {
 
   DriveManagerConfig config_;
   sim::VirtualCanBus bus_;
+  hal::CanBus* const buses_[kMaxDriveBuses] = {&bus_.node(0), nullptr, nullptr, nullptr};
   TestDrive drives_[kDrives];
 };
 
@@ -335,7 +205,7 @@ TEST_F(DriveManagerTest, RepeatedTpdoCountedLateTpdoStale) {
   cycle(manager);  // A
   take_frames(manager);
   EXPECT_FALSE(manager.positions_fresh());
-  manager.run_cycle(bus_.node(0));  // A+1, its frames taken above
+  manager.run_cycle(buses_);  // A+1, its frames taken above
   hal::CanFrame frame;
   while (bus_.node(1).receive(frame) == hal::CanStatus::ok)
     for (auto& drive : drives_) drive.take(frame, bus_.node(1));
@@ -345,18 +215,59 @@ TEST_F(DriveManagerTest, RepeatedTpdoCountedLateTpdoStale) {
   EXPECT_EQ(cycles, 9);
 }
 
+// Four drives on each of two buses, node ids 1 to 4 on both: each bus gets
+// its own NMT, SDO, RPDOs and SYNC, and a frame counts for the drive of the
+// bus it came on.
+TEST(DriveManagerBuses, NodeIdsRepeatAcrossBuses) {
+  sim::VirtualCanBus first, second;
+  hal::CanBus* const buses[kMaxDriveBuses] = {&first.node(0), &second.node(0), nullptr, nullptr};
+  DriveManagerConfig config;
+  config.drive_count = 8;
+  config.bus_count = 2;
+  TestDrive drives[8];
+  for (int i = 0; i < 8; ++i) {
+    config.drives[i] = {std::uint8_t(i / 4), NodeId(i % 4 + 1), 1000.0, 50.0};
+    drives[i].node = NodeId(i % 4 + 1);
+    drives[i].position = 1000.0 * i;
+  }
+  ASSERT_EQ(validate(config), DriveConfigStatus::ok);
+  DriveManager manager(config);
+  sim::VirtualCanBus* bus_of[2] = {&first, &second};
+  for (int n = 0; n < 300 && manager.phase() != DrivePhase::operational; ++n) {
+    hal::CanFrame frame;
+    for (int b = 0; b < 2; ++b)
+      while (bus_of[b]->node(0).receive(frame) == hal::CanStatus::ok) manager.take(frame, b);
+    manager.run_cycle(buses);
+    for (int b = 0; b < 2; ++b) {
+      while (bus_of[b]->node(1).receive(frame) == hal::CanStatus::ok)
+        for (int i = 4 * b; i < 4 * b + 4; ++i) drives[i].take(frame, bus_of[b]->node(1));
+      for (int i = 4 * b; i < 4 * b + 4; ++i) drives[i].tick(bus_of[b]->node(1));
+    }
+  }
+  ASSERT_EQ(manager.phase(), DrivePhase::operational) << to_string(manager.fault().fault);
+  hal::CanFrame frame;
+  for (int b = 0; b < 2; ++b)
+    while (bus_of[b]->node(0).receive(frame) == hal::CanStatus::ok) manager.take(frame, b);
+  ASSERT_TRUE(manager.positions_fresh());
+  for (int i = 0; i < 8; ++i) EXPECT_DOUBLE_EQ(manager.length_mm(i), 50.0 + i) << "cable " << i;
+  config.drives[5].node = 1;  // two node 1 on the second bus
+  EXPECT_EQ(validate(config), DriveConfigStatus::node_repeated);
+  config.drives[5].bus = 2;
+  EXPECT_EQ(validate(config), DriveConfigStatus::bus_invalid);
+}
+
 TEST(DriveManagerConfig, Refusals) {
   DriveManagerConfig config;
   EXPECT_EQ(validate(config), DriveConfigStatus::no_drives);
   config.drive_count = 2;
-  config.drives[0] = {1, 1000.0, 0.0};
-  config.drives[1] = {1, 1000.0, 0.0};
+  config.drives[0] = {0, 1, 1000.0, 0.0};
+  config.drives[1] = {0, 1, 1000.0, 0.0};
   EXPECT_EQ(validate(config), DriveConfigStatus::node_repeated);
-  config.drives[1] = {128, 1000.0, 0.0};
+  config.drives[1] = {0, 128, 1000.0, 0.0};
   EXPECT_EQ(validate(config), DriveConfigStatus::node_invalid);
-  config.drives[1] = {2, 0.0, 0.0};
+  config.drives[1] = {0, 2, 0.0, 0.0};
   EXPECT_EQ(validate(config), DriveConfigStatus::scale_invalid);
-  config.drives[1] = {2, -500.0, 0.0};
+  config.drives[1] = {0, 2, -500.0, 0.0};
   EXPECT_EQ(validate(config), DriveConfigStatus::ok);
   config.timing.sync_window_us = 2000;
   EXPECT_EQ(validate(config), DriveConfigStatus::timing_invalid);

@@ -389,6 +389,10 @@ TEST(DbcAgreesWithTheCodec, FaultDetailCommentNamesTheEnumOfEveryDetailedFault) 
         ASSERT_EQ(sentence_of_fault.count(fault.name), 1u);
         EXPECT_NE(sentence_of_fault[fault.name].find("model::Status"), std::string::npos);
         break;
+      case FaultDetailKind::drive_node:
+        ASSERT_EQ(sentence_of_fault.count(fault.name), 1u);
+        EXPECT_NE(sentence_of_fault[fault.name].find("node id"), std::string::npos);
+        break;
       case FaultDetailKind::none:
         EXPECT_EQ(sentence_of_fault.count(fault.name), 0u) << "named as carrying a detail";
         break;

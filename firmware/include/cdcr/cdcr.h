@@ -93,7 +93,10 @@ typedef enum cdcr_fault {
   CDCR_FAULT_CAN_TRANSMIT_FAILED = 9,    /* can_send returned non-zero */
   CDCR_FAULT_CAN_FILTERS_REFUSED = 10,   /* can_receive given without can_set_filters, or it refused */
   CDCR_FAULT_PAYLOAD_INVALID = 11,       /* a PAYLOAD frame beyond 0..50 kg: the previous payload stays */
-  CDCR_FAULT_HOMING_MALFORMED = 12       /* a HOMING frame that does not decode: the hysteresis state stays */
+  CDCR_FAULT_HOMING_MALFORMED = 12,      /* a HOMING frame that does not decode: the hysteresis state stays */
+  CDCR_FAULT_DRIVE_SILENT = 13,          /* CiA 402 drives: one stopped answering; fault_detail: its node id */
+  CDCR_FAULT_DRIVE_FAULT = 14,           /* one reported a fault or left Operation enabled; fault_detail: node */
+  CDCR_FAULT_DRIVE_REFUSED = 15          /* their configuration was refused; fault_detail: node (0: as given) */
 } cdcr_fault;
 
 /* How the last target ended (the IK_REPORT frame's OUTCOME). */

@@ -13,11 +13,14 @@ constexpr std::uint16_t kStatuswordFault = 0x0008;  // bit 3
 
 DriveConfigStatus validate(const DriveManagerConfig& config) {
   if (config.drive_count < 1 || config.drive_count > kMaxDrives) return DriveConfigStatus::no_drives;
+  if (config.bus_count < 1 || config.bus_count > kMaxDriveBuses) return DriveConfigStatus::bus_invalid;
   for (int i = 0; i < config.drive_count; ++i) {
     const DriveChannel& drive = config.drives[i];
+    if (drive.bus >= config.bus_count) return DriveConfigStatus::bus_invalid;
     if (!is_valid_node(drive.node)) return DriveConfigStatus::node_invalid;
     for (int j = 0; j < i; ++j)
-      if (config.drives[j].node == drive.node) return DriveConfigStatus::node_repeated;
+      if (config.drives[j].bus == drive.bus && config.drives[j].node == drive.node)
+        return DriveConfigStatus::node_repeated;
     if (!(std::fabs(drive.counts_per_mm) > 0.0) || !(std::fabs(drive.counts_per_mm) <= kMaxCountsPerMm))
       return DriveConfigStatus::scale_invalid;
     if (!(std::fabs(drive.offset_mm) <= kMaxOffsetMm)) return DriveConfigStatus::offset_invalid;
@@ -34,8 +37,9 @@ const char* to_string(DriveConfigStatus status) {
   switch (status) {
     case DriveConfigStatus::ok: return "ok";
     case DriveConfigStatus::no_drives: return "no drives, or more than one per cable";
+    case DriveConfigStatus::bus_invalid: return "no bus, more than 4, or a drive on a bus not configured";
     case DriveConfigStatus::node_invalid: return "a node id outside 1..127";
-    case DriveConfigStatus::node_repeated: return "two cables on one node id";
+    case DriveConfigStatus::node_repeated: return "two cables on one node id of a bus";
     case DriveConfigStatus::scale_invalid: return "counts per mm zero, not a number or beyond 1e6";
     case DriveConfigStatus::offset_invalid: return "offset not a number or beyond 1e4 mm";
     case DriveConfigStatus::timing_invalid:
@@ -77,7 +81,15 @@ const char* to_string(DriveFault fault) {
   return "unknown";
 }
 
-DriveManager::DriveManager(const DriveManagerConfig& config) : config_(config) {
+void DriveManager::configure(const DriveManagerConfig& config) {
+  config_ = config;
+  for (Drive& drive : drives_) drive = Drive{};
+  fault_ = DriveFaultReport{};
+  phase_ = DrivePhase::reset;
+  phase_start_ = cycle_;
+  cycles_in_phase_ = 0;
+  has_setpoints_ = false;
+  resetting_faults_ = false;
   const DriveConfigStatus status = validate(config);
   if (status != DriveConfigStatus::ok) {
     config_.drive_count = 0;
@@ -87,10 +99,14 @@ DriveManager::DriveManager(const DriveManagerConfig& config) : config_(config) {
   }
 }
 
-int DriveManager::find(NodeId node) const {
+int DriveManager::find(int bus, NodeId node) const {
   for (int i = 0; i < config_.drive_count; ++i)
-    if (config_.drives[i].node == node) return i;
+    if (config_.drives[i].bus == bus && config_.drives[i].node == node) return i;
   return -1;
+}
+
+void DriveManager::broadcast(Buses buses, const hal::CanFrame& frame) {
+  for (int b = 0; b < config_.bus_count; ++b) buses[b]->send(frame);
 }
 
 std::uint32_t DriveManager::cycles_of_ms(std::uint32_t ms) const {
@@ -121,10 +137,10 @@ void DriveManager::recover() {
   enter(DrivePhase::reset);
 }
 
-bool DriveManager::take(const hal::CanFrame& frame) {
+bool DriveManager::take(const hal::CanFrame& frame, int bus) {
   if (frame.fd()) return false;
   const std::uint32_t function = frame.id & kFunctionMask;
-  const int cable = find(static_cast<NodeId>(frame.id & kNodeMask));
+  const int cable = find(bus, static_cast<NodeId>(frame.id & kNodeMask));
   if (cable < 0) return false;
   Drive& drive = drives_[cable];
   switch (function) {
@@ -155,21 +171,20 @@ bool DriveManager::take(const hal::CanFrame& frame) {
     case kSdoServerBase: {
       SdoReply reply;
       if (!decode_sdo_reply(frame, reply)) return false;
-      take_sdo(reply);
+      take_sdo(cable, reply);
       return true;
     }
     case kTpdo1Base: {
       DriveState state;
       if (!decode_tpdo(frame, state)) return false;
-      take_tpdo(state);
+      take_tpdo(cable, state);
       return true;
     }
     default: return false;
   }
 }
 
-void DriveManager::take_sdo(const SdoReply& reply) {
-  const int cable = find(reply.node);
+void DriveManager::take_sdo(int cable, const SdoReply& reply) {
   Drive& drive = drives_[cable];
   // An answer nobody waits for (a repeat, or one after its timeout) changes nothing.
   if (phase_ != DrivePhase::configure || !drive.sdo_pending) return;
@@ -192,8 +207,7 @@ void DriveManager::take_sdo(const SdoReply& reply) {
   ++drive.next_write;
 }
 
-void DriveManager::take_tpdo(const DriveState& state) {
-  const int cable = find(state.node);
+void DriveManager::take_tpdo(int cable, const DriveState& state) {
   Drive& drive = drives_[cable];
   // Twice after one SYNC (a repeat, or a late one and its successor): the
   // latest counts.
@@ -250,7 +264,7 @@ void DriveManager::check_heartbeats() {
   }
 }
 
-void DriveManager::run_configure(hal::CanBus& bus) {
+void DriveManager::run_configure(Buses buses) {
   const std::uint32_t timeout = cycles_of_ms(config_.sdo_timeout_ms);
   bool done = true;
   int sent = 0;
@@ -273,7 +287,7 @@ void DriveManager::run_configure(hal::CanBus& bus) {
     hal::CanFrame frame;
     sdo_download_frame(config_.drives[cable].node, write.object, write.value, write.size, frame);
     // A request the controller did not queue goes again next cycle.
-    if (bus.send(frame) != hal::CanStatus::ok) continue;
+    if (buses[config_.drives[cable].bus]->send(frame) != hal::CanStatus::ok) continue;
     drive.sdo_pending = true;
     drive.sdo_sent_cycle = cycle_;
     ++sent;
@@ -283,7 +297,7 @@ void DriveManager::run_configure(hal::CanBus& bus) {
 }
 
 // The RPDOs, then the SYNC that releases them and asks for the TPDOs.
-void DriveManager::send_process_data(hal::CanBus& bus, bool operating) {
+void DriveManager::send_process_data(Buses buses, bool operating) {
   const double step_mm = config_.max_speed_mm_per_s * double(config_.timing.cycle_period_us) * 1e-6;
   for (int i = 0; i < config_.drive_count; ++i) {
     Drive& drive = drives_[i];
@@ -317,13 +331,13 @@ void DriveManager::send_process_data(hal::CanBus& bus, bool operating) {
       drive.target = drive.actual;  // enabled where it stands
     }
     command.target_position = drive.target;
-    bus.send(rpdo_frame(command));
+    buses[config_.drives[i].bus]->send(rpdo_frame(command));
   }
-  bus.send(sync_frame());
+  broadcast(buses, sync_frame());
   for (int i = 0; i < config_.drive_count; ++i) drives_[i].tpdo_seen = false;
 }
 
-void DriveManager::run_cycle(hal::CanBus& bus) {
+void DriveManager::run_cycle(Buses buses) {
   ++cycle_;
   cycles_in_phase_ = cycle_ - phase_start_;
   switch (phase_) {
@@ -337,7 +351,7 @@ void DriveManager::run_cycle(hal::CanBus& bus) {
         drives_[i].statusword = statusword;
       }
       has_setpoints_ = false;
-      bus.send(nmt_frame(NmtCommand::reset_communication, 0));
+      broadcast(buses, nmt_frame(NmtCommand::reset_communication, 0));
       enter(DrivePhase::boot);
       return;
     case DrivePhase::boot: {
@@ -351,9 +365,9 @@ void DriveManager::run_cycle(hal::CanBus& bus) {
       }
       return;
     }
-    case DrivePhase::configure: run_configure(bus); return;
+    case DrivePhase::configure: run_configure(buses); return;
     case DrivePhase::start:
-      bus.send(nmt_frame(NmtCommand::start, 0));
+      broadcast(buses, nmt_frame(NmtCommand::start, 0));
       // Heartbeats count from here: the producer time was just written.
       for (int i = 0; i < config_.drive_count; ++i) drives_[i].heartbeat_cycle = cycle_;
       enter(DrivePhase::enable);
@@ -369,14 +383,14 @@ void DriveManager::run_cycle(hal::CanBus& bus) {
       if (waiting < 0) {
         resetting_faults_ = false;
         enter(DrivePhase::operational);
-        send_process_data(bus, true);
+        send_process_data(buses, true);
         return;
       }
       if (cycles_in_phase_ > cycles_of_ms(config_.enable_timeout_ms)) {
         fail(DriveFault::enable_timeout, waiting, drives_[waiting].statusword);
         break;
       }
-      send_process_data(bus, false);
+      send_process_data(buses, false);
       return;
     }
     case DrivePhase::operational:
@@ -384,13 +398,13 @@ void DriveManager::run_cycle(hal::CanBus& bus) {
       for (int i = 0; i < config_.drive_count && phase_ == DrivePhase::operational; ++i)
         if (cycle_ - drives_[i].tpdo_cycle > config_.stale_cycles) fail(DriveFault::input_stale, i);
       if (phase_ != DrivePhase::operational) break;
-      send_process_data(bus, true);
+      send_process_data(buses, true);
       return;
     case DrivePhase::fault: break;
   }
   // In fault: quick stop where the drives stand, and the SYNC goes on so
   // their positions keep coming.
-  if (config_.drive_count > 0) send_process_data(bus, false);
+  if (config_.drive_count > 0) send_process_data(buses, false);
 }
 
 }  // namespace cdcr::firmware::canopen

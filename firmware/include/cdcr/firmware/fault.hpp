@@ -31,6 +31,12 @@ enum class FaultCode : std::uint8_t {
                                // previous payload stays in use
   homing_malformed = 12,       // last HOMING frame refused (wrong DLC, AT_HOME not 1): the hysteresis state
                                // is unchanged
+  // The drives of a hal::Drives backend (CiA 402): the runtime is in FAULT
+  // until they are recovered; FAULT_DETAIL is the drive's node id.
+  drive_silent = 13,           // a drive stopped answering: at boot, to its configuration, its heartbeat, its position
+  drive_fault = 14,            // a drive reported a fault (EMCY, statusword) or left Operation enabled
+  drive_refused = 15,          // the drives' configuration was refused (an SDO abort, an invalid configuration,
+                               // a setpoint beyond a drive's range)
 };
 
 constexpr const char* to_string(RuntimeState state) {
@@ -58,6 +64,9 @@ constexpr const char* to_string(FaultCode code) {
     case FaultCode::can_filters_refused: return "CAN acceptance filters refused";
     case FaultCode::payload_invalid: return "payload invalid";
     case FaultCode::homing_malformed: return "homing frame malformed";
+    case FaultCode::drive_silent: return "drive silent";
+    case FaultCode::drive_fault: return "drive fault";
+    case FaultCode::drive_refused: return "drive configuration refused";
   }
   return "unknown fault";
 }

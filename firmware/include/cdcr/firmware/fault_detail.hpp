@@ -7,6 +7,7 @@
 //   image_invalid                              model::ImageStatus (the parser's verdict)
 //   image_geometry_invalid,                    model::Status
 //   cable_lengths_invalid, target_unreachable
+//   drive_silent, drive_fault, drive_refused   the drive's node id (0: the configuration as given)
 //   every other code                           nothing (0)
 
 #include <cstdint>
@@ -17,7 +18,7 @@
 
 namespace cdcr::firmware {
 
-enum class FaultDetailKind : std::uint8_t { none, image_status, model_status };
+enum class FaultDetailKind : std::uint8_t { none, image_status, model_status, drive_node };
 
 // Which enum details a fault code (the table above).
 constexpr FaultDetailKind detail_kind(FaultCode code) {
@@ -28,6 +29,10 @@ constexpr FaultDetailKind detail_kind(FaultCode code) {
     case FaultCode::cable_lengths_invalid:
     case FaultCode::target_unreachable:
       return FaultDetailKind::model_status;
+    case FaultCode::drive_silent:
+    case FaultCode::drive_fault:
+    case FaultCode::drive_refused:
+      return FaultDetailKind::drive_node;
     case FaultCode::none:
     case FaultCode::image_missing:
     case FaultCode::cable_input_stale:
@@ -49,12 +54,14 @@ class FaultDetail {
       : kind_(FaultDetailKind::image_status), value_(static_cast<std::uint8_t>(status)) {}
   constexpr explicit FaultDetail(model::Status status)
       : kind_(FaultDetailKind::model_status), value_(static_cast<std::uint8_t>(status)) {}
+  static constexpr FaultDetail drive(std::uint8_t node) { return FaultDetail(FaultDetailKind::drive_node, node); }
 
   // The byte a receiver read, typed by the FAULT code it came with.
   static constexpr FaultDetail from_wire(FaultCode fault, std::uint8_t byte) {
     switch (detail_kind(fault)) {
       case FaultDetailKind::image_status: return FaultDetail(static_cast<model::ImageStatus>(byte));
       case FaultDetailKind::model_status: return FaultDetail(static_cast<model::Status>(byte));
+      case FaultDetailKind::drive_node: return drive(byte);
       case FaultDetailKind::none: break;
     }
     return FaultDetail();
@@ -71,11 +78,14 @@ class FaultDetail {
   constexpr model::Status model_status() const {
     return kind_ == FaultDetailKind::model_status ? static_cast<model::Status>(value_) : model::Status::ok;
   }
+  constexpr std::uint8_t drive_node() const { return kind_ == FaultDetailKind::drive_node ? value_ : 0; }
 
   friend constexpr bool operator==(FaultDetail a, FaultDetail b) { return a.kind_ == b.kind_ && a.value_ == b.value_; }
   friend constexpr bool operator!=(FaultDetail a, FaultDetail b) { return !(a == b); }
 
  private:
+  constexpr FaultDetail(FaultDetailKind kind, std::uint8_t value) : kind_(kind), value_(value) {}
+
   FaultDetailKind kind_ = FaultDetailKind::none;
   std::uint8_t value_ = 0;
 };

@@ -13,6 +13,7 @@
 #include "cdcr/firmware/kinematics.hpp"
 #include "cdcr/firmware/outbox.hpp"
 #include "cdcr/firmware/protocol.hpp"
+#include "cdcr/hal/drives.hpp"
 
 namespace cdcr::firmware {
 
@@ -51,6 +52,8 @@ class IkRequest {
       : model_(model), outbox_(outbox), hysteresis_(hysteresis) {}
   IkRequest(const IkRequest&) = delete;
   IkRequest& operator=(const IkRequest&) = delete;
+  // Setpoints to a hal::Drives backend instead of CABLE_SETPOINT frames.
+  void set_drives(hal::Drives* drives) { drives_ = drives; }
 
   // After the model is bound: the solver on it, within kMaxIk* bounds.
   void configure();
@@ -94,6 +97,7 @@ class IkRequest {
   const RobotModel& model_;
   Outbox& outbox_;
   const HysteresisTracker* hysteresis_;
+  hal::Drives* drives_ = nullptr;
   SolverCorrection solver_correction_{model_.correction, &model_.compliance, &model_.geometry};
   Solver solver_;
   // Where a target that refuses extrapolation prefers its solution

@@ -103,6 +103,12 @@ class Runtime {
   hal::CanFormat host_can_format() const { return host_bus_.format(); }
   hal::CanFormat drives_can_format() const { return drives_bus_.format(); }
   bool has_drives_bus() const { return hal_.drives_can != nullptr; }
+  // Drives of a hal::Drives backend: their health as of this cycle, and a
+  // restart after they failed (false: no backend, or nothing to recover).
+  // The runtime is in FAULT while they have failed.
+  bool has_drives() const { return hal_.drives != nullptr; }
+  const hal::DrivesHealth& drives_health() const { return drives_health_; }
+  bool recover_drives();
   // HOMING: the homing move has just ended, the robot is at home
   // (hysteresis_tracker.hpp); without a hysteresis block, nothing.
   void set_homed() { hysteresis_.homed(model_.geometry); }
@@ -177,6 +183,8 @@ class Runtime {
   void publish_pose();
   void publish_fd_pose();
   void receive_frames(hal::CanBus& bus, int frames);
+  void receive_drive_lengths();
+  bool drives_failed() const { return hal_.drives != nullptr && drives_health_.failed(); }
   void publish_uncertainty();
   protocol::PoseUncertainty uncertainty_frame() const;
   void publish_status();
@@ -215,6 +223,7 @@ class Runtime {
   PoseVariance variance_;
   HysteresisTracker hysteresis_;
 
+  hal::DrivesHealth drives_health_;
   FrameInputs frame_inputs_;
   IkRequest ik_{model_, outbox_, &hysteresis_};
   CycleScheduler scheduler_;

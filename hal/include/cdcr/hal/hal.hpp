@@ -6,6 +6,7 @@
 #include "cdcr/hal/can_bus.hpp"
 #include "cdcr/hal/clock.hpp"
 #include "cdcr/hal/console.hpp"
+#include "cdcr/hal/drives.hpp"
 #include "cdcr/hal/flash.hpp"
 #include "cdcr/hal/model_storage.hpp"
 
@@ -23,6 +24,9 @@ struct Hal {
   // A second bus for the drives (their CABLE_FEEDBACK in, the setpoints
   // out); none: the drives share `can` with the host.
   CanBus* drives_can = nullptr;
+  // Drives of another kind than the protocol's (drives.hpp), on buses of
+  // their own: CABLE_FEEDBACK is then ignored and drives_can unused.
+  Drives* drives = nullptr;
 };
 
 }  // namespace cdcr::hal

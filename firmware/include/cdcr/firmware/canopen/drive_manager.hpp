@@ -33,18 +33,22 @@
 namespace cdcr::firmware::canopen {
 
 inline constexpr int kMaxDrives = model::kMaxCables;
+// Buses the drives may be spread over, each with its own SYNC.
+inline constexpr int kMaxDriveBuses = 4;
 // SDO requests sent per cycle while configuring, over every drive.
 inline constexpr int kMaxSdoRequestsPerCycle = 4;
 
 struct DriveChannel {
-  NodeId node = 0;
+  std::uint8_t bus = 0;        // which of the manager's buses
+  NodeId node = 0;             // unique on its bus
   double counts_per_mm = 0.0;  // signed: the drive's direction
   double offset_mm = 0.0;      // cable length at position 0
 };
 
 struct DriveManagerConfig {
-  DriveChannel drives[kMaxDrives] = {};
+  DriveChannel drives[kMaxDrives] = {};  // cable i is drive i
   int drive_count = 0;
+  int bus_count = 1;
   cia402::DriveTiming timing{};
   std::uint32_t boot_timeout_ms = 2000;
   std::uint32_t sdo_timeout_ms = 100;
@@ -60,8 +64,9 @@ struct DriveManagerConfig {
 enum class DriveConfigStatus : std::uint8_t {
   ok,
   no_drives,         // drive_count 0 or above kMaxDrives
+  bus_invalid,       // bus_count 0 or above kMaxDriveBuses, a drive on a bus beyond it
   node_invalid,      // a node id outside 1..127
-  node_repeated,     // two cables on one drive
+  node_repeated,     // two cables on one drive (one node id twice on a bus)
   scale_invalid,     // counts_per_mm zero, NaN or beyond 1e6
   offset_invalid,    // offset NaN or beyond +-1e4 mm
   timing_invalid,    // cycle period 0, window beyond the period, heartbeat 0
@@ -102,13 +107,18 @@ class DriveManager {
  public:
   // An invalid configuration (validate) leaves the manager in fault
   // before it sends anything.
-  explicit DriveManager(const DriveManagerConfig& config);
+  explicit DriveManager(const DriveManagerConfig& config) { configure(config); }
+  DriveManager() { configure(DriveManagerConfig{}); }
+  // Starts over with a new configuration, from reset.
+  void configure(const DriveManagerConfig& config);
 
-  // A frame from the drives' bus; false if it is none of these drives'.
-  bool take(const hal::CanFrame& frame);
-  // Advances by one cycle and sends this cycle's frames; call after every
-  // frame of the cycle was taken.
-  void run_cycle(hal::CanBus& bus);
+  using Buses = hal::CanBus* const (&)[kMaxDriveBuses];
+  // A frame from bus `bus`; false if it is none of its drives'.
+  bool take(const hal::CanFrame& frame, int bus);
+  // Advances by one cycle and sends this cycle's frames on the buses
+  // (config.bus_count of them); call after every frame of the cycle was
+  // taken.
+  void run_cycle(Buses buses);
   // The setpoints of every cable, in mm; false (and nothing changed) for a
   // length the drive's position cannot hold.
   bool set_setpoints(const double* lengths_mm, int count);
@@ -148,13 +158,14 @@ class DriveManager {
     bool reset_sent = false;
   };
 
-  int find(NodeId node) const;
+  int find(int bus, NodeId node) const;
   void enter(DrivePhase phase);
   void fail(DriveFault fault, int cable, std::uint32_t detail = 0, ObjectAddress object = {});
-  void take_sdo(const SdoReply& reply);
-  void take_tpdo(const DriveState& state);
-  void run_configure(hal::CanBus& bus);
-  void send_process_data(hal::CanBus& bus, bool operating);
+  void take_sdo(int cable, const SdoReply& reply);
+  void take_tpdo(int cable, const DriveState& state);
+  void broadcast(Buses buses, const hal::CanFrame& frame);
+  void run_configure(Buses buses);
+  void send_process_data(Buses buses, bool operating);
   void check_heartbeats();
   std::uint32_t cycles_of_ms(std::uint32_t ms) const;
 

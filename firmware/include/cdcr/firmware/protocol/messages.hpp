@@ -104,6 +104,9 @@ inline constexpr ValueName kFaultCode[] = {
     {10, "can_filters_refused"},
     {11, "payload_invalid"},
     {12, "homing_malformed"},
+    {13, "drive_silent"},
+    {14, "drive_fault"},
+    {15, "drive_refused"},
 };
 }  // namespace values
 
@@ -339,7 +342,9 @@ inline constexpr SignalNote kSignalNotes[] = {
      "checksum_mismatch, 8 unsupported_kind, 9 over_capacity, 10 non_finite_payload, 11 invalid_parameters). FAULT 3 "
      "image_geometry_invalid, 6 cable_lengths_invalid and 8 target_unreachable: model::Status (0 ok, 1 "
      "non_finite_input, 2 invalid_geometry, 3 cable_length_not_positive, 4 cable_difference_out_of_range, 5 "
-     "theta_beyond_limit, 6 invalid_segment_count, 7 ik_not_converged, 8 correction_failed). Any other FAULT: 0."},
+     "theta_beyond_limit, 6 invalid_segment_count, 7 ik_not_converged, 8 correction_failed). FAULT 13 "
+     "drive_silent, 14 drive_fault and 15 drive_refused: the drive's CANopen node id (0: the drives' configuration "
+     "as given). Any other FAULT: 0."},
 };
 inline constexpr MessageNotes kNotes{&kMessage, "HOST", "", signal_notes(kSignalNotes)};
 }  // namespace stats
