@@ -8,6 +8,7 @@
 
 #include <gtest/gtest.h>
 
+#include "cdcr/firmware/canopen/bus_budget.hpp"
 #include "cdcr/firmware/protocol/bus_budget.hpp"
 
 namespace cdcr::firmware::protocol {
@@ -21,6 +22,26 @@ const MessageLoad* line_of(const BusBudget& budget, const std::string& name) {
 }
 
 constexpr BusSetup kClassical1Mbit{hal::CanFormat::classical, {1000000, 0}};
+
+// CiA 402 drives: a SYNC (d = 0: 34 + 8 + 13 = 55 bits), an RPDO1 and a
+// TPDO1 of 6 bytes (115) per drive every cycle, a heartbeat (d = 1:
+// 42 + 10 + 13 = 65) per drive every heartbeat period.
+TEST(BusBudget, Cia402DrivesOnABus) {
+  const BusBudget four = canopen::cia402_bus_budget(4, 1000, 50, kClassical1Mbit);
+  EXPECT_NEAR(four.load, (1000 * 55.0 + 8000 * 115.0 + 80 * 65.0) / 1e6, 1e-12);  // 98.0 %
+  EXPECT_FALSE(four.fits());
+  EXPECT_EQ(line_of(four, "SYNC")->worst_bits, 55u);
+  EXPECT_EQ(line_of(four, "RPDO1")->worst_bits, 115u);
+  EXPECT_EQ(line_of(four, "HEARTBEAT")->worst_bits, 65u);
+  EXPECT_NEAR(line_of(four, "HEARTBEAT")->frames_per_s, 80.0, 1e-12);
+  // At 500 Hz the four fit (49.3 %): 16 drives, four to a bus on four buses.
+  const BusBudget slower = canopen::cia402_bus_budget(4, 500, 50, kClassical1Mbit);
+  EXPECT_NEAR(slower.load, (500 * 55.0 + 4000 * 115.0 + 80 * 65.0) / 1e6, 1e-12);
+  EXPECT_TRUE(slower.fits());
+  // Two drives a bus fit at 1 kHz (51.8 %): 16 need eight buses.
+  EXPECT_TRUE(canopen::cia402_bus_budget(2, 1000, 50, kClassical1Mbit).fits());
+  EXPECT_FALSE(canopen::cia402_bus_budget(3, 1000, 50, kClassical1Mbit).fits());
+}
 
 TEST(BusBudget, ThePapersRobotEstimatingAt1kHz) {
   BusTraffic traffic;  // 4 segments, 1 kHz, a pose every cycle, STATUS/STATS every 10

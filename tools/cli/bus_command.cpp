@@ -127,6 +127,20 @@ void validate_bus_options(BusOptions& options) {
   }
   resolve_bus_layout(options.layout, false);
   validate_publish_rates(options.rates);
+  if (options.cia402_drives < 0 || options.cia402_drives > firmware::kMaxDrives) {
+    throw InputError(fmt::format("--cia402 must be 0 to {} drives, got {}", firmware::kMaxDrives,
+                                 options.cia402_drives));
+  }
+  if (options.cia402_buses < 1 || options.cia402_buses > firmware::kMaxDriveBuses) {
+    throw InputError(fmt::format("--cia402-buses must be 1 to {}, got {}", firmware::kMaxDriveBuses,
+                                 options.cia402_buses));
+  }
+  if (options.heartbeat_ms < 1 || options.heartbeat_ms > 65535) {
+    throw InputError(fmt::format("--heartbeat-ms must be 1 to 65535, got {}", options.heartbeat_ms));
+  }
+  if (options.cia402_drives > 0 && options.layout.drives_bus) {
+    throw InputError("--cia402 puts the drives on CANopen buses of their own: --drives-bus does not apply");
+  }
 }
 
 void validate_publish_rates(const firmware::PublishRates& rates) {
@@ -140,6 +154,7 @@ void validate_publish_rates(const firmware::PublishRates& rates) {
 }
 
 std::vector<NamedBudget> bus_budgets_of(const BusOptions& options) {
+  if (options.cia402_drives > 0) return cia402_budgets_of(options);
   protocol::BusTraffic traffic;
   traffic.segments = options.segments;
   traffic.cycle_hz = static_cast<std::uint32_t>(options.rate_hz + 0.5);
@@ -153,6 +168,30 @@ std::vector<NamedBudget> bus_budgets_of(const BusOptions& options) {
           {"drives", layout.drives, protocol::bus_budget(traffic, bus_setup(layout.drives, protocol::BusRole::drives))}};
 }
 
+// The host's bus without the drives' traffic, then each CANopen bus, the
+// first ones with a drive more when they do not share evenly.
+std::vector<NamedBudget> cia402_budgets_of(const BusOptions& options) {
+  protocol::BusTraffic traffic;
+  traffic.segments = options.segments;
+  traffic.cycle_hz = static_cast<std::uint32_t>(options.rate_hz + 0.5);
+  traffic.streaming = options.streaming;
+  traffic.rates = options.rates;
+  const BusLayout& layout = options.layout;
+  std::vector<NamedBudget> budgets{
+      {"host", layout.bus, protocol::bus_budget(traffic, bus_setup(layout.bus, protocol::BusRole::host))}};
+  const BusLine& line = layout.drives.bitrate != 0 ? layout.drives : layout.bus;
+  for (int b = 0; b < options.cia402_buses; ++b) {
+    const int drives = !options.cia402_per_bus.empty()
+                           ? options.cia402_per_bus[std::size_t(b)]
+                           : options.cia402_drives / options.cia402_buses + (b < options.cia402_drives % options.cia402_buses);
+    budgets.push_back({fmt::format("CANopen bus {} ({} CiA 402 drives)", b + 1, drives), line,
+                       firmware::canopen::cia402_bus_budget(drives, traffic.cycle_hz,
+                                                            static_cast<std::uint16_t>(options.heartbeat_ms),
+                                                            bus_setup(line, protocol::BusRole::drives))});
+  }
+  return budgets;
+}
+
 namespace {
 
 std::string rate_text(std::uint32_t bitrate) {
@@ -162,10 +201,19 @@ std::string rate_text(std::uint32_t bitrate) {
 }
 
 // "the host's", "the drives'".
-std::string possessive(const std::string& name) { return "the " + name + (name == "drives" ? "'" : "'s"); }
-std::string bus_name(const NamedBudget& bus) { return bus.name.empty() ? "the CAN bus" : possessive(bus.name) + " CAN bus"; }
+bool is_canopen(const std::string& name) { return name.rfind("CANopen", 0) == 0; }
+std::string possessive(const std::string& name) {
+  return is_canopen(name) ? name : "the " + name + (name == "drives" ? "'" : "'s");
+}
+std::string bus_name(const NamedBudget& bus) {
+  if (is_canopen(bus.name)) return "the " + bus.name;
+  return bus.name.empty() ? "the CAN bus" : possessive(bus.name) + " CAN bus";
+}
 
 std::string configuration_text(const BusOptions& options, const NamedBudget& bus) {
+  if (is_canopen(bus.name))
+    return fmt::format("SYNC, RPDO1 and TPDO1 at {:g} Hz, heartbeats every {} ms, {}", options.rate_hz,
+                       options.heartbeat_ms, bus_line_text(bus.line));
   return fmt::format("{} segment{} at {:g} Hz{}, {}{}", options.segments, options.segments == 1 ? "" : "s",
                      options.rate_hz, options.streaming ? ", a target streamed every cycle" : "",
                      bus_line_text(bus.line), bus.name.empty() ? "" : ", " + possessive(bus.name) + " traffic");
@@ -187,9 +235,14 @@ std::string format_bus_budgets(const std::vector<NamedBudget>& budgets, const Bu
   std::string text;
   for (const NamedBudget& bus : budgets) {
     const protocol::BusBudget& budget = bus.budget;
-    text += fmt::format("bus budget{}: {}; pose every {}, radii at most every {}, STATUS/STATS every {} cycles\n",
-                        bus.name.empty() ? "" : " of " + possessive(bus.name) + " bus", configuration_text(options, bus),
-                        options.rates.pose_every, options.rates.uncertainty_every, options.rates.status_every);
+    if (is_canopen(bus.name)) {
+      text += fmt::format("bus budget of the {}: {}\n", bus.name, configuration_text(options, bus));
+    } else {
+      text += fmt::format("bus budget{}: {}; pose every {}, radii at most every {}, STATUS/STATS every {} cycles\n",
+                          bus.name.empty() ? "" : " of " + possessive(bus.name) + " bus",
+                          configuration_text(options, bus), options.rates.pose_every,
+                          options.rates.uncertainty_every, options.rates.status_every);
+    }
     text += fmt::format("  {:<20} {:>10} {:>11} {:>8}\n", "message", "frames/s", "worst bits", "load");
     for (int i = 0; i < budget.message_count; ++i) {
       const protocol::MessageLoad& line = budget.messages[i];
@@ -205,13 +258,22 @@ std::string format_bus_budgets(const std::vector<NamedBudget>& budgets, const Bu
 
 std::string bus_budget_refusal(const std::vector<NamedBudget>& budgets, const BusOptions& options) {
   std::string over;
+  bool host_over = false;
   for (const NamedBudget& bus : budgets) {
     if (bus.budget.fits()) continue;
+    host_over = host_over || !is_canopen(bus.name);
     over += fmt::format("{}{} would carry up to {:.1f} % of its time ({}; worst-case stuffing)",
                         over.empty() ? "" : " and ", bus_name(bus), 100.0 * bus.budget.load,
                         configuration_text(options, bus));
   }
   if (over.empty()) return "";
+  if (!host_over) {
+    // Only CANopen buses: the drives' frames do not depend on what the
+    // runtime publishes, and CiA 402 drives send classical frames.
+    return fmt::format("{}, above the {:.0f} % limit: lower the cycle rate (--rate), raise the drives' bit rate "
+                       "(--drives-bitrate) or spread the drives over more buses (--cia402-buses, at most {})",
+                       over, 100.0 * firmware::kMaxBusLoad, firmware::kMaxDriveBuses);
+  }
   std::vector<std::string> ways{"publish less often (--pose-every, --uncertainty-every, --status-every)",
                                  "lower the cycle rate (--rate)", "raise the bit rate (--bitrate)"};
   if (!std::all_of(budgets.begin(), budgets.end(), [](const NamedBudget& bus) {
@@ -219,7 +281,9 @@ std::string bus_budget_refusal(const std::vector<NamedBudget>& budgets, const Bu
       })) {
     ways.push_back("send CAN FD frames (--can-format fd-brs, --data-bitrate)");
   }
-  if (!options.layout.drives_bus) {
+  if (options.cia402_drives > 0) {
+    ways.push_back("spread the drives over more buses (--cia402-buses, at most 4)");
+  } else if (!options.layout.drives_bus) {
     ways.push_back("put the drives on a bus of their own (" + options.layout.drives_option + ")");
   }
   std::string listed;
@@ -291,6 +355,13 @@ void register_bus_command(CLI::App& app, CommandOutput& output) {
                     "The host streams a pose target every cycle (and the runtime sends setpoints every cycle)");
   add_publish_rate_options(*command, options->rates);
   add_bus_layout_options(*command, options->layout, "The bus's bit rate, bit/s (CAN FD: the arbitration rate)", true);
+  command->add_option("--cia402", options->cia402_drives,
+                      "CiA 402 drives over CANopen instead of the protocol's drives: how many (one per cable), on "
+                      "buses of their own at the drives' format and rate (--drives-bitrate, else --bitrate)");
+  command->add_option("--cia402-buses", options->cia402_buses, "Buses the CiA 402 drives are spread over (1 to 4)")
+      ->capture_default_str();
+  command->add_option("--heartbeat-ms", options->heartbeat_ms, "The CiA 402 drives' heartbeat period, ms")
+      ->capture_default_str();
   command->add_flag("--json", options->json, "Print one JSON object instead of the table");
   command->callback([options, &output] { output = run_bus(*options); });
 }

@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include <cdcr/firmware/canopen/bus_budget.hpp>
 #include <cdcr/firmware/protocol/bus_budget.hpp>
 #include <cdcr/firmware/publish_rates.hpp>
 #include <cdcr/hal/can_timing.hpp>
@@ -49,6 +50,15 @@ struct BusOptions {
   firmware::PublishRates rates{};
   BusLayout layout;
   bool json = false;
+  // CiA 402 drives over CANopen instead of the protocol's: this many, as
+  // evenly as they go over cia402_buses buses of their own (the host's
+  // bus's format and rate), each with its heartbeat every heartbeat_ms.
+  int cia402_drives = 0;
+  int cia402_buses = 1;
+  int heartbeat_ms = 50;
+  // The drives on each bus as a configuration has them (cdcr-runtime
+  // --drives-config); empty: as evenly as they go.
+  std::vector<int> cia402_per_bus;
 };
 
 // One bus's budget, and the bus.
@@ -86,6 +96,9 @@ void validate_bus_options(BusOptions& options);
 void validate_publish_rates(const firmware::PublishRates& rates);
 // Every bus's budget, the host's first (a resolved layout).
 std::vector<NamedBudget> bus_budgets_of(const BusOptions& options);
+// With CiA 402 drives (options.cia402_drives > 0): the host's, then each
+// CANopen bus's.
+std::vector<NamedBudget> cia402_budgets_of(const BusOptions& options);
 // The budgets as tables, and their verdicts.
 std::string format_bus_budgets(const std::vector<NamedBudget>& budgets, const BusOptions& options);
 // One line when a bus's budget is above the limit: its load, the limit and

@@ -82,6 +82,13 @@ cli::BusOptions bus_options(int segments, double rate_hz, bool streaming, const 
   options.streaming = streaming;
   options.rates = bus.rates;
   options.layout = bus.layout;
+  if (!bus.cia402_per_bus.empty()) {
+    options.cia402_per_bus = bus.cia402_per_bus;
+    options.cia402_buses = int(bus.cia402_per_bus.size());
+    options.cia402_drives = 0;
+    for (int drives : bus.cia402_per_bus) options.cia402_drives += drives;
+    options.heartbeat_ms = bus.cia402_heartbeat_ms;
+  }
   return options;
 }
 

@@ -69,6 +69,15 @@ int main(int argc, char** argv) {
   cdcr::cli::add_publish_rate_options(app, bus.rates);
   std::string id_base_text;
   cdcr::cli::add_id_base_option(app, id_base_text);
+  std::string drives_kind = "protocol";
+  auto* drives_option =
+      app.add_option("--drives", drives_kind,
+                     "with --can: the drives' kind: protocol (CABLE_FEEDBACK / CABLE_SETPOINT) or cia402 (CiA 402 "
+                     "drives over CANopen, on the buses of --drives-config; SIGUSR1 recovers them after a fault)")
+          ->check(CLI::IsMember({"protocol", "cia402"}))
+          ->capture_default_str();
+  auto* drives_config_option =
+      app.add_option("--drives-config", bus.cia402_config, "with --drives cia402: the drives' configuration (JSON)");
   auto* streaming_option = app.add_flag("--streaming", bus.streaming,
                                         "with --can and --bitrate: plan the budget for a target streamed every cycle");
   replay_option->excludes(sim_option);
@@ -87,6 +96,11 @@ int main(int argc, char** argv) {
     bus.id_base = cdcr::cli::parse_id_base(id_base_text);
     if (drives_can_option->count() > 0 && can_interface.empty()) throw CLI::ValidationError("--drives-can needs --can");
     if (bus.layout.drives_bus && !run_sim) throw CLI::ValidationError("--drives-bus needs --sim (--can: --drives-can)");
+    if (drives_option->count() > 0 && can_interface.empty()) throw CLI::ValidationError("--drives needs --can");
+    if ((drives_kind == "cia402") != (drives_config_option->count() > 0))
+      throw CLI::ValidationError("--drives cia402 and --drives-config go together");
+    if (drives_kind == "cia402" && !drives_interface.empty())
+      throw CLI::ValidationError("--drives cia402 takes its buses from --drives-config, not --drives-can");
     if (!drives_interface.empty()) {
       bus.layout.drives_bus = true;
       bus.layout.drives_option = "--drives-can";

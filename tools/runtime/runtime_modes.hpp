@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <string>
+#include <vector>
 
 #include <cdcr/firmware/protocol/messages.hpp>
 #include <cdcr/firmware/publish_rates.hpp>
@@ -31,6 +32,12 @@ struct BusChoice {
   cli::BusLayout layout;
   firmware::PublishRates rates{};
   bool streaming = false;  // --can: plan for a target streamed every cycle (--circle streams)
+  // --can --drives cia402: the CiA 402 drives' configuration file
+  // (cli/drives_config.hpp); empty: the protocol's drives.
+  std::string cia402_config;
+  // Filled from it for the budget: the drives on each bus, their heartbeat.
+  std::vector<int> cia402_per_bus;
+  int cia402_heartbeat_ms = 50;
 };
 
 // Prints the budget of every bus of `segments` at rate_hz on `bus` and throws

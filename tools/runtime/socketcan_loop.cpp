@@ -6,10 +6,12 @@
 #include <stdexcept>
 #include <string>
 
+#include <cdcr/firmware/canopen/cia402_drives.hpp>
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/hal/shifted_can_bus.hpp>
 
 #include "cli/cli_errors.hpp"
+#include "cli/drives_config.hpp"
 #if CDCR_HAVE_LINUX_PLATFORM
 #include "cdcr/linux/file_flash.hpp"
 #include "cdcr/linux/mapped_model_storage.hpp"
@@ -30,8 +32,35 @@ using cli::InputError;
 namespace {
 
 volatile std::sig_atomic_t stop_requested = 0;
+volatile std::sig_atomic_t recover_requested = 0;
 
 void request_stop(int) { stop_requested = 1; }
+void request_recovery(int) { recover_requested = 1; }
+
+// The CiA 402 drives of --drives-config on their SocketCAN buses.
+struct Cia402Setup {
+  cdcr::linux_host::SocketCanBus buses[fw::canopen::kMaxDriveBuses];
+  cdcr::hal::CanBus* bus_pointers[fw::canopen::kMaxDriveBuses] = {};
+  cli::DrivesConfig config;
+};
+
+fw::canopen::Cia402Drives* open_cia402_drives(const std::string& path, double rate_hz) {
+  static Cia402Setup setup;
+  const auto period_us = static_cast<std::uint32_t>(std::llround(1e6 / rate_hz));
+  setup.config = cli::read_drives_config(path, period_us);
+  std::string error;
+  for (std::size_t b = 0; b < setup.config.buses.size(); ++b) {
+    if (!setup.buses[b].open(setup.config.buses[b], error, false))
+      throw InputError("CAN interface " + setup.config.buses[b] + " (--drives-config bus " + std::to_string(b) +
+                       "): " + error);
+    setup.bus_pointers[b] = &setup.buses[b];
+  }
+  static fw::canopen::Cia402Drives drives(setup.config.manager, setup.bus_pointers);
+  std::fprintf(stderr, "drives: %d CiA 402 drives on %zu buses, cycle %u us, heartbeat %u ms\n",
+               setup.config.manager.drive_count, setup.config.buses.size(), period_us,
+               unsigned(setup.config.manager.timing.heartbeat_ms));
+  return &drives;
+}
 
 void print_cycle_statistics(const fw::Runtime& runtime, const cdcr::hal::CanErrorCounters& can, double rate_hz,
                             double elapsed_s) {
@@ -45,6 +74,24 @@ void print_cycle_statistics(const fw::Runtime& runtime, const cdcr::hal::CanErro
               double(stats.jitter_max_ns) * 1e-3);
   std::printf("poses published %u, targets received %u; CAN tx dropped %u, rx overruns %u, bus errors %u\n",
               stats.poses_published, stats.targets_received, can.tx_dropped, can.rx_overruns, can.bus_errors);
+}
+
+// One line when the drives' phase changes, with the time since the start.
+void report_drives(const fw::canopen::Cia402Drives& drives, std::int64_t elapsed_ns) {
+  static fw::canopen::DrivePhase reported = fw::canopen::DrivePhase::reset;
+  const fw::canopen::DriveManager& manager = drives.manager();
+  if (manager.phase() == reported) return;
+  reported = manager.phase();
+  std::fprintf(stderr, "drives: %s after %.0f ms", fw::canopen::to_string(reported), double(elapsed_ns) * 1e-6);
+  if (reported == fw::canopen::DrivePhase::fault) {
+    const fw::canopen::DriveFaultReport& fault = manager.fault();
+    std::fprintf(stderr, ": %s, bus %d node %u (cable %d), detail 0x%X", fw::canopen::to_string(fault.fault),
+                 fault.cable >= 0 ? int(drives.manager().config().drives[fault.cable].bus) : -1, unsigned(fault.node),
+                 fault.cable, unsigned(fault.detail));
+    if (fault.object.index != 0)
+      std::fprintf(stderr, ", object 0x%04X:%02X", unsigned(fault.object.index), unsigned(fault.object.subindex));
+  }
+  std::fprintf(stderr, "\n");
 }
 
 }  // namespace
@@ -86,17 +133,35 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   sigaction(SIGINT, &action, nullptr);
   sigaction(SIGTERM, &action, nullptr);
 
+  struct sigaction recovery {};
+  recovery.sa_handler = request_recovery;
+  sigemptyset(&recovery.sa_mask);
+  sigaction(SIGUSR1, &recovery, nullptr);
+
   static cdcr::hal::ShiftedCanBus runtime_can(bus, protocol::id_offset(bus_choice.id_base));
   static cdcr::hal::ShiftedCanBus runtime_drives_can(drives_bus, protocol::id_offset(bus_choice.id_base));
+  fw::canopen::Cia402Drives* drives =
+      bus_choice.cia402_config.empty() ? nullptr : open_cia402_drives(bus_choice.cia402_config, rate_hz);
   static const cdcr::hal::Hal hal{clock,   timer, runtime_can, storage, console, flash_dir.empty() ? nullptr : &flash,
-                                  two_buses ? &runtime_drives_can : nullptr};
+                                  two_buses ? &runtime_drives_can : nullptr, drives};
   static fw::Runtime runtime(hal, fw::Geometry::prototype());
   if (!runtime.set_can_formats(layout.bus.format, two_buses ? layout.drives.format : layout.bus.format)) {
     throw InputError("the CAN interfaces do not take the formats asked for");
   }
   runtime.init();
+  if (drives != nullptr && runtime.geometry().cable_count() != drives->manager().drive_count()) {
+    throw InputError("--drives-config has " + std::to_string(drives->manager().drive_count()) +
+                     " drives, the model's robot " + std::to_string(runtime.geometry().cable_count()) + " cables");
+  }
   runtime.set_publish_rates(bus_choice.rates);
-  check_bus_budget(runtime.geometry().segment_count, rate_hz, bus_choice.streaming, bus_choice);
+  BusChoice planned = bus_choice;
+  if (drives != nullptr) {
+    const fw::canopen::DriveManagerConfig& config = drives->manager().config();
+    planned.cia402_per_bus.assign(std::size_t(config.bus_count), 0);
+    for (int i = 0; i < config.drive_count; ++i) ++planned.cia402_per_bus[config.drives[i].bus];
+    planned.cia402_heartbeat_ms = config.timing.heartbeat_ms;
+  }
+  check_bus_budget(runtime.geometry().segment_count, rate_hz, bus_choice.streaming, planned);
 
   const auto period_ns = static_cast<std::int64_t>(std::llround(1e9 / rate_hz));
   const std::int64_t start_ns = clock.now_ns();
@@ -105,7 +170,12 @@ int run_on_socketcan(const std::string& image_path, const std::string& interface
   while (stop_requested == 0) {
     const cdcr::hal::TimerTick tick = timer.wait_next();
     if (end_ns != 0 && tick.release_ns > end_ns) break;
+    if (recover_requested != 0) {
+      recover_requested = 0;
+      std::fprintf(stderr, runtime.recover_drives() ? "drives: recovering\n" : "drives: nothing to recover\n");
+    }
     runtime.run_cycle(tick);
+    if (drives != nullptr) report_drives(*drives, clock.now_ns() - start_ns);
   }
   print_cycle_statistics(runtime, bus.error_counters(), rate_hz, double(clock.now_ns() - start_ns) * 1e-9);
   if (two_buses) {

@@ -24,6 +24,11 @@ static_assert(kMaxSegments <= 8, "the CAN identifiers reserve room for 8 segment
 // GP training points an image may hold; bounds the per-cycle correction cost.
 using model::kMaxTrainingPoints;
 
+// CiA 402 drives (hal::Drives' CANopen backend): one per cable, over at
+// most this many buses, each with its own SYNC.
+inline constexpr int kMaxDrives = model::kMaxCables;
+inline constexpr int kMaxDriveBuses = 4;
+
 // Frames the runtime drains from the bus per cycle; the rest wait for the
 // next cycle, so a flood cannot stretch one cycle without bound.
 inline constexpr int kMaxRxFramesPerCycle = 64;

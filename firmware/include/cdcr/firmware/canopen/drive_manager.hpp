@@ -26,15 +26,14 @@
 #include <cstdint>
 
 #include "cdcr/firmware/canopen/cia402.hpp"
+#include "cdcr/firmware/capacity.hpp"
 #include "cdcr/firmware/canopen/frames.hpp"
 #include "cdcr/hal/can_bus.hpp"
-#include "cdcr/model/limits.hpp"
 
 namespace cdcr::firmware::canopen {
 
-inline constexpr int kMaxDrives = model::kMaxCables;
-// Buses the drives may be spread over, each with its own SYNC.
-inline constexpr int kMaxDriveBuses = 4;
+using firmware::kMaxDriveBuses;
+using firmware::kMaxDrives;
 // SDO requests sent per cycle while configuring, over every drive.
 inline constexpr int kMaxSdoRequestsPerCycle = 4;
 
@@ -129,6 +128,7 @@ class DriveManager {
   DrivePhase phase() const { return phase_; }
   const DriveFaultReport& fault() const { return fault_; }
   int drive_count() const { return config_.drive_count; }
+  const DriveManagerConfig& config() const { return config_; }
   // Every drive's position arrived since the last SYNC.
   bool positions_fresh() const;
   // The cable lengths of the latest TPDOs, mm.
