@@ -20,6 +20,11 @@ declare -A package_groups=(
   # modules, and drive the bus with can-utils; the CAN FD test's client is
   # python-can with the DBC read by canmatrix.
   [uml]="user-mode-linux kmod iproute2 can-utils python3-can python3-canmatrix"
+  # The simulated CiA 402 drives (ctest -L canopen): Node.js and npm, and the
+  # compiler node-gyp builds the canopen package's one native dependency
+  # (node-crc) with; then the package itself from the npm registry, pinned by
+  # tools/sim/cia402/package-lock.json.
+  [canopen]="nodejs npm make g++"
   # Cortex-M cross builds and their tests on QEMU's MPS2 boards (ctest -L qemu).
   [cross]="gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm"
 )
@@ -32,7 +37,31 @@ die() {
 }
 
 is_installed() {
-  [[ $(dpkg-query -W -f='${Status}' "$1" 2>/dev/null || true) == "install ok installed" ]]
+  [[ $(dpkg-query -W -f='${Status}' "$1" 2>/dev/null || true) == "install ok installed" ]] && return 0
+  # Or provided by an installed package (a Node.js build that brings its npm).
+  dpkg-query -W -f='${Status}|${Provides}\n' 2>/dev/null | grep '^install ok installed|' | cut -d'|' -f2 |
+    tr ',' '\n' | sed 's/ *(.*//; s/^ *//' | grep -qx "$1"
+}
+
+here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
+
+# The npm packages of the canopen group (npm ci builds node-crc with
+# node-gyp), unless every package of the lock file is there at its version
+# and canopen loads.
+install_npm_packages() {
+  local dir=$here/sim/cia402
+  if node -e "
+      const fs = require('fs'), lock = require('$dir/package-lock.json').packages;
+      for (const [path, entry] of Object.entries(lock)) {
+        if (!path) continue;
+        const manifest = '$dir/' + path + '/package.json';
+        if (!fs.existsSync(manifest) || require(manifest).version !== entry.version) process.exit(1);
+      }
+      require('$dir/node_modules/canopen');" 2>/dev/null; then
+    return 0
+  fi
+  (cd "$dir" && npm ci --no-audit --no-fund) >>"$log_file" 2>&1 </dev/null || show_log_tail_and_fail "npm ci in $dir"
+  echo "install-deps: canopen: npm packages installed in $dir (log: $log_file)"
 }
 
 show_log_tail_and_fail() {
@@ -59,8 +88,15 @@ for package in "${wanted[@]}"; do
   fi
 done
 
+wants_npm=false
+[[ " ${groups[*]} " == *" canopen "* ]] && wants_npm=true
+
 if [[ ${#missing[@]} -eq 0 ]]; then
   echo "install-deps: ${groups[*]}: all packages present"
+  if $wants_npm; then
+    : >"$log_file"
+    install_npm_packages
+  fi
   exit 0
 fi
 
@@ -73,3 +109,5 @@ apt-get update >>"$log_file" 2>&1 </dev/null || show_log_tail_and_fail "apt-get 
 apt-get install -y --no-install-recommends "${missing[@]}" >>"$log_file" 2>&1 </dev/null ||
   show_log_tail_and_fail "apt-get install"
 echo "install-deps: ${groups[*]}: installed ${missing[*]} (log: $log_file)"
+$wants_npm && install_npm_packages
+exit 0

@@ -6,11 +6,12 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
 started=$SECONDS
 # The build needs only the base packages. The test groups' packages (the
-# cross toolchain and QEMU, clang, User-Mode Linux, scikit-learn) install
-# while it runs: apt waits on the network and the disk, the build on the CPU.
+# cross toolchain and QEMU, clang, User-Mode Linux, scikit-learn, Node.js
+# and the npm canopen stack) install while it runs: apt and npm wait on the
+# network and the disk, the build on the CPU.
 bash tools/install-deps.sh base
 group_log=$(mktemp)
-bash tools/install-deps.sh sklearn fuzz uml cross >"$group_log" 2>&1 &
+bash tools/install-deps.sh sklearn fuzz uml cross canopen >"$group_log" 2>&1 &
 group_install=$!
 # The measuring programs (cdcr-bench-*) are not built here: no test runs
 # them, and they cost about 75 s of a core. Each tools/bench/run_*.sh
