@@ -181,7 +181,11 @@ TEST_F(RuntimeCia402Test, HeartbeatLossAndRefusedConfiguration) {
   EXPECT_EQ(runtime_->active_fault_detail(), FaultDetail::drive(2));
 
   // A drive that refuses CSP: the runtime never runs.
-  for (auto& drive : drives_) drive = TestDrive{drive.node, NmtState::boot_up};
+  for (auto& drive : drives_) {
+    const NodeId node = drive.node;
+    drive = TestDrive{};
+    drive.node = node;
+  }
   drives_[0].refused.insert(0x6060);
   make_runtime();
   for (int n = 0; n < 300; ++n) cycle();

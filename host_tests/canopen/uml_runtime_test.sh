@@ -1,0 +1,104 @@
+#!/bin/sh
+# The runtime with CiA 402 drives, run inside the guest (run_in_uml.sh):
+# cdcr-runtime --drives cia402 on vcan0 against 16 simulated drives
+# (tools/sim/cia402/drive_sim.js, one process per bus, four drives on each of
+# vcan1..vcan4). From power-up every drive must be configured and enabled
+# ("drives: operational" on stderr) within operational_limit_s; then
+# uml_host_peer.py sends a position target on vcan0, which must converge and
+# the drives must reach their setpoints; the pose published once the robot
+# is still must match cdcr-runtime --replay of the drives' final positions.
+#   CDCR_RUNTIME, CDCR_CHECK (socketcan_check): host-built binaries;
+#   CDCR_EXTRA: the protocol's DBC; CDCR_WORK_DIR: scratch space.
+#
+# Inside User-Mode Linux four node processes and the runtime share one slow
+# CPU, so the cycle is 20 Hz and the drives' timing generous; the peer
+# prints the SYNC rate the guest sustained.
+set -u
+work=$CDCR_WORK_DIR
+here=$(dirname "$0")
+# shellcheck disable=SC2034
+log=$work/none  # bus_waits.sh's fail copies a capture; this test keeps none
+. "$here/../socketcan/bus_waits.sh"
+bin=$(dirname "$CDCR_RUNTIME")
+drive_sim=$here/../../tools/sim/cia402/drive_sim.js
+image=$work/model.img
+config=$work/drives.json
+rate=20
+operational_limit_s=90
+
+"$CDCR_CHECK" image "$image" || fail "cannot write the model image"
+"$CDCR_CHECK" fd-values "$image" > "$work/values.txt" || fail "cannot compute the target"
+target=$(sed -n 's/^TARGET_MM=//p' "$work/values.txt")
+
+for n in 1 2 3 4; do
+  ip link add dev "vcan$n" type vcan && ip link set "vcan$n" txqueuelen 10000 && ip link set up "vcan$n" ||
+    fail "cannot add vcan$n"
+done
+
+# Cable i = 4 s + k on bus s, node k + 1. Directions and scales differ from
+# cable to cable so that a conversion that mixes them up shows; counts 0 is
+# the straight robot (120 mm cables, the prototype's segment length).
+{
+  echo '{"buses": ["vcan1", "vcan2", "vcan3", "vcan4"], "heartbeat_ms": 100, "heartbeat_periods_lost": 10,'
+  echo ' "stale_cycles": 20, "sync_window_us": 20000, "boot_timeout_ms": 20000, "sdo_timeout_ms": 2000,'
+  echo ' "enable_timeout_ms": 10000, "max_speed_mm_per_s": 20, "drives": ['
+  i=0
+  while [ "$i" -lt 16 ]; do
+    [ $((i % 2)) -eq 0 ] && direction=1 || direction=-1
+    [ $((i % 4)) -lt 2 ] && counts=1000 || counts=800
+    [ "$i" -lt 15 ] && comma=, || comma=
+    echo "  {\"cable\": $i, \"bus\": $((i / 4)), \"node\": $((i % 4 + 1)), \"counts_per_mm\": $counts,"
+    echo "   \"direction\": $direction, \"homing_offset_mm\": 120.0}$comma"
+    i=$((i + 1))
+  done
+  echo ']}'
+} > "$config"
+
+sims=""
+stop_all() {
+  [ -n "${runtime_pid:-}" ] && kill -INT "$runtime_pid" 2>/dev/null && wait "$runtime_pid"
+  # shellcheck disable=SC2086
+  kill $sims 2>/dev/null
+  # shellcheck disable=SC2086
+  wait $sims 2>/dev/null
+}
+trap stop_all EXIT
+
+# The drives first: they must answer the NMT reset of the runtime's first cycle.
+for n in 1 2 3 4; do
+  node "$drive_sim" --can "vcan$n" --nodes 1,2,3,4 --relay "$bin/cdcr-can-relay" --initial-counts 0 \
+    2> "$work/drive_sim.$n.err" &
+  sims="$sims $!"
+done
+sims_up() { [ "$(cat "$work"/drive_sim.*.err | grep -c 'drive(s) on vcan')" -ge 4 ]; }
+wait_until "the drive simulators" sims_up
+progress "16 drives up"
+
+"$CDCR_RUNTIME" --can vcan0 --drives cia402 --drives-config "$config" --image "$image" --rate "$rate" --seconds 0 \
+  > "$work/runtime.out" 2> "$work/runtime.err" &
+runtime_pid=$!
+# shellcheck disable=SC2034  # bus_waits.sh's wait_until reads it
+wait_seconds=$operational_limit_s
+operational() { grep -q '^drives: operational after' "$work/runtime.err"; }
+wait_until "drives: operational" operational
+grep '^drives: ' "$work/runtime.err"
+progress "$(grep '^drives: operational after' "$work/runtime.err")"
+
+/usr/bin/python3 "$here/uml_host_peer.py" move --dbc "$CDCR_EXTRA" --config "$config" --target "$target" \
+  --cables "$work/final_cables.csv" --pose "$work/final_pose.txt" || fail "the move"
+progress "moved and still"
+
+kill -INT "$runtime_pid"
+wait "$runtime_pid"
+runtime_status=$?
+runtime_pid=""
+echo "--- cdcr-runtime"
+cat "$work/runtime.err" "$work/runtime.out"
+[ "$runtime_status" -eq 0 ] || fail "cdcr-runtime exited with $runtime_status after SIGINT"
+grep -q '^drives: fault' "$work/runtime.err" && fail "the drives faulted"
+
+"$CDCR_RUNTIME" --replay "$work/final_cables.csv" --image "$image" --out "$work/replay.csv" || fail "the replay"
+/usr/bin/python3 "$here/uml_host_peer.py" compare --pose "$work/final_pose.txt" --replay "$work/replay.csv" ||
+  fail "the pose against the replay"
+progress "all done"
+echo "SOCKETCAN_TEST_PASS"
