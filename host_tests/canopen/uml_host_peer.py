@@ -78,6 +78,9 @@ def move(args):
             values = {k: s.phys_value for k, s in frame.decode(bytes(msg.data)).items()}
             if frame.name == "STATUS":
                 state = int(values["STATE"])
+                # A stale cycle (FAULT for a moment on a slow guest) restarts the wait for stillness.
+                if state != RUN:
+                    last_change = time.monotonic()
             elif frame.name.startswith("POSE_") and frame.name != "POSE_UNCERTAINTY":
                 for k, v in values.items():
                     if k == "SEQUENCE":  # new with every pose
@@ -112,7 +115,9 @@ def move(args):
                     return item
             if condition(None):
                 return None
-            time.sleep(0.01)
+            # Each poll is a system call per bus, slow in the guest; the
+            # sockets hold many cycles' frames.
+            time.sleep(0.05)
         fail(f"timed out waiting for {what}")
 
     wait("STATUS in RUN", lambda item: state == RUN)
@@ -144,14 +149,14 @@ def move(args):
     moved_s = time.monotonic()
 
     def settled(item):
-        if None in actual or None in target or any(abs(a - t) > SETTLED_COUNTS for a, t in zip(actual, target)):
+        if state != RUN or None in actual or None in target or any(abs(a - t) > SETTLED_COUNTS for a, t in zip(actual, target)):
             return False
         return time.monotonic() - last_change >= STILL_SECONDS
 
     wait("every drive on its setpoint, the pose still", settled)
     say(f"drives on their setpoints and still {time.monotonic() - moved_s:.1f} s after the report")
     if state != RUN:
-        fail(f"STATUS STATE {state} once still")
+        fail(f"STATUS STATE {state} once still")  # the wait above ends only in RUN
     # The setpoints the drives reached are the target's solution: the pose of
     # their positions is the target, to the residual and the bus's 0.01 mm.
     reached_mm = math.dist([float(pose[k]) for k in ("POSE_POSITION_XY_X", "POSE_POSITION_XY_Y", "POSE_POSITION_Z_Z")],
@@ -164,7 +169,7 @@ def move(args):
     # (tools/cli/drives_config.hpp).
     lengths = [0.0] * len(drives)
     for d in drives:
-        lengths[d["cable"]] = actual[d["cable"]] / (d["counts_per_mm"] * d["direction"]) + d["homing_offset_mm"] + 0.05
+        lengths[d["cable"]] = actual[d["cable"]] / (d["counts_per_mm"] * d["direction"]) + d["homing_offset_mm"]
     segments = len(drives) // 4
     with open(args.cables, "w") as out:
         out.write(",".join(f"l{s + 1}_{k + 1}" for s in range(segments) for k in range(4)) + "\n")

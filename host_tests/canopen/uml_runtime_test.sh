@@ -35,9 +35,12 @@ for n in 1 2 3 4; do
     fail "cannot add vcan$n"
 done
 
-# Cable i = 4 s + k on bus s, node k + 1. Directions and scales differ from
-# cable to cable so that a conversion that mixes them up shows; counts 0 is
-# the straight robot (120 mm cables, the prototype's segment length).
+# Cable i = 4 s + k on bus s, node k + 1. Directions, scales and homing
+# offsets differ from cable to cable so that a conversion that mixes them up
+# shows (the pose depends on a segment's cable differences only, so an
+# offset common to all would not). The drives power up on the straight robot:
+# every cable 120 mm, the prototype's segment length.
+initial_counts=2000,-1000,0,800  # (120 - homing_offset_mm) * counts_per_mm * direction
 {
   echo '{"buses": ["vcan1", "vcan2", "vcan3", "vcan4"], "heartbeat_ms": 100, "heartbeat_periods_lost": 10,'
   echo ' "stale_cycles": 20, "sync_window_us": 20000, "boot_timeout_ms": 20000, "sdo_timeout_ms": 2000,'
@@ -48,7 +51,7 @@ done
     [ $((i % 4)) -lt 2 ] && counts=1000 || counts=800
     [ "$i" -lt 15 ] && comma=, || comma=
     echo "  {\"cable\": $i, \"bus\": $((i / 4)), \"node\": $((i % 4 + 1)), \"counts_per_mm\": $counts,"
-    echo "   \"direction\": $direction, \"homing_offset_mm\": 120.0}$comma"
+    echo "   \"direction\": $direction, \"homing_offset_mm\": $((118 + i % 4)).0}$comma"
     i=$((i + 1))
   done
   echo ']}'
@@ -66,7 +69,7 @@ trap stop_all EXIT
 
 # The drives first: they must answer the NMT reset of the runtime's first cycle.
 for n in 1 2 3 4; do
-  node "$drive_sim" --can "vcan$n" --nodes 1,2,3,4 --relay "$bin/cdcr-can-relay" --initial-counts 0 \
+  node "$drive_sim" --can "vcan$n" --nodes 1,2,3,4 --relay "$bin/cdcr-can-relay" --initial-counts "$initial_counts" \
     2> "$work/drive_sim.$n.err" &
   sims="$sims $!"
 done

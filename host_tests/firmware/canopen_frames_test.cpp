@@ -17,27 +17,14 @@
 #include <cdcr/firmware/canopen/cia402.hpp>
 #include <cdcr/firmware/canopen/frames.hpp>
 
+#include "golden_frames.hpp"
+
 namespace cdcr::firmware::canopen {
 namespace {
 
-using Bytes = std::vector<std::uint8_t>;
-
-hal::CanFrame frame_of(std::uint32_t id, const Bytes& bytes) {
-  hal::CanFrame frame;
-  frame.id = id;
-  frame.dlc = static_cast<std::uint8_t>(bytes.size());
-  std::copy(bytes.begin(), bytes.end(), frame.data);
-  return frame;
-}
-
-std::string text(const hal::CanFrame& frame) {
-  char buffer[64];
-  int used = std::snprintf(buffer, sizeof buffer, "0x%03X [", unsigned(frame.id));
-  for (int i = 0; i < frame.dlc && used < 56; ++i)
-    used += std::snprintf(buffer + used, sizeof buffer - used, i ? " %02X" : "%02X", frame.data[i]);
-  std::snprintf(buffer + used, sizeof buffer - used, "]");
-  return buffer;
-}
+using test_support::Bytes;
+using test_support::frame_of;
+std::string text(const hal::CanFrame& frame) { return test_support::frame_text(frame); }
 
 void expect_frame(const hal::CanFrame& actual, std::uint32_t id, const Bytes& bytes) {
   EXPECT_EQ(text(actual), text(frame_of(id, bytes)));

@@ -24,18 +24,13 @@
 #include <cdcr/firmware/protocol.hpp>
 #include <cdcr/hal/shifted_can_bus.hpp>
 
+#include "golden_frames.hpp"
+
 namespace cdcr::firmware::protocol {
 namespace {
 
-using Bytes = std::vector<std::uint8_t>;
-
-hal::CanFrame frame_of(std::uint32_t id, const Bytes& bytes) {
-  hal::CanFrame frame;
-  frame.id = id;
-  frame.dlc = static_cast<std::uint8_t>(bytes.size());
-  std::copy(bytes.begin(), bytes.end(), frame.data);
-  return frame;
-}
+using test_support::Bytes;
+using test_support::frame_of;
 
 // "0x122 [26 9E FF FF 05 5A]", to name the golden frame a failure is about.
 std::string golden_name(std::uint32_t id, const Bytes& bytes) {

@@ -153,13 +153,22 @@ void validate_publish_rates(const firmware::PublishRates& rates) {
   }
 }
 
-std::vector<NamedBudget> bus_budgets_of(const BusOptions& options) {
-  if (options.cia402_drives > 0) return cia402_budgets_of(options);
+namespace {
+
+protocol::BusTraffic traffic_of(const BusOptions& options) {
   protocol::BusTraffic traffic;
   traffic.segments = options.segments;
   traffic.cycle_hz = static_cast<std::uint32_t>(options.rate_hz + 0.5);
   traffic.streaming = options.streaming;
   traffic.rates = options.rates;
+  return traffic;
+}
+
+}  // namespace
+
+std::vector<NamedBudget> bus_budgets_of(const BusOptions& options) {
+  if (options.cia402_drives > 0) return cia402_budgets_of(options);
+  const protocol::BusTraffic traffic = traffic_of(options);
   const BusLayout& layout = options.layout;
   if (!layout.drives_bus) {
     return {{"", layout.bus, protocol::bus_budget(traffic, bus_setup(layout.bus, protocol::BusRole::shared))}};
@@ -171,11 +180,7 @@ std::vector<NamedBudget> bus_budgets_of(const BusOptions& options) {
 // The host's bus without the drives' traffic, then each CANopen bus, the
 // first ones with a drive more when they do not share evenly.
 std::vector<NamedBudget> cia402_budgets_of(const BusOptions& options) {
-  protocol::BusTraffic traffic;
-  traffic.segments = options.segments;
-  traffic.cycle_hz = static_cast<std::uint32_t>(options.rate_hz + 0.5);
-  traffic.streaming = options.streaming;
-  traffic.rates = options.rates;
+  const protocol::BusTraffic traffic = traffic_of(options);
   const BusLayout& layout = options.layout;
   std::vector<NamedBudget> budgets{
       {"host", layout.bus, protocol::bus_budget(traffic, bus_setup(layout.bus, protocol::BusRole::host))}};
