@@ -19,6 +19,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
+#include <memory>
 #include <string>
 #include <thread>
 #include <vector>
@@ -134,11 +135,15 @@ class ManagerOnNpmStack : public ::testing::Test {
  protected:
   static constexpr int kDrives = 4;
 
+  // A fatal failure here skips the test's body.
+  void SetUp() override {
+    node_ = std::getenv("CDCR_NODE");
+    sim_ = std::getenv("CDCR_DRIVE_SIM");
+    ASSERT_TRUE(node_ != nullptr && sim_ != nullptr) << "CDCR_NODE and CDCR_DRIVE_SIM are set by ctest";
+  }
+
   void start(const std::vector<std::string>& faults = {}) {
-    const char* node = std::getenv("CDCR_NODE");
-    const char* sim = std::getenv("CDCR_DRIVE_SIM");
-    ASSERT_TRUE(node != nullptr && sim != nullptr) << "CDCR_NODE and CDCR_DRIVE_SIM are set by ctest";
-    std::vector<std::string> arguments{node, sim, "--stdio", "--nodes", "1,2,3,4", "--tau-ms", "2",
+    std::vector<std::string> arguments{node_, sim_, "--stdio", "--nodes", "1,2,3,4", "--tau-ms", "2",
                                        "--initial-counts", "0,1000,-2000,3000"};
     for (const std::string& fault : faults) {
       arguments.push_back("--fault");
@@ -179,6 +184,8 @@ class ManagerOnNpmStack : public ::testing::Test {
            std::to_string(fault.detail);
   }
 
+  const char* node_ = nullptr;
+  const char* sim_ = nullptr;
   DriveManagerConfig config_;
   std::unique_ptr<PipeBus> bus_;
   std::unique_ptr<DriveManager> manager_;
