@@ -172,6 +172,23 @@ TEST_F(DriveManagerTest, EmergencyThenRecovery) {
   for (const auto& drive : drives_) EXPECT_EQ(drive.statusword, 0x0237);
 }
 
+// A heartbeat sent just before the NMT start reached the drive arrives after
+// it: pre-operational once more, not a fault. After an operational one, or
+// once enabled, it is.
+TEST_F(DriveManagerTest, PreOperationalHeartbeatInFlightAtTheStart) {
+  DriveManager manager(config_);
+  ASSERT_GT(run_until(manager, DrivePhase::enable, 1000), 0);
+  bus_.node(1).send(heartbeat_frame({3, NmtState::pre_operational}));
+  cycle(manager);
+  ASSERT_NE(manager.phase(), DrivePhase::fault) << to_string(manager.fault().fault);
+  ASSERT_GT(run_until(manager, DrivePhase::operational, 1000), 0);
+  bus_.node(1).send(heartbeat_frame({3, NmtState::pre_operational}));
+  cycle(manager);
+  EXPECT_EQ(manager.fault().fault, DriveFault::nmt_left);
+  EXPECT_EQ(manager.fault().node, 3);
+  EXPECT_EQ(manager.fault().detail, 0x7Fu);
+}
+
 TEST_F(DriveManagerTest, StatuswordFaultWithoutEmergency) {
   DriveManager manager(config_);
   ASSERT_GT(run_until(manager, DrivePhase::operational, 1000), 0);

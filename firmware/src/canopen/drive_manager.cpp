@@ -155,8 +155,12 @@ bool DriveManager::take(const hal::CanFrame& frame, int bus) {
         // A drive that boots again has lost its configuration.
         if (phase_ == DrivePhase::start || phase_ == DrivePhase::enable || phase_ == DrivePhase::operational)
           fail(DriveFault::nmt_left, cable, static_cast<std::uint32_t>(heartbeat.state));
-      } else if ((phase_ == DrivePhase::enable || phase_ == DrivePhase::operational) &&
-                 heartbeat.state != NmtState::operational) {
+      } else if (heartbeat.state == NmtState::operational) {
+        drive.seen_operational = true;
+      } else if (phase_ == DrivePhase::operational ||
+                 (phase_ == DrivePhase::enable && drive.seen_operational)) {
+        // In enable, a heartbeat the drive sent before the NMT start reached
+        // it may still arrive: only one after an operational one counts.
         fail(DriveFault::nmt_left, cable, static_cast<std::uint32_t>(heartbeat.state));
       }
       return true;

@@ -148,6 +148,7 @@ class DriveManager {
     std::uint32_t sdo_sent_cycle = 0;
     bool heartbeat_seen = false;
     NmtState nmt = NmtState::boot_up;
+    bool seen_operational = false;  // a heartbeat said so since the NMT start
     std::uint32_t heartbeat_cycle = 0;
     bool tpdo_seen = false;        // since the last SYNC
     bool has_position = false;
