@@ -39,8 +39,13 @@ die() {
 is_installed() {
   [[ $(dpkg-query -W -f='${Status}' "$1" 2>/dev/null || true) == "install ok installed" ]] && return 0
   # Or provided by an installed package (a Node.js build that brings its npm).
-  dpkg-query -W -f='${Status}|${Provides}\n' 2>/dev/null | grep '^install ok installed|' | cut -d'|' -f2 |
-    tr ',' '\n' | sed 's/ *(.*//; s/^ *//' | grep -qx "$1"
+  # The list is read whole before it is searched: an early-exiting grep at the
+  # end of a pipe would kill the writers with SIGPIPE, which pipefail reports
+  # as "not installed" whenever the race goes that way.
+  local provided
+  provided=$(dpkg-query -W -f='${Status}|${Provides}\n' 2>/dev/null | sed -n 's/^install ok installed|//p' |
+    tr ',' '\n' | sed 's/ *(.*//; s/^ *//')
+  [[ $'\n'$provided$'\n' == *$'\n'"$1"$'\n'* ]]
 }
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
