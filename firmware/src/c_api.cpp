@@ -2,7 +2,9 @@
 // (hal/callbacks), in the caller's storage. Cable lengths, targets, the payload
 // and homing are queued and handed to the runtime's direct inputs at the next
 // step, ahead of the bus's frames, in the values the protocol's frames would
-// carry (the same checks as from a bus); its own frames go to can_send.
+// carry (the same checks as from a bus); its own frames go to can_send. With
+// CiA 402 drives (cdcr_config.cia402_drives) the cable lengths come from them
+// instead, over the drives_can callbacks.
 
 #include "cdcr/cdcr.h"
 
@@ -12,6 +14,7 @@
 #include <new>
 
 #include "cdcr/callbacks/callback_hal.hpp"
+#include "cdcr/firmware/canopen/cia402_drives.hpp"
 #include "cdcr/firmware/runtime.hpp"
 #include "cdcr/hal/shifted_can_bus.hpp"
 #include "cdcr/model/unit_quaternion.hpp"
@@ -112,21 +115,62 @@ class InputQueue final : public CycleInputs {
   int frames_ = 0;
 };
 
+// The drives' configuration of the C API's, with its defaults; false if
+// validate() refuses it.
+bool drives_config_from(const cdcr_cia402_config& in, std::int64_t period_ns, canopen::DriveManagerConfig& out) {
+  if (in.drive_count < 1 || in.drive_count > kMaxDrives || period_ns <= 0 || period_ns % 1000 != 0 ||
+      period_ns / 1000 > std::numeric_limits<std::uint32_t>::max() || in.heartbeat_ms > 0xFFFF)
+    return false;
+  out = canopen::DriveManagerConfig{};
+  out.drive_count = in.drive_count;
+  out.bus_count = in.bus_count;
+  for (int i = 0; i < in.drive_count; ++i) {
+    const cdcr_cia402_drive& d = in.drives[i];
+    if (d.bus < 0 || d.bus >= kMaxDriveBuses || d.node < 1 || d.node > 127) return false;
+    out.drives[i] = {std::uint8_t(d.bus), canopen::NodeId(d.node), double(d.counts_per_mm), double(d.homing_offset_mm)};
+  }
+  const auto or_default = [](std::uint32_t value, std::uint32_t fallback) { return value != 0 ? value : fallback; };
+  out.timing.cycle_period_us = std::uint32_t(period_ns / 1000);
+  out.timing.sync_window_us = or_default(in.sync_window_us, out.timing.cycle_period_us / 2);
+  out.timing.heartbeat_ms = std::uint16_t(or_default(in.heartbeat_ms, out.timing.heartbeat_ms));
+  out.heartbeat_periods_lost = or_default(in.heartbeat_periods_lost, out.heartbeat_periods_lost);
+  out.stale_cycles = or_default(in.stale_cycles, out.stale_cycles);
+  out.boot_timeout_ms = or_default(in.boot_timeout_ms, out.boot_timeout_ms);
+  out.sdo_timeout_ms = or_default(in.sdo_timeout_ms, out.sdo_timeout_ms);
+  out.enable_timeout_ms = or_default(in.enable_timeout_ms, out.enable_timeout_ms);
+  if (in.max_speed_mm_per_s != 0) out.max_speed_mm_per_s = double(in.max_speed_mm_per_s);
+  if (!(out.max_speed_mm_per_s > 0) || !std::isfinite(out.max_speed_mm_per_s)) return false;
+  return canopen::validate(out) == canopen::DriveConfigStatus::ok;
+}
+
 // Everything cdcr_runtime holds. The HAL comes before the runtime, which
 // keeps references to its parts.
 struct CRuntime {
-  CRuntime(const cdcr_config& config, const Geometry& fallback, std::uint32_t id_base)
+  CRuntime(const cdcr_config& config, const Geometry& fallback, std::uint32_t id_base,
+           const canopen::DriveManagerConfig* drives_config)
       : hal(config.callbacks, config.model_image, config.model_image_size),
         can(hal.hal().can, protocol::id_offset(id_base)),
-        runtime(with_can(hal.hal(), can), fallback) {}
+        drives_buses{{hal.callbacks(), 0}, {hal.callbacks(), 1}, {hal.callbacks(), 2}, {hal.callbacks(), 3}},
+        drives(drives_config != nullptr ? *drives_config : canopen::DriveManagerConfig{}, bus_pointers()),
+        runtime(with_can(hal.hal(), can, drives_config != nullptr ? &drives : nullptr), fallback) {}
 
-  static hal::Hal with_can(const hal::Hal& h, hal::CanBus& bus) {
-    return hal::Hal{h.clock, h.timer, bus, h.model_storage, h.console, h.flash};
+  static hal::Hal with_can(const hal::Hal& h, hal::CanBus& bus, hal::Drives* drives) {
+    hal::Hal out{h.clock, h.timer, bus, h.model_storage, h.console, h.flash};
+    out.drives = drives;
+    return out;
+  }
+  using BusPointers = hal::CanBus* const[kMaxDriveBuses];
+  const BusPointers& bus_pointers() {
+    for (int b = 0; b < kMaxDriveBuses; ++b) drives_bus_pointers[b] = &drives_buses[b];
+    return drives_bus_pointers;
   }
 
   std::uint32_t magic = 0;
   callbacks::CallbackHal hal;
   hal::ShiftedCanBus can;  // the callbacks' bus at the identifier base
+  callbacks::CallbackDrivesBus drives_buses[kMaxDriveBuses];
+  hal::CanBus* drives_bus_pointers[kMaxDriveBuses] = {};
+  canopen::Cia402Drives drives;  // used only with cia402_drives
   InputQueue inputs;
   Runtime runtime;
 };
@@ -178,10 +222,14 @@ namespace protocol = cdcr::firmware::protocol;
 static_assert(int(CDCR_STATE_FAULT) == int(firmware::RuntimeState::fault), "states as in fault.hpp");
 static_assert(int(CDCR_FAULT_HOMING_MALFORMED) == int(firmware::FaultCode::homing_malformed), "faults as fault.hpp");
 static_assert(int(CDCR_FAULT_DRIVE_REFUSED) == int(firmware::FaultCode::drive_refused), "faults as fault.hpp");
+static_assert(int(CDCR_FAULT_DRIVES_COMMAND_MALFORMED) == int(firmware::FaultCode::drives_command_malformed),
+              "faults as fault.hpp");
 static_assert(int(CDCR_IK_IN_PROGRESS) == int(protocol::IkOutcome::in_progress), "outcomes as in messages.hpp");
 static_assert(int(CDCR_IK_REFUSED_EXTRAPOLATING) == int(protocol::IkOutcome::refused_extrapolating), "outcomes");
 static_assert(int(CDCR_TARGET_POSE) == int(protocol::TargetMode::pose), "modes as in messages.hpp");
 static_assert(CDCR_MAX_SEGMENTS == firmware::kMaxSegments, "segment capacity as in capacity.hpp");
+static_assert(CDCR_MAX_CABLES == firmware::kMaxDrives, "a drive per cable, as in capacity.hpp");
+static_assert(CDCR_MAX_DRIVE_BUSES == firmware::kMaxDriveBuses, "drive buses as in capacity.hpp");
 
 extern "C" {
 
@@ -195,7 +243,12 @@ cdcr_result cdcr_init(cdcr_runtime* runtime, const cdcr_config* config) {
   if (!firmware::geometry_from_config(config->fallback_geometry, fallback)) return CDCR_ERROR_INVALID_ARGUMENT;
   const std::uint32_t id_base = config->can_id_base == 0 ? protocol::kDefaultIdBase : config->can_id_base;
   if (!protocol::is_valid_id_base(id_base)) return CDCR_ERROR_INVALID_ARGUMENT;
-  auto* c = new (firmware::aligned_storage(runtime)) CRuntime(*config, fallback, id_base);
+  firmware::canopen::DriveManagerConfig drives;
+  if (config->cia402_drives != nullptr &&
+      !firmware::drives_config_from(*config->cia402_drives, config->period_ns, drives))
+    return CDCR_ERROR_INVALID_ARGUMENT;
+  auto* c = new (firmware::aligned_storage(runtime))
+      CRuntime(*config, fallback, id_base, config->cia402_drives != nullptr ? &drives : nullptr);
   c->hal.timer().start(config->period_ns);
   c->runtime.init();
   c->magic = firmware::kInitializedMagic;
@@ -213,6 +266,7 @@ cdcr_result cdcr_set_segment_cable_lengths(cdcr_runtime* runtime, int segment, c
   CRuntime* c = nullptr;
   if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
   if (lengths_mm == nullptr) return CDCR_ERROR_NULL_ARGUMENT;
+  if (c->runtime.has_drives()) return CDCR_ERROR_NOT_APPLICABLE;
   if (segment < 0 || segment >= c->runtime.geometry().segment_count) return CDCR_ERROR_INVALID_ARGUMENT;
   const int cables = c->runtime.geometry().segments[segment].cables.count;
   for (int k = 0; k < cables; ++k) {
@@ -236,6 +290,7 @@ cdcr_result cdcr_set_cable_lengths(cdcr_runtime* runtime, const float* lengths_m
   CRuntime* c = nullptr;
   if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
   if (lengths_mm == nullptr) return CDCR_ERROR_NULL_ARGUMENT;
+  if (c->runtime.has_drives()) return CDCR_ERROR_NOT_APPLICABLE;
   const firmware::Geometry& geometry = c->runtime.geometry();
   const int segments = geometry.segment_count;
   if (count != size_t(geometry.cable_count())) return CDCR_ERROR_INVALID_ARGUMENT;
@@ -262,6 +317,14 @@ cdcr_result cdcr_homing(cdcr_runtime* runtime) {
   CRuntime* c = nullptr;
   if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
   return c->inputs.has_room(1) ? (c->inputs.push_homing(), CDCR_OK) : CDCR_ERROR_QUEUE_FULL;
+}
+
+cdcr_result cdcr_recover_drives(cdcr_runtime* runtime) {
+  CRuntime* c = nullptr;
+  if (const cdcr_result r = firmware::check(runtime, c); r != CDCR_OK) return r;
+  if (!c->runtime.has_drives()) return CDCR_ERROR_NOT_APPLICABLE;
+  c->runtime.recover_drives();
+  return CDCR_OK;
 }
 
 cdcr_result cdcr_set_target(cdcr_runtime* runtime, const cdcr_target* target) {
@@ -369,6 +432,7 @@ const char* cdcr_result_name(cdcr_result result) {
     case CDCR_ERROR_OUT_OF_RANGE: return "out of range";
     case CDCR_ERROR_QUEUE_FULL: return "queue full";
     case CDCR_ERROR_NO_DATA: return "no data";
+    case CDCR_ERROR_NOT_APPLICABLE: return "not applicable";
   }
   return "unknown result";
 }

@@ -40,6 +40,13 @@ bool FrameInputs::take(const hal::CanFrame& frame, Runtime& runtime) {
     } else {
       runtime.set_homed();
     }
+  } else if (protocol::drives_command::kMessage.carries(frame.id)) {
+    protocol::DrivesCommand command;
+    if (protocol::decode(frame, command) != protocol::DecodeStatus::ok) {
+      runtime.reject_input(FaultCode::drives_command_malformed);
+    } else {
+      runtime.recover_drives();
+    }
   } else {
     return false;
   }

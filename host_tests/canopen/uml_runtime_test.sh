@@ -4,9 +4,15 @@
 # (tools/sim/cia402/drive_sim.js, one process per bus, four drives on each of
 # vcan1..vcan4). From power-up every drive must be configured and enabled
 # ("drives: operational after N ms" on stderr, N within operational_limit_ms); then
-# uml_host_peer.py sends a position target on vcan0, which must converge and
-# the drives must reach their setpoints; the pose published once the robot
-# is still must match cdcr-runtime --replay of the drives' final positions.
+# uml_host_peer.py sends six pose targets on vcan0, one after the other: each
+# must converge, the drives must reach their setpoints, and the pose
+# published once the robot is still must be the target's and match
+# cdcr-runtime --replay of the drives' positions there. Then two faults,
+# each injected in a drive when the peer is ready for it (SIGUSR2 to its
+# simulator): drive 3 of vcan3 sends an EMCY and drops out of Operation
+# enabled (STATUS FAULT 14 drive_fault, FAULT_DETAIL 3, until the host's
+# DRIVES_COMMAND recovers it), then drive 2 of vcan2 stops its heartbeat
+# (FAULT 13 drive_silent, FAULT_DETAIL 2).
 #   CDCR_RUNTIME, CDCR_CHECK (socketcan_check): host-built binaries;
 #   CDCR_EXTRA: the protocol's DBC; CDCR_WORK_DIR: scratch space.
 #
@@ -29,8 +35,7 @@ rate=20
 operational_limit_ms=30000
 
 "$CDCR_CHECK" image "$image" || fail "cannot write the model image"
-"$CDCR_CHECK" fd-values "$image" > "$work/values.txt" || fail "cannot compute the target"
-target=$(sed -n 's/^TARGET_MM=//p' "$work/values.txt")
+"$CDCR_CHECK" pose-targets "$image" > "$work/targets.txt" || fail "cannot compute the targets"
 
 for n in 1 2 3 4; do
   ip link add dev "vcan$n" type vcan && ip link set "vcan$n" txqueuelen 10000 && ip link set up "vcan$n" ||
@@ -74,10 +79,15 @@ stop_all() {
 trap stop_all EXIT
 
 # The drives first: they must answer the NMT reset of the runtime's first cycle.
+# The faults wait for a SIGUSR2 each (drive_sim.js --fault ...@usr2).
+faults_1="" faults_2="--fault heartbeat-stop:2@usr2" faults_3="--fault emcy:3:2310@usr2" faults_4=""
 for n in 1 2 3 4; do
+  eval "faults=\$faults_$n"
+  # shellcheck disable=SC2086  # the options' words
   node "$drive_sim" --can "vcan$n" --nodes 1,2,3,4 --relay "$bin/cdcr-can-relay" --initial-counts "$initial_counts" \
-    2> "$work/drive_sim.$n.err" &
+    $faults 2> "$work/drive_sim.$n.err" &
   sims="$sims $!"
+  eval "sim_$n=$!"
 done
 sims_up() { [ "$(cat "$work"/drive_sim.*.err | grep -c 'drive(s) on vcan')" -ge 4 ]; }
 wait_until "the drive simulators" sims_up
@@ -96,9 +106,22 @@ operational_ms=$(sed -n 's/^drives: operational after \([0-9]*\) ms$/\1/p' "$wor
   fail "drives: operational after ${operational_ms:-?} ms, the limit is $operational_limit_ms ms"
 progress "drives: operational after $operational_ms ms (limit $operational_limit_ms ms)"
 
-/usr/bin/python3 "$here/uml_host_peer.py" move --dbc "$CDCR_EXTRA" --config "$config" --target "$target" \
-  --cables "$work/final_cables.csv" --pose "$work/final_pose.txt" || fail "the move"
-progress "moved and still"
+peer() { /usr/bin/python3 "$here/uml_host_peer.py" "$@" --dbc "$CDCR_EXTRA" --config "$config"; }
+peer targets --targets "$work/targets.txt" --cables "$work/still_cables.csv" --poses "$work/still_poses.txt" ||
+  fail "the six pose targets"
+progress "six pose targets reached"
+
+# shellcheck disable=SC2154  # sim_3, sim_2: set by eval above
+kill -USR2 "$sim_3"
+peer fault --code 14 --node 3 --recover || fail "drive 3 on vcan3: EMCY and recovery"
+grep -q '^fault: emergency, drive 3 (cable 10), detail 8976$' "$work/runtime.err" ||
+  fail "no console line for drive 3's EMCY"
+progress "EMCY of drive 3 reported and recovered"
+kill -USR2 "$sim_2"
+peer fault --code 13 --node 2 || fail "drive 2 on vcan2: heartbeat stopped"
+grep -q '^fault: heartbeat lost, drive 2 (cable 5)' "$work/runtime.err" ||
+  fail "no console line for drive 2's heartbeat"
+progress "heartbeat loss of drive 2 reported"
 
 kill -INT "$runtime_pid"
 wait "$runtime_pid"
@@ -107,10 +130,13 @@ runtime_pid=""
 echo "--- cdcr-runtime"
 cat "$work/runtime.err" "$work/runtime.out"
 [ "$runtime_status" -eq 0 ] || fail "cdcr-runtime exited with $runtime_status after SIGINT"
-grep -q '^drives: fault' "$work/runtime.err" && fail "the drives faulted"
+# The two injected faults, and no other.
+unexpected=$(grep '^fault: ' "$work/runtime.err" | grep -v '^fault: emergency, drive 3 (cable 10)' |
+  grep -v '^fault: heartbeat lost, drive 2 (cable 5)')
+[ -z "$unexpected" ] || fail "faults not injected: $unexpected"
 
-"$CDCR_RUNTIME" --replay "$work/final_cables.csv" --image "$image" --out "$work/replay.csv" || fail "the replay"
-/usr/bin/python3 "$here/uml_host_peer.py" compare --pose "$work/final_pose.txt" --replay "$work/replay.csv" ||
-  fail "the pose against the replay"
+"$CDCR_RUNTIME" --replay "$work/still_cables.csv" --image "$image" --out "$work/replay.csv" || fail "the replay"
+/usr/bin/python3 "$here/uml_host_peer.py" compare --poses "$work/still_poses.txt" --replay "$work/replay.csv" ||
+  fail "the still poses against the replay"
 progress "all done"
 echo "SOCKETCAN_TEST_PASS"

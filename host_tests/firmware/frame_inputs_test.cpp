@@ -146,6 +146,13 @@ TEST_F(FrameInputsTest, PayloadAndHoming) {
   EXPECT_TRUE(inputs.take(truncated(frame_of(protocol::Homing{})), *runtime));
   EXPECT_EQ(runtime->last_event(), FaultCode::homing_malformed);
   EXPECT_EQ(rejected(), 2u);
+
+  // Without drives behind a backend a recover command changes nothing.
+  EXPECT_TRUE(inputs.take(frame_of(protocol::DrivesCommand{}), *runtime));
+  EXPECT_EQ(rejected(), 2u);
+  EXPECT_TRUE(inputs.take(truncated(frame_of(protocol::DrivesCommand{})), *runtime));
+  EXPECT_EQ(runtime->last_event(), FaultCode::drives_command_malformed);
+  EXPECT_EQ(rejected(), 3u);
 }
 
 }  // namespace

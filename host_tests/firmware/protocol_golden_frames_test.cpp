@@ -330,6 +330,16 @@ TEST(GoldenFrames, Homing) {
   EXPECT_EQ(decode(frame_of(0x161, Bytes{0x01, 0x00}), homing), DecodeStatus::wrong_dlc);
 }
 
+// 0x162, DLC 1. COMMAND u8 at bit 0: 1 recover, nothing else.
+TEST(GoldenFrames, DrivesCommand) {
+  expect_encodes_to(DrivesCommand{}, 0x162, Bytes{0x01});
+  EXPECT_EQ(decoded<DrivesCommand>(0x162, Bytes{0x01}).command, DrivesCommandKind::recover);
+  DrivesCommand command;
+  EXPECT_EQ(decode(frame_of(0x162, Bytes{0x00}), command), DecodeStatus::out_of_range);
+  EXPECT_EQ(decode(frame_of(0x162, Bytes{0x02}), command), DecodeStatus::out_of_range);
+  EXPECT_EQ(decode(frame_of(0x162, Bytes{0x01, 0x00}), command), DecodeStatus::wrong_dlc);
+}
+
 // 0x170, DLC 6. COMMAND u4 at bit 0 (4..7 reserved); TRANSFER_ID u16 at
 // bit 8; IMAGE_SIZE u24 at bit 24, bytes.
 TEST(GoldenFrames, UpdateCommand) {
@@ -558,7 +568,7 @@ TEST(GoldenFrames, FdMessagesSitInTheirFrameGroups) {
 // A message added to the table needs its golden frame above.
 TEST(GoldenFrames, EveryMessageOfTheTableHasOne) {
   constexpr std::uint32_t kGoldenIds[] = {0x102, 0x117, 0x120, 0x121, 0x122, 0x130, 0x131, 0x132, 0x133,
-                                          0x140, 0x150, 0x151, 0x160, 0x161, 0x170, 0x171, 0x172, 0x173, 0x178};
+                                          0x140, 0x150, 0x151, 0x160, 0x161, 0x162, 0x170, 0x171, 0x172, 0x173, 0x178};
   for (const MessageSpec* message : kMessages) {
     const bool covered = std::any_of(std::begin(kGoldenIds), std::end(kGoldenIds),
                                      [&](std::uint32_t id) { return message->carries(id); });

@@ -164,10 +164,19 @@ TEST_F(RuntimeCia402Test, DriveEmergencyIsAFaultNamingItsNodeUntilRecovered) {
   EXPECT_NE(std::find(platform_->console.lines.begin(), platform_->console.lines.end(), line),
             platform_->console.lines.end())
       << line;
-  // It stays in FAULT while the positions still come.
+  // It stays in FAULT while the positions still come, and a malformed
+  // command does not recover it.
   for (int n = 0; n < 50; ++n) cycle();
   EXPECT_EQ(runtime_->state(), RuntimeState::fault);
-  ASSERT_TRUE(runtime_->recover_drives());
+  hal::CanFrame command;
+  protocol::encode(protocol::DrivesCommand{}, command);
+  command.data[0] = 2;
+  platform_->host_node.send(command);
+  for (int n = 0; n < 50; ++n) cycle();
+  EXPECT_EQ(runtime_->state(), RuntimeState::fault);
+  // The host's DRIVES_COMMAND recovers them.
+  command.data[0] = 1;
+  platform_->host_node.send(command);
   ASSERT_GT(start_drives(2000), 0) << to_string(runtime_->active_fault());
   EXPECT_EQ(drives_[cable].statusword, 0x0237);
 }
@@ -192,6 +201,43 @@ TEST_F(RuntimeCia402Test, HeartbeatLossAndRefusedConfiguration) {
   EXPECT_EQ(runtime_->state(), RuntimeState::fault);
   EXPECT_EQ(runtime_->active_fault(), FaultCode::drive_refused);
   EXPECT_EQ(runtime_->active_fault_detail(), FaultDetail::drive(1));
+}
+
+// A drive that never answers at boot; one whose TPDOs come twice (taken
+// once, no fault); one whose TPDOs stop (stale after stale_cycles): each
+// in STATUS with its node id.
+TEST_F(RuntimeCia402Test, SilentAtBootRepeatedAndMissingPositions) {
+  drives_[3].powered = false;
+  make_runtime();
+  int cycles = 0;
+  while (runtime_->active_fault() != FaultCode::drive_silent && ++cycles < 3000) cycle();
+  EXPECT_EQ(runtime_->state(), RuntimeState::fault);
+  EXPECT_EQ(runtime_->active_fault(), FaultCode::drive_silent);
+  EXPECT_EQ(runtime_->active_fault_detail(), FaultDetail::drive(config_.drives[3].node));
+  // Not before the boot timeout (2 s of 1 ms cycles).
+  EXPECT_GE(cycles, int(config_.boot_timeout_ms));
+
+  drives_[3].powered = true;
+  drives_[2].repeat_tpdo = true;
+  ASSERT_TRUE(runtime_->recover_drives());
+  ASSERT_GT(start_drives(3000), 0) << to_string(runtime_->active_fault());
+  for (int n = 0; n < 200; ++n) cycle();
+  EXPECT_EQ(runtime_->state(), RuntimeState::run) << to_string(runtime_->active_fault());
+  EXPECT_NEAR((runtime_->latest_pose().pose.position_mm -
+               [&] {
+                 PoseEstimate e;
+                 EXPECT_EQ(runtime_->estimate_pose(drive_lengths(), e), model::Status::ok);
+                 return e.pose.position_mm;
+               }())
+                  .norm(),
+              0.0, 1e-3);
+
+  drives_[5].answers_sync = false;
+  cycles = 0;
+  while (runtime_->state() != RuntimeState::fault && ++cycles < 100) cycle();
+  EXPECT_EQ(runtime_->active_fault(), FaultCode::drive_silent);
+  EXPECT_EQ(runtime_->active_fault_detail(), FaultDetail::drive(config_.drives[5].node));
+  EXPECT_GE(cycles, int(config_.stale_cycles));
 }
 
 TEST_F(RuntimeCia402Test, CableFeedbackFramesIgnored) {

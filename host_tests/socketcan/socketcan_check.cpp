@@ -7,6 +7,8 @@
 //   socketcan_check check <image> <candump log>
 //   socketcan_check fd-values <image>         the FD test's physical values (fd_client.py)
 //   socketcan_check fd-check <image> <summary>  fd_client.py's poses and setpoints
+//   socketcan_check pose-targets <image>      six reachable pose targets, physical values
+//                                             (host_tests/canopen/uml_host_peer.py)
 //
 // The log is cut into phases by marker frames (id 0x7F0, one byte: the phase
 // number) that the driver sends between the steps of the test.
@@ -97,6 +99,9 @@ model::Pose<double> pose_target(const Model& m, int target) {
                              m.correction, result);
   return result.compensated;
 }
+
+// The CiA 402 test's six pose targets: those four bends and two more.
+constexpr double kSixPoseTargetBends[][2] = {{0.1, 0.0}, {0.25, 1.0}, {0.05, -2.0}, {0.3, 2.5}, {0.2, -0.8}, {0.15, 1.8}};
 
 model::Vec3<double> target_position_mm(const Model& m) {
   model::ForwardResult<double> result;
@@ -496,6 +501,22 @@ int check(const Model& m, const std::string& log_path) {
   return c.failures() == 0 ? 0 : 1;
 }
 
+// One line per target: POSE_TARGET_<k>=x y z qw qx qy qz (mm; w >= 0).
+int print_pose_targets(const Model& m) {
+  for (int t = 0; t < int(std::size(kSixPoseTargetBends)); ++t) {
+    model::ForwardResult<double> result;
+    model::compensated_forward(bent_cables(m, kSixPoseTargetBends[t][0], kSixPoseTargetBends[t][1]), m.geometry,
+                               m.correction, result);
+    const model::Pose<double>& pose = result.compensated;
+    Eigen::Quaterniond q(pose.rotation);
+    q.normalize();
+    if (q.w() < 0) q.coeffs() = -q.coeffs();
+    std::printf("POSE_TARGET_%d=%.4f %.4f %.4f %.6f %.6f %.6f %.6f\n", t, pose.position_mm.x(), pose.position_mm.y(),
+                pose.position_mm.z(), q.w(), q.x(), q.y(), q.z());
+  }
+  return 0;
+}
+
 // The FD test's client encodes from physical values with the DBC: the
 // feedback lengths and the target as on the bus (0.01 mm).
 int print_fd_values(const Model& m) {
@@ -574,7 +595,7 @@ int main(int argc, char** argv) {
     return write_image(argv[2], std::atoi(argv[3]), static_cast<std::uint32_t>(std::strtoul(argv[4], nullptr, 10)));
   }
   Model m;
-  const bool with_image = ((command == "frames" || command == "fd-values") && argc == 3) ||
+  const bool with_image = ((command == "frames" || command == "fd-values" || command == "pose-targets") && argc == 3) ||
                           ((command == "check" || command == "fd-check") && argc == 4);
   if (with_image) {
     if (!load_model(argv[2], m)) {
@@ -583,10 +604,11 @@ int main(int argc, char** argv) {
     }
     if (command == "frames") return print_frames(m);
     if (command == "fd-values") return print_fd_values(m);
+    if (command == "pose-targets") return print_pose_targets(m);
     return command == "check" ? check(m, argv[3]) : check_fd(m, argv[3]);
   }
   std::fprintf(stderr,
                "usage: socketcan_check image <out> [points seed] | frames <image> | check <image> <candump log> | "
-               "fd-values <image> | fd-check <image> <summary>\n");
+               "fd-values <image> | fd-check <image> <summary> | pose-targets <image>\n");
   return 2;
 }

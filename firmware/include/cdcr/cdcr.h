@@ -49,7 +49,7 @@ extern "C" {
 /* Bytes of cdcr_runtime: enough for every supported target (host, Cortex-M7,
  * Cortex-M4F), checked when the library is compiled;
  * cdcr_runtime_storage_size() says how much this build uses. */
-#define CDCR_RUNTIME_STORAGE_BYTES 16384u
+#define CDCR_RUNTIME_STORAGE_BYTES 20480u
 
 /* Opaque: the caller provides the storage, typically as a static variable. */
 typedef struct cdcr_runtime {
@@ -69,7 +69,9 @@ typedef enum cdcr_result {
   CDCR_ERROR_OUT_OF_RANGE = 4,     /* a value the protocol cannot carry: NaN, infinity, a cable length
                                       outside 0.01..655.34 mm, a position beyond +-21,474 m */
   CDCR_ERROR_QUEUE_FULL = 5,       /* too many inputs before the next cdcr_step() */
-  CDCR_ERROR_NO_DATA = 6           /* nothing to read yet: no pose, or no setpoints */
+  CDCR_ERROR_NO_DATA = 6,          /* nothing to read yet: no pose, or no setpoints */
+  CDCR_ERROR_NOT_APPLICABLE = 7    /* not with this configuration: cable lengths given while CiA 402 drives
+                                      report them, drives recovered where there are none */
 } cdcr_result;
 
 /* The runtime's states (firmware/include/cdcr/firmware/fault.hpp). */
@@ -96,7 +98,8 @@ typedef enum cdcr_fault {
   CDCR_FAULT_HOMING_MALFORMED = 12,      /* a HOMING frame that does not decode: the hysteresis state stays */
   CDCR_FAULT_DRIVE_SILENT = 13,          /* CiA 402 drives: one stopped answering; fault_detail: its node id */
   CDCR_FAULT_DRIVE_FAULT = 14,           /* one reported a fault or left Operation enabled; fault_detail: node */
-  CDCR_FAULT_DRIVE_REFUSED = 15          /* their configuration was refused; fault_detail: node (0: as given) */
+  CDCR_FAULT_DRIVE_REFUSED = 15,         /* their configuration was refused; fault_detail: node (0: as given) */
+  CDCR_FAULT_DRIVES_COMMAND_MALFORMED = 16 /* a DRIVES_COMMAND frame was refused (CAN protocol only) */
 } cdcr_fault;
 
 /* How the last target ended (the IK_REPORT frame's OUTCOME). */
@@ -130,6 +133,37 @@ typedef struct cdcr_geometry {
   int cables_per_segment; /* 0 or 4: four cables at 90 degrees; 3: three at 120 degrees, cable 1 on the x axis */
 } cdcr_geometry;
 
+/* CiA 402 drives over CANopen, one per cable (firmware/canopen): the runtime
+ * is their NMT master and SYNC producer, configures them by SDO, enables
+ * them, takes the cable lengths from their positions every step and sends
+ * them the setpoints, through the callbacks drives_can_send and
+ * drives_can_receive. Cable length = position / counts_per_mm +
+ * homing_offset_mm. A drive's fault is CDCR_FAULT_DRIVE_SILENT, _FAULT or
+ * _REFUSED with its node id in fault_detail, until cdcr_recover_drives(). */
+#define CDCR_MAX_DRIVE_BUSES 4
+
+typedef struct cdcr_cia402_drive {
+  int bus;                /* 0..bus_count - 1, the index the drives_can callbacks get */
+  int node;               /* CANopen node id, 1..127, one drive per node on a bus */
+  float counts_per_mm;    /* the drive's position units per mm of cable; negative where they fall as it lengthens */
+  float homing_offset_mm; /* the cable's length at position 0 (after the drive's homing) */
+} cdcr_cia402_drive;
+
+typedef struct cdcr_cia402_config {
+  int drive_count; /* one per cable, cable 0 first: the image's cable count */
+  int bus_count;   /* 1..CDCR_MAX_DRIVE_BUSES */
+  cdcr_cia402_drive drives[CDCR_MAX_CABLES];
+  /* 0 takes the default given. The cycle period (0x1006) is cdcr_config.period_ns. */
+  uint32_t sync_window_us;         /* 0x1007, at most the period; 0: half the period */
+  uint32_t heartbeat_ms;           /* each drive's heartbeat producer time; 0: 50 */
+  uint32_t heartbeat_periods_lost; /* periods without a heartbeat before a drive is lost; 0: 3 */
+  uint32_t stale_cycles;           /* steps without a position before it is stale; 0: 10 */
+  uint32_t boot_timeout_ms;        /* 0: 2000 */
+  uint32_t sdo_timeout_ms;         /* 0: 100 */
+  uint32_t enable_timeout_ms;      /* 0: 1000 */
+  float max_speed_mm_per_s;        /* how fast a drive's target moves to its setpoint; 0: 20 */
+} cdcr_cia402_config;
+
 typedef struct cdcr_config {
   const uint8_t *model_image; /* the flash image in place (not copied); NULL: nominal kinematics */
   uint32_t model_image_size;
@@ -144,6 +178,11 @@ typedef struct cdcr_config {
    * callbacks then send and receive frames at the moved identifiers, and set
    * the filters there. */
   uint32_t can_id_base;
+  /* NULL: the board gives the cable lengths (cdcr_set_cable_lengths) and
+   * sends the setpoints to its drives itself. Otherwise the runtime runs
+   * these CiA 402 drives (copied at init; period_ns must be set, whole
+   * microseconds). */
+  const cdcr_cia402_config *cia402_drives;
 } cdcr_config;
 
 typedef struct cdcr_target {
@@ -245,6 +284,10 @@ cdcr_result cdcr_set_payload(cdcr_runtime *runtime, float payload_kg);
  * the cable lengths given next are its position (the HOMING frame's
  * meaning). Changes nothing with an image without a hysteresis block. */
 cdcr_result cdcr_homing(cdcr_runtime *runtime);
+/* After a CiA 402 drive's fault: reset and re-enable every drive; the
+ * runtime leaves the fault once all are enabled again. While they are fine
+ * it changes nothing. CDCR_ERROR_NOT_APPLICABLE without cia402_drives. */
+cdcr_result cdcr_recover_drives(cdcr_runtime *runtime);
 
 /* A target for the tip; the runtime solves it over the next steps and
  * publishes setpoints when it converges (see cdcr_status.ik_outcome). */

@@ -58,6 +58,28 @@ bool CallbackBus::set_filters(const hal::CanFilter* filters, std::size_t count) 
   return callbacks_.can_set_filters(callbacks_.user, out, count) == 1;
 }
 
+hal::CanStatus CallbackDrivesBus::send(const hal::CanFrame& frame) {
+  if (callbacks_.drives_can_send == nullptr) return hal::CanStatus::ok;
+  cdcr_can_frame out{};
+  out.id = frame.id;
+  out.dlc = frame.dlc;
+  for (int i = 0; i < 8; ++i) out.data[i] = frame.data[i];
+  if (callbacks_.drives_can_send(callbacks_.user, bus_, &out) == 0) return hal::CanStatus::ok;
+  ++counters_.tx_dropped;
+  return hal::CanStatus::queue_full;
+}
+
+hal::CanStatus CallbackDrivesBus::receive(hal::CanFrame& frame) {
+  cdcr_can_frame in{};
+  if (callbacks_.drives_can_receive == nullptr || callbacks_.drives_can_receive(callbacks_.user, bus_, &in) != 1) {
+    return hal::CanStatus::empty;
+  }
+  frame.id = in.id;
+  frame.dlc = in.dlc <= 8 ? in.dlc : 8;
+  for (int i = 0; i < 8; ++i) frame.data[i] = in.data[i];
+  return hal::CanStatus::ok;
+}
+
 void CallbackConsole::write_line(const char* line) {
   if (callbacks_.console_write_line != nullptr) callbacks_.console_write_line(callbacks_.user, line);
 }

@@ -15,12 +15,14 @@
 // Fault kinds: heartbeat-stop, emcy:NODE:CODE (hex), refuse:NODE:INDEX (hex),
 // silent, tpdo-late:NODE:N, tpdo-twice. @MS counts from the first NMT start
 // seen on the bus; for refuse and silent from the start of this process.
+// @usr2 instead: on a SIGUSR2, one such fault each, in the order given (a
+// test injects a fault when it has seen what comes before it).
 
 const { spawn } = require('child_process');
 const { Cia402Drive } = require('./cia402_layer');
 
 const USAGE = 'usage: node drive_sim.js (--can IFACE | --stdio) --nodes N[,N...] [--relay PATH] [--tau-ms MS] ' +
-    '[--play-counts C] [--initial-counts C[,C...]] [--fault KIND:NODE[:ARG][@MS]]...';
+    '[--play-counts C] [--initial-counts C[,C...]] [--fault KIND:NODE[:ARG][@MS|@usr2]]...';
 const FAULT_KINDS = ['heartbeat-stop', 'emcy', 'refuse', 'silent', 'tpdo-late', 'tpdo-twice'];
 const FROM_PROCESS_START = new Set(['refuse', 'silent']);
 
@@ -49,13 +51,14 @@ function parseHex(text, what, max) {
 }
 
 function parseFault(text, nodes) {
-    const match = /^([a-z-]+):(\d+)(?::([^@]+))?(?:@(\d+))?$/.exec(text);
-    if (!match) usageError(`--fault '${text}': expected KIND:NODE[:ARG][@MS]`);
+    const match = /^([a-z-]+):(\d+)(?::([^@]+))?(?:@(\d+|usr2))?$/.exec(text);
+    if (!match) usageError(`--fault '${text}': expected KIND:NODE[:ARG][@MS|@usr2]`);
     const [, kind, nodeText, arg, msText] = match;
     if (!FAULT_KINDS.includes(kind)) usageError(`--fault '${text}': kind is one of ${FAULT_KINDS.join(', ')}`);
     const node = parseNumber(nodeText, `--fault '${text}' node`, { integer: true, min: 1, max: 127 });
     if (!nodes.includes(node)) usageError(`--fault '${text}': node ${node} is not in --nodes`);
-    const fault = { kind, node, atMs: msText === undefined ? 0 : Number(msText), text };
+    const onSignal = msText === 'usr2';
+    const fault = { kind, node, onSignal, atMs: msText === undefined || onSignal ? 0 : Number(msText), text };
     const needsArg = kind === 'emcy' || kind === 'refuse' || kind === 'tpdo-late';
     if (needsArg && arg === undefined) usageError(`--fault '${text}': ${kind} takes an argument`);
     if (!needsArg && arg !== undefined) usageError(`--fault '${text}': ${kind} takes no argument`);
@@ -184,8 +187,15 @@ function main() {
             else setTimeout(() => inject(fault), fault.atMs);
         }
     };
-    schedule(options.faults.filter((f) => FROM_PROCESS_START.has(f.kind)));
-    const afterStart = options.faults.filter((f) => !FROM_PROCESS_START.has(f.kind));
+    const onSignal = options.faults.filter((f) => f.onSignal);
+    process.on('SIGUSR2', () => {
+        const fault = onSignal.shift();
+        if (fault) inject(fault);
+        else log('SIGUSR2: no fault left to inject');
+    });
+    const timed = options.faults.filter((f) => !f.onSignal);
+    schedule(timed.filter((f) => FROM_PROCESS_START.has(f.kind)));
+    const afterStart = timed.filter((f) => !FROM_PROCESS_START.has(f.kind));
     let started = false;
     for (const drive of drives.values()) {
         drive.on('nmtStart', () => {

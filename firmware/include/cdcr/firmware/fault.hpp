@@ -37,6 +37,7 @@ enum class FaultCode : std::uint8_t {
   drive_fault = 14,            // a drive reported a fault (EMCY, statusword) or left Operation enabled
   drive_refused = 15,          // the drives' configuration was refused (an SDO abort, an invalid configuration,
                                // a setpoint beyond a drive's range)
+  drives_command_malformed = 16,  // last DRIVES_COMMAND frame refused (wrong DLC, unknown command)
 };
 
 constexpr const char* to_string(RuntimeState state) {
@@ -67,6 +68,7 @@ constexpr const char* to_string(FaultCode code) {
     case FaultCode::drive_silent: return "drive silent";
     case FaultCode::drive_fault: return "drive fault";
     case FaultCode::drive_refused: return "drive configuration refused";
+    case FaultCode::drives_command_malformed: return "drives command malformed";
   }
   return "unknown fault";
 }

@@ -42,6 +42,7 @@ constexpr FaultDetailKind detail_kind(FaultCode code) {
     case FaultCode::can_filters_refused:
     case FaultCode::payload_invalid:
     case FaultCode::homing_malformed:
+    case FaultCode::drives_command_malformed:
       return FaultDetailKind::none;
   }
   return FaultDetailKind::none;

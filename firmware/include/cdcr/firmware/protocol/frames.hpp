@@ -64,6 +64,12 @@ struct Payload {
   double payload_kg = 0;
 };
 
+// What the host asks of the drives (DRIVES_COMMAND).
+enum class DrivesCommandKind : std::uint8_t { recover = 1 };
+struct DrivesCommand {
+  DrivesCommandKind command = DrivesCommandKind::recover;
+};
+
 struct TargetOrientation {
   double qw = 1, qx = 0, qy = 0, qz = 0;
 };
@@ -218,6 +224,8 @@ template <>
 struct FrameFields<Payload> : MessageFields<payload::kMessage, field::Refused<&Payload::payload_kg>> {};
 template <>
 struct FrameFields<Homing> : MessageFields<homing::kMessage, field::Value<&Homing::at_home>> {};
+template <>
+struct FrameFields<DrivesCommand> : MessageFields<drives_command::kMessage, field::Value<&DrivesCommand::command>> {};
 
 // The SEQUENCE of a TARGET_POSITION_Z frame that did not decode, so that
 // the rejection can name its target; 0 when the frame is too short to hold one.

@@ -56,7 +56,7 @@ inline constexpr hal::CanFilter kCableSetpointsFdFrames{0x118, 0x7F8};  // CABLE
 inline constexpr hal::CanFilter kPoseFrames{0x130, 0x7F8};           // POSE_POSITION_XY, _POSITION_Z, _ORIENTATION, _UNCERTAINTY, POSE_FD
 inline constexpr hal::CanFilter kIkReportFrames{0x140, 0x7FF};       // IK_REPORT
 inline constexpr hal::CanFilter kStatusFrames{0x150, 0x7FE};         // STATUS, STATS
-inline constexpr hal::CanFilter kPayloadFrames{0x160, 0x7FE};        // PAYLOAD, HOMING
+inline constexpr hal::CanFilter kPayloadFrames{0x160, 0x7FC};        // PAYLOAD, HOMING, DRIVES_COMMAND
 
 enum class TargetMode : std::uint8_t { position = 0, pose = 1 };
 
@@ -107,7 +107,9 @@ inline constexpr ValueName kFaultCode[] = {
     {13, "drive_silent"},
     {14, "drive_fault"},
     {15, "drive_refused"},
+    {16, "drives_command_malformed"},
 };
+inline constexpr ValueName kDrivesCommand[] = {{1, "recover"}};
 }  // namespace values
 
 // Layouts shared by several messages.
@@ -380,6 +382,22 @@ inline constexpr MessageNotes kNotes{
     "the image it changes nothing. Bits 1 to 7 are reserved (0)."};
 }  // namespace homing
 
+// 0x162: a command to the drives behind a hal::Drives backend (CiA 402).
+// RECOVER: fault reset and re-enable every drive, and leave FAULT once they
+// are all in Operation enabled again; sent while the drives are fine it
+// changes nothing, so a repeated frame is harmless.
+namespace drives_command {
+inline constexpr SignalSpec kCommand{"COMMAND", 0, 8, false, 1, 0, 1, 1, "", value_table(values::kDrivesCommand)};
+inline constexpr const SignalSpec* kSignals[] = {&kCommand};
+inline constexpr MessageSpec kMessage{"DRIVES_COMMAND", 0x162, 1, 1, "HOST", signal_list(kSignals), kPayloadFrames};
+inline constexpr MessageNotes kNotes{
+    &kMessage, "RUNTIME",
+    "A command to the runtime's CiA 402 drives. COMMAND 1 (recover): fault reset and re-enable every drive; the "
+    "runtime leaves FAULT 13 to 15 once all are in Operation enabled again. Sent while the drives are fine it changes "
+    "nothing. A frame that does not decode is refused (FAULT 16 drives_command_malformed). Without CiA 402 drives it "
+    "changes nothing."};
+}  // namespace drives_command
+
 // Model updates (0x170..0x17F; firmware/model_update.hpp): the host writes a
 // new model image into the inactive flash slot, in blocks of up to
 // kUpdateBlockBytes, each an UPDATE_BLOCK header and its UPDATE_DATA frames.
@@ -584,7 +602,7 @@ inline constexpr const MessageNotes* kMessageNotes[] = {
     &target_position_xy::kNotes, &target_position_z::kNotes, &pose_position_xy::kNotes,
     &pose_position_z::kNotes,    &pose_orientation::kNotes, &pose_uncertainty::kNotes,
     &ik_report::kNotes,          &status::kNotes,           &stats::kNotes,
-    &payload::kNotes,            &homing::kNotes,
+    &payload::kNotes,            &homing::kNotes,           &drives_command::kNotes,
     &update_command::kNotes,     &update_digest::kNotes,    &update_block::kNotes,
     &update_data::kNotes,        &update_report::kNotes,
 };

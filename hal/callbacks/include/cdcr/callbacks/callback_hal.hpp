@@ -57,6 +57,22 @@ class CallbackBus final : public hal::CanBus {
   hal::CanErrorCounters counters_;
 };
 
+// One of the CiA 402 drives' buses: the board's drives_can_send and
+// drives_can_receive for that bus index.
+class CallbackDrivesBus final : public hal::CanBus {
+ public:
+  CallbackDrivesBus(const cdcr_callbacks& callbacks, int bus) : callbacks_(callbacks), bus_(bus) {}
+  hal::CanStatus send(const hal::CanFrame& frame) override;
+  hal::CanStatus receive(hal::CanFrame& frame) override;
+  bool set_filters(const hal::CanFilter*, std::size_t) override { return true; }
+  hal::CanErrorCounters error_counters() const override { return counters_; }
+
+ private:
+  const cdcr_callbacks& callbacks_;
+  int bus_;
+  hal::CanErrorCounters counters_;
+};
+
 class ImageStorage final : public hal::ModelStorage {
  public:
   ImageStorage(const std::uint8_t* data, std::uint32_t size) : region_{data, data != nullptr ? size : 0} {}
@@ -90,6 +106,7 @@ class CallbackHal {
 
   hal::Hal hal() { return hal::Hal{clock_, timer_, bus_, storage_, console_}; }
   SteppedTimer& timer() { return timer_; }
+  const cdcr_callbacks& callbacks() const { return callbacks_; }
 
  private:
   cdcr_callbacks callbacks_;  // first: the parts below keep references to it

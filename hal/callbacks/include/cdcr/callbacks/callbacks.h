@@ -40,6 +40,13 @@ typedef struct cdcr_callbacks {
   int (*can_send)(void *user, const cdcr_can_frame *frame);
   int (*can_receive)(void *user, cdcr_can_frame *frame);
   int (*can_set_filters)(void *user, const cdcr_can_filter *filters, size_t count);
+  /* The CiA 402 drives' buses (cdcr_config.cia402_drives; NULL otherwise),
+   * bus 0 to 3 as the drives' configuration numbers them, which may be the
+   * protocol's bus too: as can_send and can_receive, for that bus. Every
+   * frame on a drives' bus goes to the runtime, which takes what its drives
+   * send (no filters are set there). */
+  int (*drives_can_send)(void *user, int bus, const cdcr_can_frame *frame);
+  int (*drives_can_receive)(void *user, int bus, cdcr_can_frame *frame);
 } cdcr_callbacks;
 
 #ifdef __cplusplus
