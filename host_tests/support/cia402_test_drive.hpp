@@ -2,19 +2,74 @@
 // A CiA 402 drive as CiA 301 and 402-2 describe its bus side: NMT, an
 // expedited SDO server, RPDO1 and TPDO1 released by the SYNC, heartbeat,
 // EMCY and the power state machine, with a first-order position loop. For
-// the manager's and the runtime's unit tests; the drives on the npm
+// the manager's, the runtime's and the C API's unit tests, and the boards'
+// budget with the CiA 402 backend (host_tests/qemu/programs), so it holds
+// everything in fixed arrays: nothing allocates. The drives on the npm
 // `canopen` stack (tools/sim/cia402) check the same against a stack this
 // project did not write.
 
+#include <cstddef>
 #include <cstdint>
-#include <map>
-#include <set>
-#include <vector>
 
 #include <cdcr/firmware/canopen/frames.hpp>
 #include <cdcr/hal/can_bus.hpp>
 
 namespace cdcr::firmware::canopen {
+
+// A few values in a fixed array, as much of std::set and std::map as the
+// tests use. A full table drops what does not fit and says so in `full`.
+template <typename Key, typename Value, std::size_t Capacity>
+struct FixedTable {
+  Key keys[Capacity] = {};
+  Value values[Capacity] = {};
+  std::size_t used = 0;
+  bool full = false;
+
+  int find(Key key) const {
+    for (std::size_t i = 0; i < used; ++i)
+      if (keys[i] == key) return int(i);
+    return -1;
+  }
+  std::size_t count(Key key) const { return find(key) >= 0 ? 1 : 0; }
+  std::size_t size() const { return used; }
+  // The value, or ~0 when there is none (so a test's comparison fails).
+  Value at(Key key) const {
+    const int i = find(key);
+    return i >= 0 ? values[i] : Value(~Value(0));
+  }
+  void set(Key key, Value value = Value()) {
+    const int i = find(key);
+    if (i >= 0) {
+      values[i] = value;
+    } else if (used < Capacity) {
+      keys[used] = key;
+      values[used++] = value;
+    } else {
+      full = true;
+    }
+  }
+  void insert(Key key) { set(key); }
+  void erase(Key key) {
+    const int i = find(key);
+    if (i < 0) return;
+    for (std::size_t j = std::size_t(i) + 1; j < used; ++j) {
+      keys[j - 1] = keys[j];
+      values[j - 1] = values[j];
+    }
+    --used;
+  }
+};
+
+// The SDO writes in order, as many as fit.
+template <std::size_t Capacity>
+struct WriteLog {
+  std::uint32_t entries[Capacity] = {};
+  std::size_t used = 0;
+  void push_back(std::uint32_t key) {
+    if (used < Capacity) entries[used++] = key;
+  }
+  std::size_t size() const { return used; }
+};
 
 struct TestDrive {
   NodeId node = 0;
@@ -23,9 +78,9 @@ struct TestDrive {
   bool heartbeat_on = true;     // produces its heartbeat
   bool answers_sync = true;     // sends its TPDO on SYNC
   bool repeat_tpdo = false;     // sends each TPDO twice
-  std::set<std::uint16_t> refused;  // objects whose writes it aborts (value range)
-  std::map<std::uint32_t, std::uint32_t> objects;  // (index << 8 | subindex) -> value
-  std::vector<std::uint32_t> written;             // in order
+  FixedTable<std::uint16_t, bool, 4> refused;             // objects whose writes it aborts (value range)
+  FixedTable<std::uint32_t, std::uint32_t, 32> objects;   // (index << 8 | subindex) -> value
+  WriteLog<64> written;                                   // in order
   std::uint16_t statusword = 0x0250;              // switch on disabled
   std::uint16_t controlword = 0;
   std::uint16_t pending_controlword = 0;
@@ -36,8 +91,7 @@ struct TestDrive {
   std::uint32_t ms = 0;
 
   std::uint16_t heartbeat_ms() const {
-    auto it = objects.find(0x101700);
-    return it == objects.end() ? 0 : std::uint16_t(it->second);
+    return objects.count(0x101700) != 0 ? std::uint16_t(objects.at(0x101700)) : 0;
   }
   void step_power_state(std::uint16_t cw) {
     const bool fault_reset = (cw & 0x80) && !(controlword & 0x80);
@@ -108,7 +162,7 @@ struct TestDrive {
         const int size = 4 - ((frame.data[0] >> 2) & 3);
         std::uint32_t value = 0;
         for (int i = 0; i < size; ++i) value |= std::uint32_t(frame.data[4 + i]) << (8 * i);
-        objects[(std::uint32_t(index) << 8) | sub] = value;
+        objects.set((std::uint32_t(index) << 8) | sub, value);
         written.push_back((std::uint32_t(index) << 8) | sub);
         reply.data[0] = 0x60;
       } else {
