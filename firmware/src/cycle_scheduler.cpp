@@ -5,7 +5,7 @@ namespace cdcr::firmware {
 void CycleScheduler::configure(const ModelCosts& costs) {
   const std::uint32_t forward_units =
       kWorkCosts.cycle_overhead + (costs.compensated ? costs.mean_units + costs.compliance_units : 0) +
-      costs.hysteresis_units;
+      costs.hysteresis_units + costs.drives_units;
   // A payload model's points cost more units each (work_costs.hpp), and
   // IK's smallest step may then be a block of its gradient.
   const std::uint32_t min_ik_units =

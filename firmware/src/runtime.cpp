@@ -79,7 +79,8 @@ RuntimeState Runtime::init() {
   scheduler_.configure({model_.compensated, model_.uncertainty.has_variance(),
                         model_.correction.training_points() * model_.correction.mean_point_units(),
                         model_.correction.smallest_gradient_slice_units(), hysteresis_units(hysteresis_),
-                        model_.compliance.empty() ? 0 : kComplianceUnits});
+                        model_.compliance.empty() ? 0 : kComplianceUnits,
+                        hal_.drives != nullptr ? kWorkCosts.drive * std::uint32_t(hal_.drives->drive_count()) : 0});
   enter(mode());
   if (boot_fault_ != FaultCode::none) {
     ConsoleLine line;

@@ -225,7 +225,7 @@ def fault(args):
     peer.wait(f"STATUS FAULT {args.code} with FAULT_DETAIL {args.node}",
               lambda item: item is not None and item[0] == "STATS" and peer.state == FAULT and
               peer.fault == args.code and peer.fault_detail == args.node)
-    say(f"STATUS FAULT {args.code}, FAULT_DETAIL {args.node}: {time.monotonic() - started_s:.2f} s after the injection")
+    say(f"STATUS FAULT {args.code}, FAULT_DETAIL {args.node}: {time.monotonic() - started_s:.2f} s after this peer started")
     if not args.recover:
         return
     # Held in FAULT: nothing brings the runtime back but the command.

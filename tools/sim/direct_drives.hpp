@@ -26,6 +26,7 @@ class DirectCableDrives final : public hal::Drives {
   hal::DrivesHealth health() const override { return health_; }
   bool recover() override;
   const char* describe(std::uint8_t kind) const override;
+  int drive_count() const override { return int(cables_mm_.size()); }
 
   // Cable `cable`'s drive stops answering (silent) or reports a fault; its
   // drive number in health() is cable + 1.

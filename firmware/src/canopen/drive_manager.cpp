@@ -96,6 +96,13 @@ void DriveManager::configure(const DriveManagerConfig& config) {
     phase_ = DrivePhase::fault;
     fault_.fault = DriveFault::config_invalid;
     fault_.detail = static_cast<std::uint32_t>(status);
+    return;
+  }
+  const double step_mm = config_.max_speed_mm_per_s * double(config_.timing.cycle_period_us) * 1e-6;
+  for (int i = 0; i < config_.drive_count; ++i) {
+    mm_per_count_[i] = 1.0 / config_.drives[i].counts_per_mm;
+    const double step = std::round(step_mm * std::fabs(config_.drives[i].counts_per_mm));
+    ramp_counts_[i] = step < 1.0 ? 1 : step > 2147483647.0 ? 2147483647 : std::int32_t(step);
   }
 }
 
@@ -238,7 +245,7 @@ bool DriveManager::positions_fresh() const {
 
 double DriveManager::length_mm(int cable) const {
   const DriveChannel& channel = config_.drives[cable];
-  return double(drives_[cable].actual) / channel.counts_per_mm + channel.offset_mm;
+  return double(drives_[cable].actual) * mm_per_count_[cable] + channel.offset_mm;
 }
 
 bool DriveManager::set_setpoints(const double* lengths_mm, int count) {
@@ -302,7 +309,6 @@ void DriveManager::run_configure(Buses buses) {
 
 // The RPDOs, then the SYNC that releases them and asks for the TPDOs.
 void DriveManager::send_process_data(Buses buses, bool operating) {
-  const double step_mm = config_.max_speed_mm_per_s * double(config_.timing.cycle_period_us) * 1e-6;
   for (int i = 0; i < config_.drive_count; ++i) {
     Drive& drive = drives_[i];
     DriveCommand command;
@@ -317,11 +323,10 @@ void DriveManager::send_process_data(Buses buses, bool operating) {
         // CSP takes a new position every SYNC: the manager ramps to the
         // setpoint within the speed limit, so no step trips the drive's
         // following-error check.
-        const double step = step_mm * std::fabs(config_.drives[i].counts_per_mm);
-        const double delta = double(setpoint_[i]) - double(drive.target);
-        drive.target = std::fabs(delta) <= step ? setpoint_[i]
-                                                : static_cast<std::int32_t>(double(drive.target) +
-                                                                            (delta > 0 ? step : -step));
+        const std::int64_t step = ramp_counts_[i];
+        const std::int64_t delta = std::int64_t(setpoint_[i]) - drive.target;
+        drive.target = delta <= step && delta >= -step ? setpoint_[i]
+                                                       : std::int32_t(drive.target + (delta > 0 ? step : -step));
       }
     } else if (!drive.has_position) {
       command.controlword = cia402::kDisableVoltage;

@@ -195,8 +195,10 @@ int main() {
   console::console_write_int(buses);
   console::console_write(" buses\n");
 
+  tally.expect_poses(false);
   bool ok = run_until_running(5000);
   if (!ok) console::console_write("FAIL: the drives did not reach RUN\n");
+  tally.expect_poses(true);
 
   phase = kMove;
   for (int t = 0; ok && t < 4; ++t) {
@@ -224,6 +226,32 @@ int main() {
   console::console_write(recovered ? "recovered: RUN\n" : "FAIL: not recovered\n");
   ok = ok && recovered;
   for (int n = 0; n < 100; ++n) cycle();
+
+  // What the drives cost a cycle apart from the rest (what the runtime
+  // charges them, kWorkCosts.drive units each): the backend's calls of one
+  // operational cycle, on the drives' frames of the last.
+  exchange_with_drives();
+  double lengths_mm[firmware::kMaxDrives];
+  double setpoints_mm[firmware::kMaxDrives];
+  const bool have_lengths = [&] {
+    backend.receive();
+    return backend.lengths(setpoints_mm, cables);
+  }();
+  exchange_with_drives();
+  const std::uint32_t drives_instructions = counter.instructions([&] {
+    backend.receive();
+    backend.lengths(lengths_mm, cables);
+    backend.command(setpoints_mm, cables);
+    backend.transmit();
+  });
+  console::console_write("the drives' work: ");
+  console::console_write_int(static_cast<std::int32_t>(drives_instructions));
+  console::console_write(" instructions a cycle for ");
+  console::console_write_int(cables);
+  console::console_write(" drives (charged ");
+  console::console_write_int(static_cast<std::int32_t>(firmware::kWorkCosts.drive));
+  console::console_write(" units each)\n");
+  ok = ok && have_lengths;
 
   for (int p = 0; p < kPhases; ++p) {
     console::console_write("worst ");

@@ -21,6 +21,7 @@ struct ModelCosts {
   std::uint32_t gradient_slice = 0;  // the smallest block of the GP gradient
   std::uint32_t hysteresis_units = 0;  // the cables' hysteresis (hysteresis_units(); 0 without a block)
   std::uint32_t compliance_units = 0;  // the payload's sag (kComplianceUnits; 0 without a block)
+  std::uint32_t drives_units = 0;      // a hal::Drives backend's drives (kWorkCosts.drive each; 0 without one)
 };
 
 // The cycle's decisions, in the order the runtime acts on them.

@@ -58,6 +58,8 @@ class Drives : public Interface {
   virtual bool recover() = 0;
   // A short name of health().kind, for the console.
   virtual const char* describe(std::uint8_t kind) const = 0;
+  // How many drives it runs: the runtime charges each a share of the cycle.
+  virtual int drive_count() const = 0;
 
  protected:
   ~Drives() = default;

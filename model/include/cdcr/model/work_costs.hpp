@@ -38,6 +38,10 @@ struct WorkCosts {
   // mean's point, and the point with its gradient.
   std::uint32_t run_time_loop_point = 3;
   std::uint32_t run_time_loop_gradient_point = 10;
+  // A drive behind a hal::Drives backend, every cycle (CiA 402: its TPDO
+  // taken, its heartbeat watched, its setpoint converted, its RPDO built
+  // and queued, its share of the SYNC).
+  std::uint32_t drive = 4;
 };
 
 // A forward cycle's instructions on a board as a function of the model's

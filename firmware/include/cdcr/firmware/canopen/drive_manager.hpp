@@ -180,6 +180,10 @@ class DriveManager {
   std::uint32_t repeated_pdos_ = 0;
   int sdo_cursor_ = 0;
   std::int32_t setpoint_[kMaxDrives] = {};
+  // From the configuration, so that a cycle multiplies and steps in whole
+  // counts (a board without a double FPU divides in software).
+  double mm_per_count_[kMaxDrives] = {};
+  std::int32_t ramp_counts_[kMaxDrives] = {};  // the speed limit's step a cycle
   bool has_setpoints_ = false;
   bool resetting_faults_ = false;
 };
