@@ -28,12 +28,28 @@ hal::TimerTick SteppedTimer::wait_next() {
   return tick;
 }
 
-hal::CanStatus CallbackBus::send(const hal::CanFrame& frame) {
-  if (callbacks_.can_send == nullptr) return hal::CanStatus::ok;
+namespace {
+
+cdcr_can_frame to_board(const hal::CanFrame& frame) {
   cdcr_can_frame out{};
   out.id = frame.id;
   out.dlc = frame.dlc;
   for (int i = 0; i < 8; ++i) out.data[i] = frame.data[i];
+  return out;
+}
+
+// A DLC beyond 8 from the board is cut to 8.
+void from_board(const cdcr_can_frame& in, hal::CanFrame& frame) {
+  frame.id = in.id;
+  frame.dlc = in.dlc <= 8 ? in.dlc : 8;
+  for (int i = 0; i < 8; ++i) frame.data[i] = in.data[i];
+}
+
+}  // namespace
+
+hal::CanStatus CallbackBus::send(const hal::CanFrame& frame) {
+  if (callbacks_.can_send == nullptr) return hal::CanStatus::ok;
+  const cdcr_can_frame out = to_board(frame);
   if (callbacks_.can_send(callbacks_.user, &out) == 0) return hal::CanStatus::ok;
   ++counters_.tx_dropped;
   return hal::CanStatus::queue_full;
@@ -44,9 +60,7 @@ hal::CanStatus CallbackBus::receive(hal::CanFrame& frame) {
   if (callbacks_.can_receive == nullptr || callbacks_.can_receive(callbacks_.user, &in) != 1) {
     return hal::CanStatus::empty;
   }
-  frame.id = in.id;
-  frame.dlc = in.dlc <= 8 ? in.dlc : 8;
-  for (int i = 0; i < 8; ++i) frame.data[i] = in.data[i];
+  from_board(in, frame);
   return hal::CanStatus::ok;
 }
 
@@ -60,10 +74,7 @@ bool CallbackBus::set_filters(const hal::CanFilter* filters, std::size_t count) 
 
 hal::CanStatus CallbackDrivesBus::send(const hal::CanFrame& frame) {
   if (callbacks_.drives_can_send == nullptr) return hal::CanStatus::ok;
-  cdcr_can_frame out{};
-  out.id = frame.id;
-  out.dlc = frame.dlc;
-  for (int i = 0; i < 8; ++i) out.data[i] = frame.data[i];
+  const cdcr_can_frame out = to_board(frame);
   if (callbacks_.drives_can_send(callbacks_.user, bus_, &out) == 0) return hal::CanStatus::ok;
   ++counters_.tx_dropped;
   return hal::CanStatus::queue_full;
@@ -74,9 +85,7 @@ hal::CanStatus CallbackDrivesBus::receive(hal::CanFrame& frame) {
   if (callbacks_.drives_can_receive == nullptr || callbacks_.drives_can_receive(callbacks_.user, bus_, &in) != 1) {
     return hal::CanStatus::empty;
   }
-  frame.id = in.id;
-  frame.dlc = in.dlc <= 8 ? in.dlc : 8;
-  for (int i = 0; i < 8; ++i) frame.data[i] = in.data[i];
+  from_board(in, frame);
   return hal::CanStatus::ok;
 }
 

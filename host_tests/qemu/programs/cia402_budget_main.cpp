@@ -253,15 +253,7 @@ int main() {
   console::console_write(" units each)\n");
   ok = ok && have_lengths;
 
-  for (int p = 0; p < kPhases; ++p) {
-    console::console_write("worst ");
-    console::console_write(kPhaseNames[p]);
-    console::console_write(" cycle: ");
-    console::console_write_int(static_cast<std::int32_t>(worst_of[p]));
-    console::console_write(" instructions over ");
-    console::console_write_int(static_cast<std::int32_t>(cycles_of[p]));
-    console::console_write(" cycles\n");
-  }
+  cdcr::qemu_programs::report_phases(kPhaseNames, worst_of, cycles_of, kPhases);
   ok = tally.report() && ok;
   console::console_write(ok ? "PASS\n" : "FAIL\n");
   return ok ? 0 : 1;

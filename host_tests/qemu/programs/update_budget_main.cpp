@@ -207,15 +207,7 @@ int main() {
   console::console_write(rolled_back ? "rollback to slot 0: running\n" : "FAIL: rollback to slot 0\n");
   ok = ok && rolled_back;
 
-  for (int p = 0; p < kPhases; ++p) {
-    console::console_write("worst ");
-    console::console_write(kPhaseNames[p]);
-    console::console_write(" cycle: ");
-    console::console_write_int(static_cast<std::int32_t>(worst_of[p]));
-    console::console_write(" instructions over ");
-    console::console_write_int(static_cast<std::int32_t>(cycles_of[p]));
-    console::console_write(" cycles\n");
-  }
+  cdcr::qemu_programs::report_phases(kPhaseNames, worst_of, cycles_of, kPhases);
   ok = tally.report() && ok;
   if (switches != 3) {
     console::console_write("FAIL: expected 3 switches\n");

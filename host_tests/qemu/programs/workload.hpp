@@ -54,4 +54,18 @@ inline void report_worst_cycle(std::uint32_t worst, std::uint32_t cycles) {
   cortexm::console_write(")\n");
 }
 
+// `worst <phase> cycle: N instructions over C cycles`, a line per phase.
+inline void report_phases(const char* const* names, const std::uint32_t* worst, const std::uint32_t* cycles,
+                          int phases) {
+  for (int p = 0; p < phases; ++p) {
+    cortexm::console_write("worst ");
+    cortexm::console_write(names[p]);
+    cortexm::console_write(" cycle: ");
+    cortexm::console_write_int(static_cast<std::int32_t>(worst[p]));
+    cortexm::console_write(" instructions over ");
+    cortexm::console_write_int(static_cast<std::int32_t>(cycles[p]));
+    cortexm::console_write(" cycles\n");
+  }
+}
+
 }  // namespace cdcr::qemu_programs

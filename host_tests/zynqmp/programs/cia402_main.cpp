@@ -28,6 +28,7 @@
 
 #include "board.hpp"
 #include "checks.hpp"
+#include "counted_cycle.hpp"
 #include "cia402_test_drive.hpp"
 #include "golden_check.hpp"
 #include "peer_workload.hpp"
@@ -40,7 +41,7 @@ namespace hal = cdcr::hal;
 namespace model = cdcr::model;
 namespace protocol = cdcr::firmware::protocol;
 namespace zynqmp = cdcr::zynqmp;
-using namespace cdcr::zynqmp_checks;  // check, print, verdict
+using namespace cdcr::zynqmp_checks;  // check, print, verdict, counted_run_cycle
 using firmware::RuntimeState;
 
 constexpr double kCountsPerMm = 1000.0;
@@ -121,13 +122,7 @@ void exchange_with_drives() {
 void cycle() {
   const hal::TimerTick tick = board.timer.wait_next();
   exchange_with_drives();
-  asm volatile("" ::: "memory");
-  const std::uint64_t start = board.timer.now_counts();
-  asm volatile("" ::: "memory");
-  runtime.run_cycle(tick);
-  asm volatile("" ::: "memory");
-  const std::uint64_t counts = board.timer.now_counts() - start;
-  asm volatile("" ::: "memory");
+  const std::uint64_t counts = counted_run_cycle(board.timer, runtime, tick);
   if (counts > worst_counts) worst_counts = counts;
   if (counts > cdcr::boards::zcu102_r5f::kCycleBudgetInstructions) ++over_budget;
   ++cycles_run;

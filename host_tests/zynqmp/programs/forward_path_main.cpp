@@ -24,6 +24,7 @@
 #include "board.hpp"
 #include "bus_view.hpp"
 #include "checks.hpp"
+#include "counted_cycle.hpp"
 
 namespace {
 
@@ -117,13 +118,7 @@ int main() {
   for (int cycle = 0; cycle < kCycles; ++cycle) {
     const cdcr::hal::TimerTick tick = board.timer.wait_next();
     send_cables(cycle);
-    asm volatile("" ::: "memory");
-    const std::uint64_t cycle_start = board.timer.now_counts();
-    asm volatile("" ::: "memory");
-    runtime.run_cycle(tick);
-    asm volatile("" ::: "memory");
-    const std::uint64_t cycle_counts = board.timer.now_counts() - cycle_start;
-    asm volatile("" ::: "memory");
+    const std::uint64_t cycle_counts = counted_run_cycle(board.timer, runtime, tick);
     if (cycle_counts > worst_cycle_counts) worst_cycle_counts = cycle_counts;
     const int pose_frames_before = bus.pose_frames;
     drain(bus);
