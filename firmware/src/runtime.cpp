@@ -172,12 +172,7 @@ void Runtime::receive_drive_lengths() {
   const bool was_failed = drives_failed();
   drives_health_ = drives.health();
   if (drives_failed()) {
-    if (!was_failed) {
-      ConsoleLine line;
-      line << "fault: " << drives.describe(drives_health_.kind) << ", drive " << unsigned(drives_health_.drive)
-           << " (cable " << int(drives_health_.cable) << "), detail " << unsigned(drives_health_.detail);
-      hal_.console.write_line(line.c_str());
-    }
+    if (!was_failed) report_drives_fault();
     if (state_ != RuntimeState::fault && state_ != RuntimeState::boot) {
       enter(RuntimeState::fault);
       if (ik_.running()) ik_.end(protocol::IkOutcome::aborted_fault);
@@ -193,6 +188,15 @@ void Runtime::receive_drive_lengths() {
     for (int k = 0; k < model_.geometry.segments[s].cables.count; ++k) segment_mm[k] = Scalar(lengths_mm[first + k]);
     set_cable_lengths(s, segment_mm);
   }
+}
+
+// Out of line: the cycle's code stays small on the boards (the M7's code
+// budget), and a fault is reported once.
+[[gnu::noinline]] void Runtime::report_drives_fault() const {
+  ConsoleLine line;
+  line << "fault: " << hal_.drives->describe(drives_health_.kind) << ", drive " << unsigned(drives_health_.drive)
+       << " (cable " << int(drives_health_.cable) << "), detail " << unsigned(drives_health_.detail);
+  hal_.console.write_line(line.c_str());
 }
 
 bool Runtime::recover_drives() {

@@ -184,6 +184,7 @@ class Runtime {
   void publish_fd_pose();
   void receive_frames(hal::CanBus& bus, int frames);
   void receive_drive_lengths();
+  void report_drives_fault() const;
   bool drives_failed() const { return hal_.drives != nullptr && drives_health_.failed(); }
   void publish_uncertainty();
   protocol::PoseUncertainty uncertainty_frame() const;
