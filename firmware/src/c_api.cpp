@@ -139,7 +139,6 @@ bool drives_config_from(const cdcr_cia402_config& in, std::int64_t period_ns, ca
   out.sdo_timeout_ms = or_default(in.sdo_timeout_ms, out.sdo_timeout_ms);
   out.enable_timeout_ms = or_default(in.enable_timeout_ms, out.enable_timeout_ms);
   if (in.max_speed_mm_per_s != 0) out.max_speed_mm_per_s = double(in.max_speed_mm_per_s);
-  if (!(out.max_speed_mm_per_s > 0) || !std::isfinite(out.max_speed_mm_per_s)) return false;
   return canopen::validate(out) == canopen::DriveConfigStatus::ok;
 }
 

@@ -25,7 +25,7 @@ hal::DrivesCondition condition_of(DriveFault fault) {
 }
 
 Cia402Drives::Cia402Drives(const DriveManagerConfig& config, hal::CanBus* const (&buses)[kMaxDriveBuses])
-    : manager_(config), drive_count_(config.drive_count >= 0 && config.drive_count <= kMaxDrives ? config.drive_count : 0) {
+    : manager_(config) {
   bus_count_ = config.bus_count >= 1 && config.bus_count <= kMaxDriveBuses ? config.bus_count : 0;
   for (int b = 0; b < bus_count_; ++b) {
     buses_[b] = buses[b];

@@ -24,7 +24,7 @@ class Cia402Drives final : public hal::Drives {
   hal::DrivesHealth health() const override;
   bool recover() override;
   const char* describe(std::uint8_t kind) const override { return to_string(static_cast<DriveFault>(kind)); }
-  int drive_count() const override { return drive_count_; }
+  int drive_count() const override { return manager_.drive_count(); }
 
   const DriveManager& manager() const { return manager_; }
 
@@ -32,7 +32,6 @@ class Cia402Drives final : public hal::Drives {
   DriveManager manager_;
   hal::CanBus* buses_[kMaxDriveBuses] = {};
   int bus_count_ = 0;
-  int drive_count_ = 0;
 };
 
 // Which condition the runtime reports for a manager's fault.
