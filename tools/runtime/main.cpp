@@ -80,6 +80,13 @@ int main(int argc, char** argv) {
       app.add_option("--drives-config", bus.cia402_config, "with --drives cia402: the drives' configuration (JSON)");
   auto* streaming_option = app.add_flag("--streaming", bus.streaming,
                                         "with --can and --bitrate: plan the budget for a target streamed every cycle");
+  auto* view_option = app.add_option("--view", bus.view.port,
+                                     "with --sim: serve the robot live on this port (Foxglove WebSocket, "
+                                     "tools/view; 0: any free port); the loop then runs in real time");
+  auto* record_option = app.add_option("--record", bus.view.record_path,
+                                       "with --sim or --replay: record the view's channels to this MCAP file");
+  app.add_option("--view-rate", bus.view.scene_rate_hz, "the scene's rate for --view and --record, Hz")
+      ->capture_default_str();
   replay_option->excludes(sim_option);
   can_option->excludes(sim_option)->excludes(replay_option);
   try {
@@ -88,6 +95,16 @@ int main(int argc, char** argv) {
       throw CLI::ValidationError("one of --replay, --sim or --can is required");
     }
     if (circle && !run_sim) throw CLI::ValidationError("--circle needs --sim");
+    if (view_option->count() > 0 && !run_sim) throw CLI::ValidationError("--view needs --sim (a bus: cdcr view --can)");
+    if (view_option->count() > 0 && !(bus.view.port >= 0 && bus.view.port <= 65535)) {
+      throw CLI::ValidationError("--view must be a port in [0, 65535]");
+    }
+    if (record_option->count() > 0 && !run_sim && replay_path.empty()) {
+      throw CLI::ValidationError("--record needs --sim or --replay");
+    }
+    if (!(bus.view.scene_rate_hz > 0) || !(bus.view.scene_rate_hz <= 1000)) {
+      throw CLI::ValidationError("--view-rate must be in (0, 1000] Hz");
+    }
     if (hysteresis && !run_sim) throw CLI::ValidationError("--hysteresis needs --sim");
     if (!flash_dir.empty() && can_interface.empty()) throw CLI::ValidationError("--flash-dir needs --can");
     if (streaming_option->count() > 0 && can_interface.empty()) {
@@ -129,7 +146,7 @@ int main(int argc, char** argv) {
     if (run_sim && circle) {
       return follow_circle(image_path, rate_hz, circle_radius_mm, circle_speed_mm_s, robot, bus);
     }
-    return run_sim ? simulate(image_path, rate_hz, seconds, robot, bus) : replay(image_path, replay_path, out_path);
+    return run_sim ? simulate(image_path, rate_hz, seconds, robot, bus) : replay(image_path, replay_path, out_path, bus.view);
   } catch (const std::invalid_argument& e) {
     std::fprintf(stderr, "cdcr-runtime: error: %s\n", e.what());
     return kExitUsage;

@@ -3,12 +3,15 @@
 // (the data's t_s column): the state is carried from row to row, each
 // session starting at home, and the pose is that of the effective lengths.
 
+#include <cmath>
 #include <cstdio>
+#include <vector>
 #include <stdexcept>
 #include <string>
 
 #include <Eigen/Geometry>
 
+#include <cdcr/firmware/protocol/frames.hpp>
 #include <cdcr/firmware/runtime.hpp>
 #include <cdcr/model/hysteresis_sequence.hpp>
 #include <cdcr/model/unit_quaternion.hpp>
@@ -18,6 +21,8 @@
 #include "export/binary_file.hpp"
 #include "runtime_modes.hpp"
 #include "sim/simulated_platform.hpp"
+#include "view/robot_view.hpp"
+#include "view/view_recording.hpp"
 
 namespace cdcr::runtime_host {
 
@@ -31,7 +36,58 @@ void require_rate(double rate_hz) {
   if (!(rate_hz > 0) || !(rate_hz <= 100000)) throw std::invalid_argument("--rate must be in (0, 100000] Hz");
 }
 
-int replay(const std::string& image_path, const std::string& cables_path, const std::string& out_path) {
+namespace {
+
+// The rows as the drives would have sent them, through a view into an MCAP
+// recording: each row's CABLE_FEEDBACK frames at its time (a row every
+// millisecond without a t_s column), HOMING at each session's start when the
+// image tracks the hysteresis. Rows a frame cannot carry are left out, and
+// counted.
+void record_rows(const std::string& image_path, const cdcr::dataset::Dataset& data, const fw::Runtime& runtime,
+                 const ViewChoice& choice) {
+  view::ViewRecording recording(choice.record_path);
+  view::ViewOptions options;
+  options.scene_rate_hz = choice.scene_rate_hz;
+  view::RobotView robot_view(cdcr::exporting::read_binary_file(image_path), options, recording);
+  const fw::Geometry& geometry = runtime.geometry();
+  std::size_t next_session = 0;
+  long left_out = 0;
+  for (Eigen::Index i = 0; i < data.cables_mm.rows(); ++i) {
+    const auto time_ns = static_cast<std::uint64_t>(
+        data.has_time ? std::llround(data.time_s[i] * 1e9) : std::int64_t(i) * 1000000);
+    cdcr::hal::CanFrame frame;
+    if (next_session < data.session_starts.size() && data.session_starts[next_session] == i) {
+      ++next_session;
+      if (runtime.hysteresis().active()) {
+        protocol::encode(protocol::Homing{true}, frame);
+        robot_view.on_frame(frame, time_ns);
+      }
+    }
+    std::vector<cdcr::hal::CanFrame> frames;
+    const Eigen::VectorXd row = data.cables_mm.row(i).transpose();
+    for (int s = 0; s < geometry.segment_count; ++s) {
+      const auto feedback = protocol::segment_cables_frame<protocol::CableFeedback>(
+          s, row, geometry.first_cable(s), geometry.segments[s].cables.count);
+      if (!protocol::encode(feedback, frame)) break;
+      frames.push_back(frame);
+    }
+    if (int(frames.size()) != geometry.segment_count) {
+      ++left_out;
+      continue;
+    }
+    for (const cdcr::hal::CanFrame& f : frames) robot_view.on_frame(f, time_ns);
+  }
+  recording.close();
+  std::printf("recording: %s, %llu messages of %lld rows (%ld left out: lengths a CABLE_FEEDBACK frame cannot "
+              "carry)\n",
+              choice.record_path.c_str(), static_cast<unsigned long long>(recording.message_count()),
+              static_cast<long long>(data.cables_mm.rows()), left_out);
+}
+
+}  // namespace
+
+int replay(const std::string& image_path, const std::string& cables_path, const std::string& out_path,
+           const ViewChoice& view) {
   sim::SimulatedPlatform platform;
   platform.storage.assign(cdcr::exporting::read_binary_file(image_path));
   fw::Runtime runtime(platform.hal, fw::Geometry::prototype());
@@ -108,6 +164,7 @@ int replay(const std::string& image_path, const std::string& cables_path, const 
                  static_cast<double>(uncertainty.r95_deg), uncertainty.extrapolating ? 1 : 0);
   }
   if (std::fclose(out) != 0) throw InputError("cannot write " + out_path);
+  if (!view.record_path.empty()) record_rows(image_path, data, runtime, view);
   return 0;
 }
 

@@ -11,6 +11,7 @@
 #include <cdcr/firmware/protocol/messages.hpp>
 #include <cdcr/firmware/publish_rates.hpp>
 
+#include "bus_view.hpp"
 #include "cli/bus_command.hpp"
 
 namespace cdcr::runtime_host {
@@ -38,6 +39,9 @@ struct BusChoice {
   // Filled from it for the budget: the drives on each bus, their heartbeat.
   std::vector<int> cia402_per_bus;
   int cia402_heartbeat_ms = 50;
+  // A listener on the bus: the view served live and/or recorded (--sim
+  // --view, --record; bus_view.hpp).
+  ViewChoice view;
 };
 
 // Prints the budget of every bus of `segments` at rate_hz on `bus` and throws
@@ -46,8 +50,12 @@ struct BusChoice {
 void check_bus_budget(int segments, double rate_hz, bool streaming, const BusChoice& bus);
 
 // --replay: the forward path over recorded cable lengths, as fast as
-// possible, into a pose CSV.
-int replay(const std::string& image_path, const std::string& cables_path, const std::string& out_path);
+// possible, into a pose CSV; with view.record_path also the view's
+// recording of the rows, sent as the drives would send them (CABLE_FEEDBACK
+// at each row's time, HOMING at each session's start for an image that
+// tracks the cables' hysteresis).
+int replay(const std::string& image_path, const std::string& cables_path, const std::string& out_path,
+           const ViewChoice& view = {});
 
 // The simulated robot of --sim: --ideal-robot turns every error source off;
 // --hysteresis turns the cables' friction hysteresis on (source 7 of

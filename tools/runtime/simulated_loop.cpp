@@ -3,6 +3,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <memory>
 #include <random>
 #include <stdexcept>
 #include <string>
@@ -88,6 +89,20 @@ struct SimulatedLoop {
     for (BusTally* tally : {&bus_tally, &drives_tally}) tally->set_id_offset(protocol::id_offset(bus.id_base));
     if (platform.bus.timed()) platform.bus.set_observer(&bus_tally);
     if (layout.drives_bus && platform.drives_bus.timed()) platform.drives_bus.set_observer(&drives_tally);
+    if (bus.view.wanted()) {
+      // The view listens on the buses' one free node.
+      std::vector<cdcr::hal::CanBus*> listeners{&platform.bus.node(3)};
+      if (layout.drives_bus) listeners.push_back(&platform.drives_bus.node(3));
+      view = std::make_unique<BusView>(image_path, bus.view, protocol::id_offset(bus.id_base), listeners);
+    }
+  }
+
+  // Ends the view's run: prints its figures and where the recording is.
+  void finish_view() {
+    if (view) {
+      view->take_frames(platform.clock.now_ns());
+      view->finish();
+    }
   }
 
   // The bus the drives are on: their own, or the host's.
@@ -123,6 +138,7 @@ struct SimulatedLoop {
   cdcr::hal::FormattedCanBus homing_can;
   BusTally bus_tally;
   BusTally drives_tally;
+  std::unique_ptr<BusView> view;
 };
 
 // The simulated drives on the loop's bus, the host's node that sends the
@@ -147,6 +163,7 @@ struct DrivenLoop {
   // Waits for the next tick and moves the drives, and the robot's cables
   // with them, one period on.
   cdcr::hal::TimerTick advance_drives() {
+    if (loop.view) loop.view->take_frames(loop.platform.clock.now_ns());
     const cdcr::hal::TimerTick tick = loop.platform.timer.wait_next();
     drives.step(dt_s);
     effective_cables = loop.robot.move_cables(drives.cables_mm());
@@ -377,6 +394,7 @@ int follow_circle(const std::string& image_path, double rate_hz, double radius_m
               runtime.setpoints_published() - setpoints_before, stream_cycles, cycles_without_setpoints, cycles,
               poses_missing, stats.overruns, stats.rejected_frames, double(host_max_ns) * 1e-3);
   loop.print_bus_report(rate_hz, true);
+  loop.finish_view();
   return 0;
 }
 
@@ -466,7 +484,7 @@ class RandomTargetRun {
 
   // Checks the bus budget (with a bit rate), before anything runs.
   void check_budget() const { check_bus_budget(geometry_.segment_count, rate_hz_, false, loop_.bus); }
-  void print_report() const;
+  void print_report();
 
  private:
   void print_run_report() const;
@@ -601,9 +619,10 @@ class RandomTargetRun {
   RandomTargetTallies tallies_;
 };
 
-void RandomTargetRun::print_report() const {
+void RandomTargetRun::print_report() {
   print_run_report();
   loop_.print_bus_report(rate_hz_, false);
+  loop_.finish_view();
 }
 
 void RandomTargetRun::print_run_report() const {
