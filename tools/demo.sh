@@ -9,12 +9,16 @@
 #   8.   the firmware runtime with that image in closed loop with the
 #        simulated robot over the simulated bus at 1 kHz;
 #   9.   the same loop following a streamed circle (a TRACKING pose target
-#        every cycle, 40 mm radius at 50 mm/s).
+#        every cycle, 40 mm radius at 50 mm/s), recorded as the view sees it
+#        on the bus (tools/view);
+#   10.  the recording read back by the reference MCAP reader (@mcap/core),
+#        every message checked, and how to open it.
 # Everything it writes goes to build/demo/.
 set -euo pipefail
 cd "$(dirname "${BASH_SOURCE[0]}")/.."
 
-bash tools/install-deps.sh base
+# view: Node.js and the MCAP reader that checks the recording of step 10.
+bash tools/install-deps.sh base view
 
 build_log=build/demo-build.log
 mkdir -p build
@@ -95,5 +99,16 @@ heading "8. The firmware runtime in closed loop with the simulated robot, 1 kHz 
 echo "(the same robot: targets it can reach, cable drives on the simulated bus)"
 run build/bin/cdcr-runtime --image "$out/model.img" --sim --rate 1000 --seconds 3
 
-heading "9. The same loop following a streamed circle: a pose target every cycle, 40 mm radius at 50 mm/s"
-run build/bin/cdcr-runtime --image "$out/model.img" --sim --circle --circle-radius 40 --circle-speed 50
+heading "9. The same loop following a streamed circle: a pose target every cycle, 40 mm radius at 50 mm/s, recorded"
+run build/bin/cdcr-runtime --image "$out/model.img" --sim --circle --circle-radius 40 --circle-speed 50 \
+  --record "$out/circle.mcap"
+
+heading "10. The recording, read back by the reference MCAP reader"
+run node tools/view/clients/check_mcap.js "$out/circle.mcap" --runtime build/bin/cdcr-runtime --image "$out/model.img"
+cat <<EOF
+
+Open $out/circle.mcap in Foxglove or Lichtblick (Open local file; a 3D panel
+shows /scene, plots /cables and /cables/following_error) or in PlotJuggler.
+Live: build/bin/cdcr-runtime --image $out/model.img --sim --circle --view 8765,
+then connect Foxglove to ws://localhost:8765 (tools/view/README.md).
+EOF

@@ -8,7 +8,7 @@
 set -euo pipefail
 
 declare -A package_groups=(
-  [base]="build-essential cmake pkg-config libeigen3-dev libopenblas-dev libcli11-dev nlohmann-json3-dev libfmt-dev liblbfgspp-dev libgtest-dev libgmock-dev libbenchmark-dev python3 universal-ctags"
+  [base]="build-essential cmake pkg-config libeigen3-dev libopenblas-dev libcli11-dev nlohmann-json3-dev libfmt-dev liblbfgspp-dev libgtest-dev libgmock-dev libbenchmark-dev python3 universal-ctags libwebsocketpp-dev libasio-dev"
   # The reference implementation the GP trainer is tested and benchmarked against.
   [sklearn]="python3-sklearn python3-numpy"
   # The libFuzzer targets (ctest -L fuzz). clang does not pull in the fuzzer
@@ -25,6 +25,13 @@ declare -A package_groups=(
   # (node-crc) with; then the package itself from the npm registry, pinned by
   # tools/sim/cia402/package-lock.json.
   [canopen]="nodejs npm make g++"
+  # The view's reference clients (ctest -L view, and the demo's check of its
+  # recording): Node.js and npm, then the Foxglove WebSocket client, the MCAP
+  # reader and Foxglove's schemas from the npm registry, pinned by
+  # tools/view/clients/package-lock.json.
+  [view]="nodejs npm"
+  # The view's screenshot test: a headless browser.
+  [browser]="chromium"
   # Cortex-M cross builds and their tests on QEMU's MPS2 boards (ctest -L qemu).
   [cross]="gcc-arm-none-eabi libstdc++-arm-none-eabi-newlib libnewlib-arm-none-eabi binutils-arm-none-eabi qemu-system-arm"
 )
@@ -50,11 +57,12 @@ is_installed() {
 
 here=$(cd "$(dirname "${BASH_SOURCE[0]}")" && pwd)
 
-# The npm packages of the canopen group (npm ci builds node-crc with
-# node-gyp), unless every package of the lock file is there at its version
-# and canopen loads.
+# The npm packages of a group's folder, installed from its lock file (npm
+# ci), unless every package of the lock file is there at its version and
+# the group's main package loads.
+#   install_npm_packages <group> <folder> <package that must load>
 install_npm_packages() {
-  local dir=$here/sim/cia402
+  local group=$1 dir=$2 main=$3
   if node -e "
       const fs = require('fs'), lock = require('$dir/package-lock.json').packages;
       for (const [path, entry] of Object.entries(lock)) {
@@ -62,11 +70,19 @@ install_npm_packages() {
         const manifest = '$dir/' + path + '/package.json';
         if (!fs.existsSync(manifest) || require(manifest).version !== entry.version) process.exit(1);
       }
-      require('$dir/node_modules/canopen');" 2>/dev/null; then
+      require('$dir/node_modules/$main');" 2>/dev/null; then
     return 0
   fi
   (cd "$dir" && npm ci --no-audit --no-fund) >>"$log_file" 2>&1 </dev/null || show_log_tail_and_fail "npm ci in $dir"
-  echo "install-deps: canopen: npm packages installed in $dir (log: $log_file)"
+  echo "install-deps: $group: npm packages installed in $dir (log: $log_file)"
+}
+
+# The groups whose npm packages are asked for (npm ci builds the canopen
+# stack's node-crc with node-gyp).
+install_wanted_npm_packages() {
+  [[ " ${groups[*]} " == *" canopen "* ]] && install_npm_packages canopen "$here/sim/cia402" canopen
+  [[ " ${groups[*]} " == *" view "* ]] && install_npm_packages view "$here/view/clients" @mcap/core
+  return 0
 }
 
 show_log_tail_and_fail() {
@@ -94,13 +110,13 @@ for package in "${wanted[@]}"; do
 done
 
 wants_npm=false
-[[ " ${groups[*]} " == *" canopen "* ]] && wants_npm=true
+[[ " ${groups[*]} " == *" canopen "* || " ${groups[*]} " == *" view "* ]] && wants_npm=true
 
 if [[ ${#missing[@]} -eq 0 ]]; then
   echo "install-deps: ${groups[*]}: all packages present"
   if $wants_npm; then
     : >"$log_file"
-    install_npm_packages
+    install_wanted_npm_packages
   fi
   exit 0
 fi
@@ -114,5 +130,5 @@ apt-get update >>"$log_file" 2>&1 </dev/null || show_log_tail_and_fail "apt-get 
 apt-get install -y --no-install-recommends "${missing[@]}" >>"$log_file" 2>&1 </dev/null ||
   show_log_tail_and_fail "apt-get install"
 echo "install-deps: ${groups[*]}: installed ${missing[*]} (log: $log_file)"
-$wants_npm && install_npm_packages
+$wants_npm && install_wanted_npm_packages
 exit 0

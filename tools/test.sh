@@ -11,7 +11,7 @@ started=$SECONDS
 # network and the disk, the build on the CPU.
 bash tools/install-deps.sh base
 group_log=$(mktemp)
-bash tools/install-deps.sh sklearn fuzz uml cross canopen >"$group_log" 2>&1 &
+bash tools/install-deps.sh sklearn fuzz uml cross canopen view browser >"$group_log" 2>&1 &
 group_install=$!
 # The measuring programs (cdcr-bench-*) are not built here: no test runs
 # them, and they cost about 75 s of a core. Each tools/bench/run_*.sh

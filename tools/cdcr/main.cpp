@@ -17,6 +17,7 @@
 #include "cli/fk_command.hpp"
 #if CDCR_HAVE_DEPLOY
 #include "cli/deploy_command.hpp"
+#include "cli/view_command.hpp"
 #endif
 #include "cli/ik_command.hpp"
 #include "cli/training_commands.hpp"
@@ -81,6 +82,7 @@ int main(int argc, char** argv) {
   register_bus_command(app, output);
 #if CDCR_HAVE_DEPLOY
   register_deploy_command(app, output);
+  register_view_command(app, output);
 #endif
 
   try {

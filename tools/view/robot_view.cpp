@@ -263,8 +263,9 @@ void RobotView::on_feedback_complete(std::uint64_t time_ns) {
   if (s.runtime.estimate_pose(effective, estimate) != model::Status::ok) return;
   s.estimate = estimate;
   s.uncertainty = s.runtime.estimate_uncertainty(estimate);
-  s.nominal_tip = model::forward_kinematics_bend(model::bend_from_joints(estimate.joints), s.runtime.geometry())
-                      .cast<double>();
+  // In double, as the backbone is drawn, so that the drawn backbone ends at it.
+  const model::JointVector<double> bend = model::bend_from_joints(estimate.joints).cast<double>();
+  s.nominal_tip = model::forward_kinematics_bend(bend, s.geometry);
   s.has_estimate = true;
   const model::Pose<double> tip = estimate.pose.cast<double>();
   sink_.publish(Topic::tip_pose, time_ns,
