@@ -21,6 +21,39 @@ using namespace cdcr::runtime_host;
 using cdcr::cli::kExitInvalidInput;
 using cdcr::cli::kExitUsage;
 
+namespace {
+
+// --view, --record and --view-rate (bus_view.hpp), checked after parsing.
+struct ViewOptions {
+  CLI::Option* view;
+  CLI::Option* record;
+};
+
+ViewOptions add_view_options(CLI::App& app, ViewChoice& choice) {
+  ViewOptions options;
+  options.view = app.add_option("--view", choice.port,
+                                "with --sim: serve the robot live on this port (Foxglove WebSocket, tools/view; 0: "
+                                "any free port); the loop then runs in real time");
+  options.record = app.add_option("--record", choice.record_path,
+                                  "with --sim or --replay: record the view's channels to this MCAP file");
+  app.add_option("--view-rate", choice.scene_rate_hz, "the scene's rate for --view and --record, Hz")
+      ->capture_default_str();
+  return options;
+}
+
+void check_view_options(const ViewOptions& options, const ViewChoice& choice, bool run_sim, bool replay) {
+  if (options.view->count() > 0 && !run_sim) throw CLI::ValidationError("--view needs --sim (a bus: cdcr view --can)");
+  if (options.view->count() > 0 && !(choice.port >= 0 && choice.port <= 65535)) {
+    throw CLI::ValidationError("--view must be a port in [0, 65535]");
+  }
+  if (options.record->count() > 0 && !run_sim && !replay) throw CLI::ValidationError("--record needs --sim or --replay");
+  if (!(choice.scene_rate_hz > 0) || !(choice.scene_rate_hz <= 1000)) {
+    throw CLI::ValidationError("--view-rate must be in (0, 1000] Hz");
+  }
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
   CLI::App app{"The firmware runtime on the host: replay recorded cables or run the simulated closed loop."};
   app.name("cdcr-runtime");
@@ -80,13 +113,7 @@ int main(int argc, char** argv) {
       app.add_option("--drives-config", bus.cia402_config, "with --drives cia402: the drives' configuration (JSON)");
   auto* streaming_option = app.add_flag("--streaming", bus.streaming,
                                         "with --can and --bitrate: plan the budget for a target streamed every cycle");
-  auto* view_option = app.add_option("--view", bus.view.port,
-                                     "with --sim: serve the robot live on this port (Foxglove WebSocket, "
-                                     "tools/view; 0: any free port); the loop then runs in real time");
-  auto* record_option = app.add_option("--record", bus.view.record_path,
-                                       "with --sim or --replay: record the view's channels to this MCAP file");
-  app.add_option("--view-rate", bus.view.scene_rate_hz, "the scene's rate for --view and --record, Hz")
-      ->capture_default_str();
+  const ViewOptions view_options = add_view_options(app, bus.view);
   replay_option->excludes(sim_option);
   can_option->excludes(sim_option)->excludes(replay_option);
   try {
@@ -95,16 +122,7 @@ int main(int argc, char** argv) {
       throw CLI::ValidationError("one of --replay, --sim or --can is required");
     }
     if (circle && !run_sim) throw CLI::ValidationError("--circle needs --sim");
-    if (view_option->count() > 0 && !run_sim) throw CLI::ValidationError("--view needs --sim (a bus: cdcr view --can)");
-    if (view_option->count() > 0 && !(bus.view.port >= 0 && bus.view.port <= 65535)) {
-      throw CLI::ValidationError("--view must be a port in [0, 65535]");
-    }
-    if (record_option->count() > 0 && !run_sim && replay_path.empty()) {
-      throw CLI::ValidationError("--record needs --sim or --replay");
-    }
-    if (!(bus.view.scene_rate_hz > 0) || !(bus.view.scene_rate_hz <= 1000)) {
-      throw CLI::ValidationError("--view-rate must be in (0, 1000] Hz");
-    }
+    check_view_options(view_options, bus.view, run_sim, !replay_path.empty());
     if (hysteresis && !run_sim) throw CLI::ValidationError("--hysteresis needs --sim");
     if (!flash_dir.empty() && can_interface.empty()) throw CLI::ValidationError("--flash-dir needs --can");
     if (streaming_option->count() > 0 && can_interface.empty()) {

@@ -85,29 +85,16 @@ void McapWriter::write(const std::string& bytes) {
 
 std::uint16_t McapWriter::add_schema(const std::string& name, const std::string& encoding, const std::string& data) {
   schemas_.push_back({name, encoding, data});
-  const auto id = static_cast<std::uint16_t>(schemas_.size());
-  std::string content;
-  put16(content, id);
-  put_string(content, name);
-  put_string(content, encoding);
-  put_string(content, data);
-  write(record(kSchema, content));
-  return id;
+  write(schema_record(schemas_.size() - 1));
+  return static_cast<std::uint16_t>(schemas_.size());
 }
 
 std::uint16_t McapWriter::add_channel(std::uint16_t schema_id, const std::string& topic,
                                       const std::string& message_encoding) {
   if (schema_id == 0 || schema_id > schemas_.size()) throw std::invalid_argument("MCAP channel on an unknown schema");
   channels_.push_back({schema_id, topic, message_encoding});
-  const auto id = static_cast<std::uint16_t>(channels_.size());
-  std::string content;
-  put16(content, id);
-  put16(content, schema_id);
-  put_string(content, topic);
-  put_string(content, message_encoding);
-  put32(content, 0);  // no metadata
-  write(record(kChannel, content));
-  return id;
+  write(channel_record(channels_.size() - 1));
+  return static_cast<std::uint16_t>(channels_.size());
 }
 
 void McapWriter::write_message(std::uint16_t channel_id, std::uint64_t log_time_ns, const std::string& data) {
@@ -174,97 +161,7 @@ void McapWriter::close() {
   put32(data_end, data_crc_);  // every byte before the Data End record
   write(record(kDataEnd, data_end));
 
-  // The summary: one group per record kind, each found by its offset record.
-  const std::uint64_t summary_start = offset_;
-  std::uint32_t summary_crc = 0;
-  struct Group {
-    Opcode opcode;
-    std::uint64_t start, length;
-  };
-  std::vector<Group> groups;
-  const auto write_group = [&](Opcode opcode, const std::vector<std::string>& records) {
-    if (records.empty()) return;
-    const std::uint64_t start = offset_;
-    for (const std::string& r : records) {
-      write(r);
-      summary_crc = crc(r, summary_crc);
-    }
-    groups.push_back({opcode, start, offset_ - start});
-  };
-  std::vector<std::string> schemas, channels, chunk_indexes;
-  for (std::size_t i = 0; i < schemas_.size(); ++i) {
-    std::string content;
-    put16(content, static_cast<std::uint16_t>(i + 1));
-    put_string(content, schemas_[i].name);
-    put_string(content, schemas_[i].encoding);
-    put_string(content, schemas_[i].data);
-    schemas.push_back(record(kSchema, content));
-  }
-  for (std::size_t i = 0; i < channels_.size(); ++i) {
-    std::string content;
-    put16(content, static_cast<std::uint16_t>(i + 1));
-    put16(content, channels_[i].schema_id);
-    put_string(content, channels_[i].topic);
-    put_string(content, channels_[i].encoding);
-    put32(content, 0);
-    channels.push_back(record(kChannel, content));
-  }
-  std::string statistics;
-  put64(statistics, message_count_);
-  put16(statistics, static_cast<std::uint16_t>(schemas_.size()));
-  put32(statistics, static_cast<std::uint32_t>(channels_.size()));
-  put32(statistics, 0);  // attachments
-  put32(statistics, 0);  // metadata
-  put32(statistics, static_cast<std::uint32_t>(chunk_indexes_.size()));
-  put64(statistics, first_time_);
-  put64(statistics, last_time_);
-  put32(statistics, static_cast<std::uint32_t>(channel_message_counts_.size() * 10));
-  for (const auto& [channel, count] : channel_message_counts_) {
-    put16(statistics, channel);
-    put64(statistics, count);
-  }
-  for (const ChunkIndex& index : chunk_indexes_) {
-    std::string content;
-    put64(content, index.start_time);
-    put64(content, index.end_time);
-    put64(content, index.offset);
-    put64(content, index.length);
-    put32(content, static_cast<std::uint32_t>(index.message_index_offsets.size() * 10));
-    for (const auto& [channel, offset] : index.message_index_offsets) {
-      put16(content, channel);
-      put64(content, offset);
-    }
-    put64(content, index.message_index_length);
-    put_string(content, "");
-    put64(content, index.uncompressed_size);  // compressed size: stored as is
-    put64(content, index.uncompressed_size);
-    chunk_indexes.push_back(record(kChunkIndex, content));
-  }
-  write_group(kSchema, schemas);
-  write_group(kChannel, channels);
-  write_group(kStatistics, {record(kStatistics, statistics)});
-  write_group(kChunkIndex, chunk_indexes);
-
-  const std::uint64_t summary_offset_start = offset_;
-  for (const Group& group : groups) {
-    std::string content;
-    put8(content, group.opcode);
-    put64(content, group.start);
-    put64(content, group.length);
-    const std::string r = record(kSummaryOffset, content);
-    write(r);
-    summary_crc = crc(r, summary_crc);
-  }
-  // The footer's CRC covers the summary and the footer up to itself.
-  std::string footer;
-  put8(footer, kFooter);
-  put64(footer, 8 + 8 + 4);
-  put64(footer, summary_start);
-  put64(footer, summary_offset_start);
-  summary_crc = crc(footer, summary_crc);
-  put32(footer, summary_crc);
-  write(footer);
-  write(std::string(kMagic, kMagicSize));
+  write_summary_and_footer();
 
   std::FILE* file = file_;
   file_ = nullptr;
@@ -276,6 +173,100 @@ void McapWriter::close() {
     std::remove(temporary_path_.c_str());
     throw std::runtime_error("cannot rename " + temporary_path_ + " to " + path_ + ": " + std::strerror(errno));
   }
+}
+
+// The records of the summary (and, for schemas and channels, of the data
+// section too), as the specification lays them out.
+std::string McapWriter::schema_record(std::size_t index) const {
+  std::string content;
+  put16(content, static_cast<std::uint16_t>(index + 1));
+  put_string(content, schemas_[index].name);
+  put_string(content, schemas_[index].encoding);
+  put_string(content, schemas_[index].data);
+  return record(kSchema, content);
+}
+
+std::string McapWriter::channel_record(std::size_t index) const {
+  std::string content;
+  put16(content, static_cast<std::uint16_t>(index + 1));
+  put16(content, channels_[index].schema_id);
+  put_string(content, channels_[index].topic);
+  put_string(content, channels_[index].encoding);
+  put32(content, 0);  // no metadata
+  return record(kChannel, content);
+}
+
+std::string McapWriter::statistics_record() const {
+  std::string content;
+  put64(content, message_count_);
+  put16(content, static_cast<std::uint16_t>(schemas_.size()));
+  put32(content, static_cast<std::uint32_t>(channels_.size()));
+  put32(content, 0);  // attachments
+  put32(content, 0);  // metadata
+  put32(content, static_cast<std::uint32_t>(chunk_indexes_.size()));
+  put64(content, first_time_);
+  put64(content, last_time_);
+  put32(content, static_cast<std::uint32_t>(channel_message_counts_.size() * 10));
+  for (const auto& [channel, count] : channel_message_counts_) {
+    put16(content, channel);
+    put64(content, count);
+  }
+  return record(kStatistics, content);
+}
+
+std::string McapWriter::chunk_index_record(const ChunkIndex& index) {
+  std::string content;
+  put64(content, index.start_time);
+  put64(content, index.end_time);
+  put64(content, index.offset);
+  put64(content, index.length);
+  put32(content, static_cast<std::uint32_t>(index.message_index_offsets.size() * 10));
+  for (const auto& [channel, offset] : index.message_index_offsets) {
+    put16(content, channel);
+    put64(content, offset);
+  }
+  put64(content, index.message_index_length);
+  put_string(content, "");
+  put64(content, index.uncompressed_size);  // compressed size: stored as is
+  put64(content, index.uncompressed_size);
+  return record(kChunkIndex, content);
+}
+
+// The summary: one group per record kind, each found by its offset record,
+// then the footer (its CRC over the summary and itself) and the magic.
+void McapWriter::write_summary_and_footer() {
+  const std::uint64_t summary_start = offset_;
+  std::uint32_t summary_crc = 0;
+  const auto write_summary = [&](const std::string& r) {
+    write(r);
+    summary_crc = crc(r, summary_crc);
+  };
+  std::vector<std::string> offsets;
+  const auto write_group = [&](Opcode opcode, std::size_t count, const auto& record_at) {
+    if (count == 0) return;
+    const std::uint64_t start = offset_;
+    for (std::size_t i = 0; i < count; ++i) write_summary(record_at(i));
+    std::string content;
+    put8(content, opcode);
+    put64(content, start);
+    put64(content, offset_ - start);
+    offsets.push_back(record(kSummaryOffset, content));
+  };
+  write_group(kSchema, schemas_.size(), [this](std::size_t i) { return schema_record(i); });
+  write_group(kChannel, channels_.size(), [this](std::size_t i) { return channel_record(i); });
+  write_group(kStatistics, 1, [this](std::size_t) { return statistics_record(); });
+  write_group(kChunkIndex, chunk_indexes_.size(), [this](std::size_t i) { return chunk_index_record(chunk_indexes_[i]); });
+  const std::uint64_t summary_offset_start = offset_;
+  for (const std::string& r : offsets) write_summary(r);
+  std::string footer;
+  put8(footer, kFooter);
+  put64(footer, 8 + 8 + 4);
+  put64(footer, summary_start);
+  put64(footer, summary_offset_start);
+  summary_crc = crc(footer, summary_crc);
+  put32(footer, summary_crc);
+  write(footer);
+  write(std::string(kMagic, kMagicSize));
 }
 
 }  // namespace cdcr::view

@@ -55,6 +55,11 @@ class McapWriter {
 
   void write(const std::string& bytes);
   void flush_chunk();
+  void write_summary_and_footer();
+  std::string schema_record(std::size_t index) const;
+  std::string channel_record(std::size_t index) const;
+  std::string statistics_record() const;
+  static std::string chunk_index_record(const ChunkIndex& index);
 
   std::string path_, temporary_path_;
   std::FILE* file_ = nullptr;

@@ -128,39 +128,47 @@ int RobotView::segment_count() const { return state_->geometry.segment_count; }
 
 void RobotView::on_frame(const hal::CanFrame& wire_frame, std::uint64_t time_ns) {
   ++frames_;
-  State& s = *state_;
   hal::CanFrame frame = wire_frame;
   frame.id = hal::ShiftedCanBus::unshifted(wire_frame.id, options_.id_offset);
-  const int segments = s.geometry.segment_count;
-  const auto take_segment = [&](const double* lengths_mm, int segment, fw::Cables& into) {
-    if (segment < 0 || segment >= segments) return false;
-    const int first = s.geometry.first_cable(segment);
-    for (int k = 0; k < s.geometry.segments[segment].cables.count; ++k) {
-      into[first + k] = static_cast<fw::Scalar>(lengths_mm[k]);
-    }
-    return true;
-  };
-  const auto decoded = [&](protocol::DecodeStatus status) {
-    if (status == protocol::DecodeStatus::ok) return true;
-    if (status != protocol::DecodeStatus::wrong_id) ++malformed_;
-    return false;
-  };
+  if (take_cables(frame, time_ns) || take_target(frame, time_ns)) return;
+  take_report(frame, time_ns);
+}
 
+bool RobotView::decoded(protocol::DecodeStatus status) {
+  if (status == protocol::DecodeStatus::ok) return true;
+  if (status != protocol::DecodeStatus::wrong_id) ++malformed_;
+  return false;
+}
+
+// A segment's cables from its frame into `into`; false for a segment the
+// image's robot does not have.
+bool RobotView::take_segment(const double* lengths_mm, int segment, fw::Cables& into) const {
+  const State& s = *state_;
+  if (segment < 0 || segment >= s.geometry.segment_count) return false;
+  const int first = s.geometry.first_cable(segment);
+  for (int k = 0; k < s.geometry.segments[segment].cables.count; ++k) {
+    into[first + k] = static_cast<fw::Scalar>(lengths_mm[k]);
+  }
+  return true;
+}
+
+bool RobotView::take_cables(const hal::CanFrame& frame, std::uint64_t time_ns) {
+  State& s = *state_;
   protocol::CableFeedback feedback;
   if (decoded(protocol::decode(frame, feedback))) {
-    if (!take_segment(feedback.lengths_mm, feedback.segment, s.feedback)) return;
+    if (!take_segment(feedback.lengths_mm, feedback.segment, s.feedback)) return true;
     s.segment_seen[feedback.segment] = true;
-    if (feedback.segment == segments - 1) {
+    if (feedback.segment == s.geometry.segment_count - 1) {
       bool complete = true;
       for (bool seen : s.segment_seen) complete = complete && seen;
       if (complete) on_feedback_complete(time_ns);
     }
-    return;
+    return true;
   }
   protocol::CableSetpoint setpoint;
   if (decoded(protocol::decode(frame, setpoint))) {
     s.has_setpoints = take_segment(setpoint.lengths_mm, setpoint.segment, s.setpoints) || s.has_setpoints;
-    return;
+    return true;
   }
   protocol::CableSetpointsFd setpoints_fd;
   if (decoded(protocol::decode(frame, setpoints_fd))) {
@@ -168,10 +176,21 @@ void RobotView::on_frame(const hal::CanFrame& wire_frame, std::uint64_t time_ns)
       const protocol::CableSetpoint& part = setpoints_fd.segments[k];
       s.has_setpoints = take_segment(part.lengths_mm, part.segment, s.setpoints) || s.has_setpoints;
     }
-    return;
+    return true;
   }
-  const auto commit_target = [&](const protocol::TargetPositionXy& xy, const protocol::TargetPositionZ& z,
-                                 const protocol::TargetOrientation& q) {
+  protocol::Homing homing;
+  if (decoded(protocol::decode(frame, homing))) {
+    if (homing.at_home) s.tracker.homed(s.runtime.geometry());
+    return true;
+  }
+  return false;
+}
+
+// The target's frames until its commit (TARGET_POSITION_Z), or TARGET_FD.
+bool RobotView::take_target(const hal::CanFrame& frame, std::uint64_t time_ns) {
+  State& s = *state_;
+  const auto commit = [&](const protocol::TargetPositionXy& xy, const protocol::TargetPositionZ& z,
+                          const protocol::TargetOrientation& q) {
     s.has_target = true;
     s.target_is_pose = z.mode == protocol::TargetMode::pose;
     s.target.position_mm = model::Vec3<double>(xy.x_mm, xy.y_mm, z.z_mm);
@@ -183,28 +202,28 @@ void RobotView::on_frame(const hal::CanFrame& wire_frame, std::uint64_t time_ns)
   protocol::TargetPositionXy xy;
   if (decoded(protocol::decode(frame, xy))) {
     s.pending_xy = xy;
-    return;
+    return true;
   }
   protocol::TargetOrientation orientation;
   if (decoded(protocol::decode(frame, orientation))) {
     s.pending_orientation = orientation;
-    return;
+    return true;
   }
   protocol::TargetPositionZ z;
   if (decoded(protocol::decode(frame, z))) {
-    commit_target(s.pending_xy, z, s.pending_orientation);
-    return;
+    commit(s.pending_xy, z, s.pending_orientation);
+    return true;
   }
   protocol::TargetFd target_fd;
   if (decoded(protocol::decode(frame, target_fd))) {
-    commit_target(target_fd.position_xy, target_fd.position_z, target_fd.orientation);
-    return;
+    commit(target_fd.position_xy, target_fd.position_z, target_fd.orientation);
+    return true;
   }
-  protocol::Homing homing;
-  if (decoded(protocol::decode(frame, homing))) {
-    if (homing.at_home) s.tracker.homed(s.runtime.geometry());
-    return;
-  }
+  return false;
+}
+
+// STATUS and IK_REPORT, as decoded.
+void RobotView::take_report(const hal::CanFrame& frame, std::uint64_t time_ns) {
   protocol::Status status;
   if (decoded(protocol::decode(frame, status))) {
     json message{{"timestamp", stamp(time_ns)},
@@ -229,7 +248,6 @@ void RobotView::on_frame(const hal::CanFrame& wire_frame, std::uint64_t time_ns)
                  {"position_residual_mm", report.position_residual_mm},
                  {"orientation_residual_rad", report.orientation_residual_rad}};
     sink_.publish(Topic::ik_report, time_ns, message.dump());
-    return;
   }
 }
 

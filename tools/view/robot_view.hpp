@@ -22,6 +22,8 @@
 #include <string>
 #include <vector>
 
+#include <cdcr/firmware/kinematics.hpp>
+#include <cdcr/firmware/protocol/message_codec.hpp>
 #include <cdcr/hal/can_bus.hpp>
 
 #include "view/view_channels.hpp"
@@ -58,6 +60,13 @@ class RobotView {
 
  private:
   struct State;
+  // Each takes the frame if it is one of its messages (true).
+  bool take_cables(const hal::CanFrame& frame, std::uint64_t time_ns);
+  bool take_target(const hal::CanFrame& frame, std::uint64_t time_ns);
+  void take_report(const hal::CanFrame& frame, std::uint64_t time_ns);
+  bool take_segment(const double* lengths_mm, int segment, firmware::Cables& into) const;
+  // Counts a frame at a message's identifier that does not decode.
+  bool decoded(firmware::protocol::DecodeStatus status);
   void on_feedback_complete(std::uint64_t time_ns);
   void publish_scene(std::uint64_t time_ns);
 

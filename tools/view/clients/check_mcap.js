@@ -8,7 +8,8 @@
 //
 // Without --runtime it checks the file and the schemas only (what the demo
 // runs); with it also the values against `cdcr-runtime --replay`.
-// --of-replay: a recording of --replay, which has only the drives' cables.
+// --of-replay: a recording of --replay, which has only the drives' cables;
+// --require TOPIC,...: the topics that must have messages (default: all).
 "use strict";
 
 const fs = require("fs");
@@ -20,6 +21,7 @@ function parseArguments(argv) {
   const options = { file: undefined, runtime: undefined, image: undefined };
   for (let i = 0; i < argv.length; ++i) {
     if (argv[i] === "--of-replay") options.required = kReplayTopics;
+    else if (argv[i] === "--require") options.required = argv[++i].split(",");
     else if (argv[i] === "--runtime") options.runtime = argv[++i];
     else if (argv[i] === "--image") options.image = argv[++i];
     else if (!options.file && !argv[i].startsWith("--")) options.file = argv[i];

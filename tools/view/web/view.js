@@ -48,84 +48,83 @@ function resize() {
   requestDraw();
 }
 
-// Unit primitives scaled per instance: a cylinder along +y and a sphere, both
-// of diameter 1.
-const cylinder = new THREE.CylinderGeometry(0.5, 0.5, 1, 20);
-const ball = new THREE.SphereGeometry(0.5, 32, 16);
-const yAxis = new THREE.Vector3(0, 1, 0);
-
-function material({ r, g, b, a }) {
-  const color = new THREE.Color().setRGB(r, g, b, THREE.SRGBColorSpace);
-  return new THREE.MeshLambertMaterial({ color, transparent: a < 1, opacity: a, depthWrite: a >= 1 });
+// Every solid primitive is an instance of one of two meshes, a unit cylinder
+// along +y and a unit ball: two draw calls a frame, as SwiftShader (headless
+// Chromium's WebGL) spends its time per call. Translucent spheres are meshes
+// of their own, drawn after the solid.
+const CAPACITY = 4096; // instances of each; more are not drawn
+function instanced(geometry) {
+  const mesh = new THREE.InstancedMesh(geometry, new THREE.MeshLambertMaterial(), CAPACITY);
+  mesh.instanceMatrix.setUsage(THREE.DynamicDrawUsage);
+  mesh.frustumCulled = false; // its bounds are the unit geometry's, not the instances'
+  mesh.count = 0;
+  scene.add(mesh);
+  return mesh;
 }
+const ball = new THREE.SphereGeometry(0.5, 32, 16);
+const pieces = instanced(new THREE.CylinderGeometry(0.5, 0.5, 1, 20)), balls = instanced(ball);
+const translucent = new THREE.Group();
+scene.add(translucent);
 
-function place(object, pose) {
-  const { position: p, orientation: q } = pose;
-  object.position.set(p.x, p.y, p.z);
-  object.quaternion.set(q.x, q.y, q.z, q.w);
+const yAxis = new THREE.Vector3(0, 1, 0);
+const vector = (p) => new THREE.Vector3(p.x, p.y, p.z);
+const srgb = ({ r, g, b }) => new THREE.Color().setRGB(r, g, b, THREE.SRGBColorSpace);
+const poseMatrix = ({ position: p, orientation: q }) =>
+  new THREE.Matrix4().compose(vector(p), new THREE.Quaternion(q.x, q.y, q.z, q.w), new THREE.Vector3(1, 1, 1));
+
+function add(mesh, frame, position, quaternion, scale, color) {
+  if (mesh.count >= CAPACITY) return;
+  mesh.setMatrixAt(mesh.count, frame.clone().multiply(new THREE.Matrix4().compose(position, quaternion, scale)));
+  mesh.setColorAt(mesh.count, color);
+  mesh.count += 1;
 }
 
 // WebGL draws lines 1 px wide, so each piece of a line is a cylinder of the
-// line's thickness, with a ball at each point to round the joints.
-function addLine(group, line) {
-  const lineGroup = new THREE.Group();
-  place(lineGroup, line.pose);
-  const mat = material(line.color);
-  const points = line.points.map((p) => new THREE.Vector3(p.x, p.y, p.z));
-  const d = line.thickness;
+// line's thickness, with a ball at each point to round the joints. A line's
+// alpha is not drawn.
+function addLine(line) {
+  const frame = poseMatrix(line.pose), color = srgb(line.color), d = line.thickness;
+  const points = line.points.map(vector);
+  const step = line.type === 2 ? 2 : 1; // LINE_LIST: pairs; LINE_STRIP, LINE_LOOP: a chain
   const pairs = [];
-  if (line.type === 2) for (let i = 0; i + 1 < points.length; i += 2) pairs.push([points[i], points[i + 1]]);
-  else for (let i = 0; i + 1 < points.length; ++i) pairs.push([points[i], points[i + 1]]);
+  for (let i = 0; i + 1 < points.length; i += step) pairs.push([points[i], points[i + 1]]);
   if (line.type === 1 && points.length > 2) pairs.push([points[points.length - 1], points[0]]);
   for (const [a, b] of pairs) {
     const length = a.distanceTo(b);
     if (!(length > 0)) continue;
-    const piece = new THREE.Mesh(cylinder, mat);
-    piece.position.copy(a).add(b).multiplyScalar(0.5);
-    piece.quaternion.setFromUnitVectors(yAxis, b.clone().sub(a).divideScalar(length));
-    piece.scale.set(d, length, d);
-    lineGroup.add(piece);
+    const direction = new THREE.Quaternion().setFromUnitVectors(yAxis, b.clone().sub(a).divideScalar(length));
+    add(pieces, frame, a.clone().add(b).multiplyScalar(0.5), direction, new THREE.Vector3(d, length, d), color);
   }
-  for (const p of points) {
-    const joint = new THREE.Mesh(ball, mat);
-    joint.position.copy(p);
-    joint.scale.setScalar(d);
-    lineGroup.add(joint);
-  }
-  group.add(lineGroup);
+  for (const p of points) add(balls, frame, p, new THREE.Quaternion(), new THREE.Vector3(d, d, d), color);
 }
 
-function addSphere(group, sphere) {
-  const mesh = new THREE.Mesh(ball, material(sphere.color));
-  place(mesh, sphere.pose);
-  mesh.scale.set(sphere.size.x, sphere.size.y, sphere.size.z);
-  mesh.renderOrder = sphere.color.a < 1 ? 1 : 0; // translucent ones after the solid
-  group.add(mesh);
+function addSphere({ pose, size, color }) {
+  if (color.a >= 1) return add(balls, poseMatrix(pose), new THREE.Vector3(), new THREE.Quaternion(), vector(size), srgb(color));
+  const mesh = new THREE.Mesh(ball, new THREE.MeshLambertMaterial({ color: srgb(color), transparent: true, opacity: color.a, depthWrite: false }));
+  mesh.applyMatrix4(poseMatrix(pose));
+  mesh.scale.copy(vector(size));
+  translucent.add(mesh);
 }
 
-// Every entity is in the frame "base", the world here.
+// The entities by id, each redrawn whole; all in the frame "base", the world here.
 const entities = new Map();
-function removeEntity(id) {
-  const group = entities.get(id);
-  if (!group) return;
-  group.traverse((o) => o.material && o.material.dispose());
-  scene.remove(group);
-  entities.delete(id);
-}
-
 let pendingTime = null;
 function applySceneUpdate(update, time) {
   for (const deletion of update.deletions) {
-    if (deletion.type === 1) [...entities.keys()].forEach(removeEntity);
-    else removeEntity(deletion.id);
+    if (deletion.type === 1) entities.clear();
+    else entities.delete(deletion.id);
   }
-  for (const entity of update.entities) {
-    removeEntity(entity.id);
-    const group = new THREE.Group();
-    entity.lines.forEach((line) => addLine(group, line));
-    entity.spheres.forEach((sphere) => addSphere(group, sphere));
-    entities.set(entity.id, group);
-    scene.add(group);
+  for (const entity of update.entities) entities.set(entity.id, entity);
+  pieces.count = balls.count = 0;
+  translucent.children.forEach((mesh) => mesh.material.dispose());
+  translucent.clear();
+  for (const entity of entities.values()) {
+    entity.lines.forEach(addLine);
+    entity.spheres.forEach(addSphere);
+  }
+  for (const mesh of [pieces, balls]) {
+    mesh.instanceMatrix.needsUpdate = true;
+    if (mesh.instanceColor) mesh.instanceColor.needsUpdate = true;
   }
   pendingTime = time;
   requestDraw();
