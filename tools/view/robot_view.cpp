@@ -330,7 +330,7 @@ void RobotView::publish_scene(std::uint64_t time_ns) {
     }
     backbone["lines"].push_back({{"type", 0},
                                  {"pose", at_origin()},
-                                 {"thickness", 0.04 * total_length_mm * kMetresPerMm},
+                                 {"thickness", 0.025 * total_length_mm * kMetresPerMm},
                                  {"scale_invariant", false},
                                  {"points", points},
                                  {"color", segment_colors[i % 2]},
@@ -340,21 +340,22 @@ void RobotView::publish_scene(std::uint64_t time_ns) {
   }
   // The base frame and the compensated tip's.
   add_axes(backbone["lines"], model::Pose<double>{}, 0.15 * total_length_mm, 0.015 * total_length_mm);
-  add_axes(backbone["lines"], tip, 0.1 * total_length_mm, 0.01 * total_length_mm);
+  add_axes(backbone["lines"], tip, 0.06 * total_length_mm, 0.005 * total_length_mm);
 
-  // The tip: the compensated one in its r95 sphere, red when extrapolating;
-  // the nominal one grey.
+  // The tip: the compensated one (small, so that its r95 sphere shows
+  // around it), red when extrapolating; the nominal one grey, where the
+  // backbone ends. Sizes in shares of the robot's length.
   json tip_entity = entity("tip", time_ns);
   const bool extrapolating = s.uncertainty.extrapolating;
   const json tip_color = extrapolating ? rgba(0.9, 0.1, 0.1, 1) : rgba(0.1, 0.7, 0.3, 1);
-  const double marker_mm = 0.05 * total_length_mm;
+  const double marker_mm = 0.012 * total_length_mm;
   tip_entity["spheres"].push_back(sphere(tip.position_mm, marker_mm, tip_color));
   const double r95_mm = double(s.uncertainty.r95_mm);
   if (std::isfinite(r95_mm) && r95_mm > 0) {
     tip_entity["spheres"].push_back(sphere(tip.position_mm, 2 * r95_mm,
                                            extrapolating ? rgba(0.9, 0.1, 0.1, 0.3) : rgba(0.1, 0.7, 0.3, 0.25)));
   }
-  tip_entity["spheres"].push_back(sphere(s.nominal_tip.position_mm, 0.6 * marker_mm, rgba(0.6, 0.6, 0.6, 1)));
+  tip_entity["spheres"].push_back(sphere(s.nominal_tip.position_mm, 0.035 * total_length_mm, rgba(0.6, 0.6, 0.6, 1)));
   json update{{"deletions", json::array()}, {"entities", json::array({backbone, tip_entity})}};
   json transforms = json::array();
   const auto transform = [&](const char* child, const model::Pose<double>& pose) {
@@ -368,7 +369,8 @@ void RobotView::publish_scene(std::uint64_t time_ns) {
   transform("nominal_tip", s.nominal_tip);
   if (s.has_target) {
     json target = entity("target", time_ns);
-    target["spheres"].push_back(sphere(s.target.position_mm, 0.7 * marker_mm, rgba(0.95, 0.85, 0.1, 0.9)));
+    // A halo: the tip sits inside it once it has reached the target.
+    target["spheres"].push_back(sphere(s.target.position_mm, 0.04 * total_length_mm, rgba(0.95, 0.8, 0.1, 0.35)));
     if (s.target_is_pose) add_axes(target["lines"], s.target, 0.07 * total_length_mm, 0.008 * total_length_mm);
     update["entities"].push_back(target);
     transform("target", s.target);

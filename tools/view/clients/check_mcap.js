@@ -114,7 +114,13 @@ async function main() {
   try {
     const options = parseArguments(process.argv.slice(2));
     const summary = await check(options);
-    console.log(`check_mcap: ${options.file}: ${JSON.stringify(summary)}`);
+    console.log(`check_mcap: ${options.file}: ${summary.messages} messages in ${summary.chunks} chunks on ${summary.channels} ` +
+      "channels; the index, the statistics and every CRC agree with the data; every message decoded and valid against its schema");
+    if (options.runtime) {
+      console.log(`check_mcap: ${summary.scenes} scenes consistent with the poses; ${summary.compared} tip poses against ` +
+        `cdcr-runtime --replay of their cables: within ${summary.worstMm.toExponential(1)} mm, ` +
+        `${summary.worstQ.toExponential(1)} in the quaternion, r95 within ${summary.worstR95.toExponential(1)} mm`);
+    }
   } catch (e) {
     // The reference reader's own refusals are one line too.
     console.error(`check_mcap: ${e instanceof CheckError ? e.message : `the MCAP reader refused the file: ${e.message || e}`}`);

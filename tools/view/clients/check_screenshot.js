@@ -144,7 +144,7 @@ async function main() {
 
     const { robot, missed, far, painted } = checkPicture(PNG.sync.read(fs.readFileSync(out)), update);
     console.log(`check_screenshot: scene at ${when} s (${scenes.size} received): ${robot.length - missed.length} of ` +
-      `${robot.length} backbone points drawn, ${far.length - painted.length} of ${far.length} points away from the robot background`);
+      `${robot.length} backbone points drawn, ${far.length - painted.length} of ${far.length} points away from every entity background`);
     if (missed.length) {
       throw new Error(`${missed.length} backbone points not drawn, first at pixel (${missed[0].at.map(Math.round)}) in ${out}`);
     }

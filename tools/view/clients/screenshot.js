@@ -19,8 +19,8 @@ const WebSocket = require('ws');
 const WEB_ROOT = path.join(__dirname, '..', 'web');
 const THREE_ROOT = path.join(__dirname, 'node_modules', 'three');
 const TYPES = { '.html': 'text/html', '.js': 'text/javascript', '.css': 'text/css', '.png': 'image/png' };
-// Headless without a GPU: WebGL on SwiftShader, the software renderer
-// Chromium ships; it is no longer allowed unless asked for.
+// WebGL without a GPU is SwiftShader, the software renderer Chromium ships;
+// Chromium is retiring its silent fallback to it, so it is asked for.
 const CHROMIUM_FLAGS = ['--headless=new', '--no-sandbox', '--disable-gpu', '--use-angle=swiftshader',
   '--enable-unsafe-swiftshader', '--disable-quic', '--no-first-run', '--disable-background-networking',
   '--disable-component-update', '--disable-sync', '--disable-dev-shm-usage', '--hide-scrollbars',
@@ -29,7 +29,8 @@ const CHROMIUM_FLAGS = ['--headless=new', '--no-sandbox', '--disable-gpu', '--us
 // The page at /, three.js at /three/; nothing outside those two directories.
 function servePage() {
   const server = http.createServer((req, res) => {
-    const url = decodeURIComponent(new URL(req.url, 'http://localhost').pathname);
+    let url;
+    try { url = decodeURIComponent(new URL(req.url, 'http://localhost').pathname); } catch { return res.writeHead(400).end(); }
     const [root, rest] = url.startsWith('/three/') ? [THREE_ROOT, url.slice(7)] : [WEB_ROOT, url === '/' ? 'index.html' : url];
     const file = path.join(root, path.normalize('/' + rest));
     fs.readFile(file, (err, body) => {
@@ -55,8 +56,8 @@ function getJson(url) {
   });
 }
 
-// One DevTools connection: commands by id, events to `onEvent`, and the
-// first page error (exception, console.error, failed load) kept in `error`.
+// One DevTools connection: commands by id, and the first page error
+// (exception, console.error, failed load) kept in `error`.
 class Devtools {
   constructor(url, deadline) {
     this.deadline = deadline;

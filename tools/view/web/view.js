@@ -14,7 +14,8 @@
 // screenshot shows exactly the scene of sceneTime.
 import * as THREE from '/three/build/three.module.js';
 
-// The background the screenshot test tells the robot from (check_screenshot.js).
+// The background, uniform: check_screenshot.js tells the robot from it (and
+// holds the same value).
 export const BACKGROUND = 0xf2f2f2;
 
 const params = new URLSearchParams(location.search);
@@ -61,7 +62,7 @@ function instanced(geometry) {
   scene.add(mesh);
   return mesh;
 }
-const ball = new THREE.SphereGeometry(0.5, 32, 16);
+const ball = new THREE.SphereGeometry(0.5, 20, 12);
 const pieces = instanced(new THREE.CylinderGeometry(0.5, 0.5, 1, 20)), balls = instanced(ball);
 const translucent = new THREE.Group();
 scene.add(translucent);
@@ -80,10 +81,12 @@ function add(mesh, frame, position, quaternion, scale, color) {
 }
 
 // WebGL draws lines 1 px wide, so each piece of a line is a cylinder of the
-// line's thickness, with a ball at each point to round the joints. A line's
-// alpha is not drawn.
+// line's thickness, with a ball at each point to round the joints (a little
+// narrower than the line, so that the cylinders hide the balls' facets). A
+// line's alpha is not drawn.
 function addLine(line) {
-  const frame = poseMatrix(line.pose), color = srgb(line.color), d = line.thickness;
+  const frame = poseMatrix(line.pose), color = srgb(line.color);
+  const d = line.scale_invariant ? line.thickness / ppm : line.thickness; // pixels, or metres
   const points = line.points.map(vector);
   const step = line.type === 2 ? 2 : 1; // LINE_LIST: pairs; LINE_STRIP, LINE_LOOP: a chain
   const pairs = [];
@@ -95,7 +98,8 @@ function addLine(line) {
     const direction = new THREE.Quaternion().setFromUnitVectors(yAxis, b.clone().sub(a).divideScalar(length));
     add(pieces, frame, a.clone().add(b).multiplyScalar(0.5), direction, new THREE.Vector3(d, length, d), color);
   }
-  for (const p of points) add(balls, frame, p, new THREE.Quaternion(), new THREE.Vector3(d, d, d), color);
+  const joint = new THREE.Vector3(d, d, d).multiplyScalar(0.95);
+  for (const p of points) add(balls, frame, p, new THREE.Quaternion(), joint, color);
 }
 
 function addSphere({ pose, size, color }) {
@@ -170,7 +174,7 @@ function connect(url) {
     applySceneUpdate(JSON.parse(text.decode(new Uint8Array(event.data, 13))),
                      { sec: Number(ns / 1000000000n), nsec: Number(ns % 1000000000n) });
   };
-  ws.onerror = () => console.error(`view: cannot connect to ${url}`);
+  ws.onerror = () => console.error(`view: WebSocket error on ${url}`);
   ws.onclose = () => {
     if (window.cdcrView.frozen) return;
     status.hidden = false;
