@@ -7,8 +7,9 @@ cd "$(dirname "${BASH_SOURCE[0]}")/.."
 started=$SECONDS
 # The build needs only the base packages. The test groups' packages (the
 # cross toolchain and QEMU, clang, User-Mode Linux, scikit-learn, Node.js
-# and the npm canopen stack) install while it runs: apt and npm wait on the
-# network and the disk, the build on the CPU.
+# with the npm canopen stack and the view's clients, Chromium) install while
+# it runs: apt and npm wait on the network and the disk, the build on the
+# CPU.
 bash tools/install-deps.sh base
 group_log=$(mktemp)
 bash tools/install-deps.sh sklearn fuzz uml cross canopen view browser >"$group_log" 2>&1 &
