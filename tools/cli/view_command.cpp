@@ -94,6 +94,7 @@ CommandOutput run_view(const ViewCommandOptions& options) {
   } catch (const std::runtime_error& e) {
     throw InputError(e.what());
   }
+  if (!robot_view->note().empty()) std::fprintf(stderr, "view: note: %s\n", robot_view->note().c_str());
   std::fprintf(stderr, "view: ws://localhost:%u (Foxglove WebSocket) from %s%s%s; Ctrl-C stops\n",
                unsigned(server->port()), options.can_interface.c_str(),
                options.drives_can_interface.empty() ? "" : " and ", options.drives_can_interface.c_str());

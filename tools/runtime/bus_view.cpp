@@ -34,6 +34,7 @@ BusView::BusView(const std::string& image_path, const ViewChoice& choice, std::u
   const std::vector<std::uint8_t> image =
       image_path.empty() ? std::vector<std::uint8_t>{} : cdcr::exporting::read_binary_file(image_path);
   view_ = std::make_unique<view::RobotView>(image, options, *sinks_);
+  if (!view_->note().empty()) std::fprintf(stderr, "view: note: %s\n", view_->note().c_str());
   worker_ = std::make_unique<view::ViewWorker>(*view_);
   wall_start_ns_ = static_cast<std::uint64_t>(
       std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())

@@ -115,6 +115,10 @@ RobotView::RobotView(const std::vector<std::uint8_t>& image, const ViewOptions& 
   if (booted != fw::RuntimeState::run && booted != fw::RuntimeState::degraded) {
     throw std::runtime_error(std::string("the view cannot use the image: ") + fw::to_string(s.runtime.boot_fault()));
   }
+  if (booted == fw::RuntimeState::degraded) {
+    note_ = std::string("the image is not used (") + fw::to_string(s.runtime.boot_fault()) +
+            "): the view shows the nominal model of the prototype's geometry, as the runtime runs";
+  }
   s.tracker = s.runtime.hysteresis();
   s.geometry = s.runtime.geometry().cast<double>();
   s.feedback.setZero(s.geometry.cable_count());

@@ -57,6 +57,8 @@ class RobotView {
   long malformed_frames() const { return malformed_; }
   long scenes() const { return scenes_; }
   int segment_count() const;
+  // Empty, or why the image's model is not the one shown (one line).
+  const std::string& note() const { return note_; }
 
  private:
   struct State;
@@ -74,6 +76,7 @@ class RobotView {
   ViewOptions options_;
   ViewSink& sink_;
   long frames_ = 0, malformed_ = 0, scenes_ = 0;
+  std::string note_;
 };
 
 // The sinks a view feeds at once (the live server and a recording).
