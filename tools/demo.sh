@@ -110,5 +110,5 @@ cat <<EOF
 Open $out/circle.mcap in Foxglove or Lichtblick (Open local file; a 3D panel
 shows /scene, plots /cables and /cables/following_error) or in PlotJuggler.
 Live: build/bin/cdcr-runtime --image $out/model.img --sim --circle --view 8765,
-then connect Foxglove to ws://localhost:8765 (tools/view/README.md).
+then connect Foxglove to ws://127.0.0.1:8765 (tools/view/README.md).
 EOF

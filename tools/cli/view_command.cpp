@@ -95,7 +95,7 @@ CommandOutput run_view(const ViewCommandOptions& options) {
     throw InputError(e.what());
   }
   if (!robot_view->note().empty()) std::fprintf(stderr, "view: note: %s\n", robot_view->note().c_str());
-  std::fprintf(stderr, "view: ws://localhost:%u (Foxglove WebSocket) from %s%s%s; Ctrl-C stops\n",
+  std::fprintf(stderr, "view: ws://127.0.0.1:%u (Foxglove WebSocket) from %s%s%s; Ctrl-C stops\n",
                unsigned(server->port()), options.can_interface.c_str(),
                options.drives_can_interface.empty() ? "" : " and ", options.drives_can_interface.c_str());
   std::fflush(stderr);

@@ -19,7 +19,7 @@ BusView::BusView(const std::string& image_path, const ViewChoice& choice, std::u
   if (choice.port >= 0) {
     server_ = std::make_unique<view::FoxgloveServer>(static_cast<std::uint16_t>(choice.port), "cdcr-runtime --sim");
     std::fprintf(stderr,
-                 "view: ws://localhost:%u (Foxglove WebSocket; the simulated loop runs in real time while served)\n",
+                 "view: ws://127.0.0.1:%u (Foxglove WebSocket; the simulated loop runs in real time while served)\n",
                  unsigned(server_->port()));
     std::fflush(stderr);
     sinks_->add(server_.get());

@@ -25,7 +25,7 @@ trap 'kill "$pid" 2>/dev/null || true; rm -f "$log"' EXIT
 
 port=
 for _ in $(seq 100); do
-  port=$(sed -n 's|^view: ws://localhost:\([0-9]*\).*|\1|p' "$log")
+  port=$(sed -n 's|^view: ws://127.0.0.1:\([0-9]*\).*|\1|p' "$log")
   [[ -n $port ]] && break
   kill -0 "$pid" 2>/dev/null || break
   sleep 0.1
@@ -36,6 +36,6 @@ done
 # headless Chromium draws fewer than the view's 30 a second (~10 on a loaded
 # two-core host). Portrait, for the tall robot.
 sleep 1.5
-scene_time=$(node tools/view/clients/screenshot.js --ws "ws://localhost:$port" --out "$out" \
+scene_time=$(node tools/view/clients/screenshot.js --ws "ws://127.0.0.1:$port" --out "$out" \
   --width 720 --height 800 --cx -0.05 --cz 0.255 --ppm 1300)
 echo "wrote $out (scene at $scene_time)"

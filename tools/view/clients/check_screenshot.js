@@ -113,14 +113,14 @@ async function main() {
       runtime.on('error', (e) => reject(new Error(`cannot start ${runtimePath}: ${e.message}`)));
       runtime.stderr.on('data', (d) => {
         stderr += d;
-        const m = /^view: ws:\/\/localhost:(\d+)/m.exec(stderr);
+        const m = /^view: ws:\/\/127\.0\.0\.1:(\d+)/m.exec(stderr);
         if (m) { clearTimeout(timer); resolve(Number(m[1])); }
       });
       exited.then(({ code }) => reject(new Error(`cdcr-runtime exited (${code}) before serving: ${stderr.trim().split('\n').pop()}`)));
     });
 
     // The reference client's copy of every scene, by its time.
-    const url = `ws://localhost:${port}`;
+    const url = `ws://127.0.0.1:${port}`;
     const scenes = new Map();
     client = new FoxgloveClient({ ws: new WebSocket(url, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
     await new Promise((resolve, reject) => {

@@ -39,7 +39,7 @@ function startRuntime(options) {
   const port = new Promise((resolve, reject) => {
     child.stderr.on("data", (d) => {
       stderr += d;
-      const match = /view: ws:\/\/localhost:(\d+)/.exec(stderr);
+      const match = /view: ws:\/\/127\.0\.0\.1:(\d+)/.exec(stderr);
       if (match) resolve(Number(match[1]));
     });
     child.on("exit", (code) => reject(new CheckError(`cdcr-runtime exited (${code}) before serving: ${stderr.trim()}`)));
@@ -48,7 +48,7 @@ function startRuntime(options) {
 }
 
 async function receive(port) {
-  const client = new FoxgloveClient({ ws: new WebSocket(`ws://localhost:${port}`, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
+  const client = new FoxgloveClient({ ws: new WebSocket(`ws://127.0.0.1:${port}`, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]) });
   const validators = new Map(); // by subscription id
   const topics = new Map();
   const byTopic = {};

@@ -2,7 +2,7 @@
 // the page served over HTTP on 127.0.0.1, headless Chromium driven over the
 // DevTools protocol, the PNG taken once the page has drawn a few scenes.
 //
-//   node screenshot.js --ws ws://localhost:PORT --out view.png
+//   node screenshot.js --ws ws://127.0.0.1:PORT --out view.png
 //        [--width 800] [--height 600] [--cx 0] [--cz 0.25] [--ppm 1000] [--min-scenes 3]
 //   node screenshot.js --serve     (only serve the page, for a desktop browser)
 //
@@ -214,7 +214,7 @@ if (require.main === module) {
     process.exit(1);
   };
   if (args.includes('--serve')) {
-    servePage().then((server) => console.log(`page: http://127.0.0.1:${server.address().port}/?ws=ws://localhost:PORT`), (e) => fail(e.message));
+    servePage().then((server) => console.log(`page: http://127.0.0.1:${server.address().port}/?ws=ws://127.0.0.1:PORT`), (e) => fail(e.message));
   } else {
     if (!option('ws') || !option('out')) fail('usage: screenshot.js --ws URL --out PNG [--width W --height H --cx M --cz M --ppm N --min-scenes N]');
     const n = (name, fallback) => Number(option(name, fallback));

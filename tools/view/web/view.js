@@ -6,7 +6,7 @@
 // In a desktop browser: serve this directory with three at /three/, e.g.
 //   node tools/view/clients/screenshot.js --serve
 // start `cdcr-runtime ... --view 0`, and open the printed address with
-//   ?ws=ws://localhost:PORT&cx=0&cz=0.25&ppm=1000
+//   ?ws=ws://127.0.0.1:PORT&cx=0&cz=0.25&ppm=1000
 // (cx, cz: the metres at the window's centre; ppm: pixels per metre).
 //
 // window.cdcrView = {scenes, sceneTime} counts the scenes drawn and gives the
