@@ -9,7 +9,10 @@
 // Without --runtime it checks the file and the schemas only (what the demo
 // runs); with it also the values against `cdcr-runtime --replay`.
 // --of-replay: a recording of --replay, which has only the drives' cables;
-// --require TOPIC,...: the topics that must have messages (default: all).
+// --require TOPIC,...: the topics that must have messages (default: all);
+// --poses POSES.csv: the recording of a replay, its tips row by row against
+// that replay's own poses (the rows' lengths must be ones CABLE_FEEDBACK
+// carries exactly: hundredths of a millimetre).
 "use strict";
 
 const fs = require("fs");
@@ -22,6 +25,7 @@ function parseArguments(argv) {
   for (let i = 0; i < argv.length; ++i) {
     if (argv[i] === "--of-replay") options.required = kReplayTopics;
     else if (argv[i] === "--require") options.required = argv[++i].split(",");
+    else if (argv[i] === "--poses") options.poses = argv[++i];
     else if (argv[i] === "--runtime") options.runtime = argv[++i];
     else if (argv[i] === "--image") options.image = argv[++i];
     else if (!options.file && !argv[i].startsWith("--")) options.file = argv[i];
@@ -30,6 +34,18 @@ function parseArguments(argv) {
   if (!options.file) fail("usage: node check_mcap.js FILE.mcap [--runtime PATH --image PATH [--of-replay]]");
   if (!options.runtime !== !options.image) fail("--runtime and --image go together");
   return options;
+}
+
+function compareRows(tips, posesPath) {
+  const rows = fs.readFileSync(posesPath, "utf8").trim().split("\n").slice(1).map((line) => line.split(",").map(Number));
+  if (rows.length !== tips.length) fail(`${tips.length} tip poses recorded for ${rows.length} rows of ${posesPath}`);
+  let worst = 0;
+  rows.forEach(([x, y, z], i) => {
+    const p = tips[i].pose.position;
+    worst = Math.max(worst, Math.hypot(p.x * 1e3 - x, p.y * 1e3 - y, p.z * 1e3 - z));
+  });
+  if (!(worst <= 1e-3)) fail(`the recorded tips differ from ${posesPath} by up to ${worst} mm`);
+  return worst;
 }
 
 async function check(options) {
@@ -106,6 +122,7 @@ async function check(options) {
   if (streamed !== total || footers !== 1) fail(`the stream reader read ${streamed} messages and ${footers} footers`);
 
   const summary = { messages: total, chunks: reader.chunkIndexes.length, channels: topics.size };
+  if (options.poses) summary.rowsWorstMm = compareRows(byTopic["/tip/pose"] || [], options.poses);
   if (options.runtime) Object.assign(summary, checkValues(byTopic, options));
   return summary;
 }
@@ -116,6 +133,9 @@ async function main() {
     const summary = await check(options);
     console.log(`check_mcap: ${options.file}: ${summary.messages} messages in ${summary.chunks} chunks on ${summary.channels} ` +
       "channels; the index, the statistics and every CRC agree with the data; every message decoded and valid against its schema");
+    if (options.poses) {
+      console.log(`check_mcap: every row's tip within ${summary.rowsWorstMm.toExponential(1)} mm of ${options.poses}`);
+    }
     if (options.runtime) {
       console.log(`check_mcap: ${summary.scenes} scenes consistent with the poses; ${summary.compared} tip poses against ` +
         `cdcr-runtime --replay of their cables: within ${summary.worstMm.toExponential(1)} mm, ` +
