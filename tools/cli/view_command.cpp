@@ -16,9 +16,7 @@
 #include "bus_command.hpp"
 #include "cli_errors.hpp"
 #include "export/binary_file.hpp"
-#include "view/foxglove_server.hpp"
-#include "view/robot_view.hpp"
-#include "view/view_recording.hpp"
+#include "view/view_session.hpp"
 
 namespace cdcr::cli {
 
@@ -26,12 +24,6 @@ namespace {
 
 volatile std::sig_atomic_t stop_requested = 0;
 void request_stop(int) { stop_requested = 1; }
-
-std::uint64_t wall_clock_ns() {
-  return static_cast<std::uint64_t>(
-      std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch())
-          .count());
-}
 
 }  // namespace
 
@@ -79,24 +71,17 @@ CommandOutput run_view(const ViewCommandOptions& options) {
   } catch (const std::exception& e) {
     throw InputError(e.what());
   }
-  view::SinkList sinks;
-  std::unique_ptr<view::ViewRecording> recording;
-  std::unique_ptr<view::RobotView> robot_view;
-  std::unique_ptr<view::FoxgloveServer> server;
+  std::unique_ptr<view::ViewSession> session;
   try {
-    server = std::make_unique<view::FoxgloveServer>(static_cast<std::uint16_t>(options.port), "cdcr view");
-    sinks.add(server.get());
-    if (!options.record_path.empty()) {
-      recording = std::make_unique<view::ViewRecording>(options.record_path);
-      sinks.add(recording.get());
-    }
-    robot_view = std::make_unique<view::RobotView>(image, view_options, sinks);
+    session = std::make_unique<view::ViewSession>(image, view_options,
+                                                  view::ViewOutputs{options.port, options.record_path, "cdcr view"});
   } catch (const std::runtime_error& e) {
     throw InputError(e.what());
   }
-  if (!robot_view->note().empty()) std::fprintf(stderr, "view: note: %s\n", robot_view->note().c_str());
+  view::RobotView& robot_view = session->view();
+  if (!robot_view.note().empty()) std::fprintf(stderr, "view: note: %s\n", robot_view.note().c_str());
   std::fprintf(stderr, "view: ws://127.0.0.1:%u (Foxglove WebSocket) from %s%s%s; Ctrl-C stops\n",
-               unsigned(server->port()), options.can_interface.c_str(),
+               unsigned(session->port()), options.can_interface.c_str(),
                options.drives_can_interface.empty() ? "" : " and ", options.drives_can_interface.c_str());
   std::fflush(stderr);
 
@@ -112,19 +97,17 @@ CommandOutput run_view(const ViewCommandOptions& options) {
     hal::CanFrame frame;
     for (auto& bus : buses) {
       while (bus->receive(frame) == hal::CanStatus::ok) {
-        robot_view->on_frame(frame, wall_clock_ns());
+        robot_view.on_frame(frame, view::wall_clock_ns());
         any = true;
       }
     }
     if (!any) std::this_thread::sleep_for(std::chrono::microseconds(500));
   }
   CommandOutput output;
-  output.text = fmt::format("view: {} frames seen ({} malformed), {} scenes\n", robot_view->frames(),
-                            robot_view->malformed_frames(), robot_view->scenes());
-  if (recording) {
-    recording->close();
-    output.text += fmt::format("recording: {}, {} messages (MCAP)\n", options.record_path, recording->message_count());
-  }
+  output.text = fmt::format("view: {} frames seen ({} malformed), {} scenes\n", robot_view.frames(),
+                            robot_view.malformed_frames(), robot_view.scenes());
+  session->close_recording();
+  if (const std::string report = session->recording_report(); !report.empty()) output.text += report + "\n";
   return output;
 }
 

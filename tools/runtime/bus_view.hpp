@@ -15,10 +15,7 @@
 #include <cdcr/hal/can_bus.hpp>
 
 namespace cdcr::view {
-class FoxgloveServer;
-class RobotView;
-class SinkList;
-class ViewRecording;
+class ViewSession;
 class ViewWorker;
 }  // namespace cdcr::view
 
@@ -47,13 +44,9 @@ class BusView {
 
  private:
   std::vector<hal::CanBus*> listeners_;
-  std::unique_ptr<view::SinkList> sinks_;
-  std::unique_ptr<view::FoxgloveServer> server_;
-  std::unique_ptr<view::ViewRecording> recording_;
-  std::unique_ptr<view::RobotView> view_;
-  std::unique_ptr<view::ViewWorker> worker_;
-  std::string record_path_;
   double scene_rate_hz_;
+  std::unique_ptr<view::ViewSession> session_;
+  std::unique_ptr<view::ViewWorker> worker_;
   std::int64_t last_ns_ = 0;
   std::uint64_t wall_start_ns_ = 0;
   std::chrono::steady_clock::time_point steady_start_;

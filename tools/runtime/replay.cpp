@@ -5,9 +5,9 @@
 
 #include <cmath>
 #include <cstdio>
-#include <vector>
 #include <stdexcept>
 #include <string>
+#include <vector>
 
 #include <Eigen/Geometry>
 
@@ -21,8 +21,7 @@
 #include "export/binary_file.hpp"
 #include "runtime_modes.hpp"
 #include "sim/simulated_platform.hpp"
-#include "view/robot_view.hpp"
-#include "view/view_recording.hpp"
+#include "view/view_session.hpp"
 
 namespace cdcr::runtime_host {
 
@@ -45,10 +44,11 @@ namespace {
 // counted.
 void record_rows(const std::string& image_path, const cdcr::dataset::Dataset& data, const fw::Runtime& runtime,
                  const ViewChoice& choice) {
-  view::ViewRecording recording(choice.record_path);
   view::ViewOptions options;
   options.scene_rate_hz = choice.scene_rate_hz;
-  view::RobotView robot_view(cdcr::exporting::read_binary_file(image_path), options, recording);
+  view::ViewSession session(cdcr::exporting::read_binary_file(image_path), options,
+                            view::ViewOutputs{-1, choice.record_path, ""});
+  view::RobotView& robot_view = session.view();
   const fw::Geometry& geometry = runtime.geometry();
   std::size_t next_session = 0;
   long left_out = 0;
@@ -77,10 +77,10 @@ void record_rows(const std::string& image_path, const cdcr::dataset::Dataset& da
     }
     for (const cdcr::hal::CanFrame& f : frames) robot_view.on_frame(f, time_ns);
   }
-  recording.close();
+  session.close_recording();
   std::printf("recording: %s, %llu messages of %lld rows (%ld left out: lengths a CABLE_FEEDBACK frame cannot "
               "carry)\n",
-              choice.record_path.c_str(), static_cast<unsigned long long>(recording.message_count()),
+              choice.record_path.c_str(), static_cast<unsigned long long>(session.recorded_messages()),
               static_cast<long long>(data.cables_mm.rows()), left_out);
 }
 

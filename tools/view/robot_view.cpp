@@ -58,19 +58,24 @@ json sphere(const model::Vec3<double>& center_mm, double diameter_mm, const json
   return json{{"pose", pose_json(pose)}, {"size", {{"x", d}, {"y", d}, {"z", d}}}, {"color", color}};
 }
 
+// A LINE_STRIP through `points` (already in metres), in the base frame.
+json line_strip(json points, double thickness_mm, const json& color) {
+  return json{{"type", 0},
+              {"pose", at_origin()},
+              {"thickness", thickness_mm * kMetresPerMm},
+              {"scale_invariant", false},
+              {"points", std::move(points)},
+              {"color", color},
+              {"colors", json::array()},
+              {"indices", json::array()}};
+}
+
 // A frame's three axes as red, green and blue lines from its origin.
 void add_axes(json& lines, const model::Pose<double>& frame, double length_mm, double thickness_mm) {
   const json colors[3] = {rgba(0.9, 0.1, 0.1, 1), rgba(0.1, 0.75, 0.1, 1), rgba(0.15, 0.3, 0.95, 1)};
   for (int axis = 0; axis < 3; ++axis) {
     const model::Vec3<double> end = frame.position_mm + length_mm * frame.rotation.col(axis);
-    lines.push_back({{"type", 0},
-                     {"pose", at_origin()},
-                     {"thickness", thickness_mm * kMetresPerMm},
-                     {"scale_invariant", false},
-                     {"points", {vector_json(frame.position_mm), vector_json(end)}},
-                     {"color", colors[axis]},
-                     {"colors", json::array()},
-                     {"indices", json::array()}});
+    lines.push_back(line_strip({vector_json(frame.position_mm), vector_json(end)}, thickness_mm, colors[axis]));
   }
 }
 
@@ -99,9 +104,10 @@ struct RobotView::State {
   protocol::TargetOrientation pending_orientation;
   bool has_target = false, target_is_pose = false;
   model::Pose<double> target;
-  // The latest estimate of a complete cable set.
-  bool has_estimate = false;
+  // The latest estimate of a complete cable set, and its bend in double
+  // (the backbone is drawn from it and ends at nominal_tip).
   fw::PoseEstimate estimate;
+  model::JointVector<double> bend;
   model::PoseUncertainty<fw::Scalar> uncertainty;
   model::Pose<double> nominal_tip;
   std::uint64_t next_scene_ns = 0;
@@ -285,10 +291,8 @@ void RobotView::on_feedback_complete(std::uint64_t time_ns) {
   if (s.runtime.estimate_pose(effective, estimate) != model::Status::ok) return;
   s.estimate = estimate;
   s.uncertainty = s.runtime.estimate_uncertainty(estimate);
-  // In double, as the backbone is drawn, so that the drawn backbone ends at it.
-  const model::JointVector<double> bend = model::bend_from_joints(estimate.joints).cast<double>();
-  s.nominal_tip = model::forward_kinematics_bend(bend, s.geometry);
-  s.has_estimate = true;
+  s.bend = model::bend_from_joints(estimate.joints).cast<double>();
+  s.nominal_tip = model::forward_kinematics_bend(s.bend, s.geometry);
   const model::Pose<double> tip = estimate.pose.cast<double>();
   sink_.publish(Topic::tip_pose, time_ns,
                 json{{"timestamp", stamp(time_ns)}, {"frame_id", "base"}, {"pose", pose_json(tip)}}.dump());
@@ -320,11 +324,10 @@ void RobotView::publish_scene(std::uint64_t time_ns) {
   // The backbone: one line strip per segment, its nominal arc.
   json backbone = entity("backbone", time_ns);
   const json segment_colors[2] = {rgba(0.95, 0.6, 0.1, 1), rgba(0.2, 0.55, 0.95, 1)};
-  const model::JointVector<double> bend = model::bend_from_joints(s.estimate.joints).cast<double>();
   model::Pose<double> segment_base;
   const int n = std::max(2, options_.points_per_segment);
   for (int i = 0; i < s.geometry.segment_count; ++i) {
-    const model::Vec2<double> segment_bend = bend.segment<2>(2 * i);
+    const model::Vec2<double> segment_bend = s.bend.segment<2>(2 * i);
     const double length_mm = s.geometry.segments[i].backbone_length_mm;
     json points = json::array();
     for (int k = 0; k <= n; ++k) {
@@ -332,14 +335,7 @@ void RobotView::publish_scene(std::uint64_t time_ns) {
       const model::Pose<double> along = segment_base * model::segment_pose<double>(fraction * segment_bend, fraction * length_mm);
       points.push_back(vector_json(along.position_mm));
     }
-    backbone["lines"].push_back({{"type", 0},
-                                 {"pose", at_origin()},
-                                 {"thickness", 0.025 * total_length_mm * kMetresPerMm},
-                                 {"scale_invariant", false},
-                                 {"points", points},
-                                 {"color", segment_colors[i % 2]},
-                                 {"colors", json::array()},
-                                 {"indices", json::array()}});
+    backbone["lines"].push_back(line_strip(std::move(points), 0.025 * total_length_mm, segment_colors[i % 2]));
     segment_base = segment_base * model::segment_pose<double>(segment_bend, length_mm);
   }
   // The base frame and the compensated tip's.

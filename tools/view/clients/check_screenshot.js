@@ -6,12 +6,12 @@
 //
 //   node check_screenshot.js --runtime build/bin/cdcr-runtime --image model.img --out view.png
 'use strict';
-const { spawn } = require('child_process');
 const fs = require('fs');
 const { FoxgloveClient } = require('@foxglove/ws-protocol');
 const { PNG } = require('pngjs');
 const WebSocket = require('ws');
 const { openBrowser } = require('./screenshot');
+const { startServedRuntime } = require('./view_checks');
 
 // view.js's BACKGROUND, and how far an antialiased pixel may stray from it.
 const BACKGROUND = [0xf2, 0xf2, 0xf2];
@@ -104,20 +104,9 @@ async function main() {
     // start drawing (random targets, in real time while served), stopped
     // once the picture is checked.
     browser = await openBrowser({ width: CAMERA.width, height: CAMERA.height });
-    runtime = spawn(runtimePath, ['--image', image, '--sim', '--seconds', '120', '--view', '0'],
-      { stdio: ['ignore', 'ignore', 'pipe'] });
-    const exited = new Promise((resolve) => runtime.on('close', (code, signal) => resolve({ code, signal })));
-    let stderr = '';
-    const port = await new Promise((resolve, reject) => {
-      const timer = setTimeout(() => reject(new Error('cdcr-runtime printed no view address in 15 s')), 15000);
-      runtime.on('error', (e) => reject(new Error(`cannot start ${runtimePath}: ${e.message}`)));
-      runtime.stderr.on('data', (d) => {
-        stderr += d;
-        const m = /^view: ws:\/\/127\.0\.0\.1:(\d+)/m.exec(stderr);
-        if (m) { clearTimeout(timer); resolve(Number(m[1])); }
-      });
-      exited.then(({ code }) => reject(new Error(`cdcr-runtime exited (${code}) before serving: ${stderr.trim().split('\n').pop()}`)));
-    });
+    const served = await startServedRuntime(runtimePath, ['--image', image, '--sim', '--seconds', '120']);
+    runtime = served.child;
+    const port = served.port;
 
     // The reference client's copy of every scene, by its time.
     const url = `ws://127.0.0.1:${port}`;

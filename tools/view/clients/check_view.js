@@ -7,10 +7,10 @@
 //   node check_view.js --runtime PATH --image PATH
 "use strict";
 
-const { spawn, spawnSync } = require("child_process");
+const { spawnSync } = require("child_process");
 const { FoxgloveClient } = require("@foxglove/ws-protocol");
 const WebSocket = require("ws");
-const { CheckError, fail, channelValidator, checkValues, kChannels } = require("./view_checks");
+const { CheckError, fail, channelValidator, checkValues, kChannels, startServedRuntime } = require("./view_checks");
 
 const kRunArguments = ["--sim", "--circle", "--circle-radius", "40", "--circle-speed", "50"];
 const kSceneRateHz = 30;
@@ -25,26 +25,6 @@ function parseArguments(argv) {
   }
   if (!options.runtime || !options.image) fail("usage: node check_view.js --runtime PATH --image PATH");
   return options;
-}
-
-// Starts the runtime with the view on a free port; resolves with the port
-// and a promise of the runtime's exit and stdout.
-function startRuntime(options) {
-  const child = spawn(options.runtime, ["--image", options.image, ...kRunArguments, "--view", "0"], {
-    stdio: ["ignore", "pipe", "pipe"],
-  });
-  let stdout = "", stderr = "";
-  child.stdout.on("data", (d) => (stdout += d));
-  const exited = new Promise((resolve) => child.on("exit", (code) => resolve({ code, stdout, stderr })));
-  const port = new Promise((resolve, reject) => {
-    child.stderr.on("data", (d) => {
-      stderr += d;
-      const match = /view: ws:\/\/127\.0\.0\.1:(\d+)/.exec(stderr);
-      if (match) resolve(Number(match[1]));
-    });
-    child.on("exit", (code) => reject(new CheckError(`cdcr-runtime exited (${code}) before serving: ${stderr.trim()}`)));
-  });
-  return { child, port, exited };
 }
 
 async function receive(port) {
@@ -112,9 +92,8 @@ async function main() {
   let runtime;
   try {
     const options = parseArguments(process.argv.slice(2));
-    runtime = startRuntime(options);
-    const port = await runtime.port;
-    const { byTopic, messages } = await receive(port);
+    runtime = await startServedRuntime(options.runtime, ["--image", options.image, ...kRunArguments]);
+    const { byTopic, messages } = await receive(runtime.port);
     const run = await runtime.exited;
     if (run.code !== 0) fail(`cdcr-runtime --view exited with ${run.code}: ${run.stderr.trim()}`);
 

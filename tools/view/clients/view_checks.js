@@ -6,7 +6,7 @@
 // scene's geometry against the poses, the following error against the cables.
 "use strict";
 
-const { spawnSync } = require("child_process");
+const { spawn, spawnSync } = require("child_process");
 const fs = require("fs");
 const os = require("os");
 const path = require("path");
@@ -212,7 +212,35 @@ function checkValues(byTopic, { runtime, image, maxRows = 3000, required = Objec
   }
 }
 
+// Starts `runtime args... --view 0` and resolves, once it prints its
+// address, with the child, the port and a promise of its exit ({code,
+// signal, stdout, stderr}); rejects when it exits first, cannot start, or
+// prints no address in 15 s.
+function startServedRuntime(runtime, args) {
+  const child = spawn(runtime, [...args, "--view", "0"], { stdio: ["ignore", "pipe", "pipe"] });
+  let stdout = "", stderr = "";
+  child.stdout.on("data", (d) => (stdout += d));
+  const exited = new Promise((resolve) => child.on("close", (code, signal) => resolve({ code, signal, stdout, stderr })));
+  const port = new Promise((resolve, reject) => {
+    const timer = setTimeout(() => {
+      child.kill();
+      reject(new CheckError("cdcr-runtime printed no view address in 15 s"));
+    }, 15000);
+    child.on("error", (e) => reject(new CheckError(`cannot start ${runtime}: ${e.message}`)));
+    child.stderr.on("data", (d) => {
+      stderr += d;
+      const match = /^view: ws:\/\/127\.0\.0\.1:(\d+)/m.exec(stderr);
+      if (match) {
+        clearTimeout(timer);
+        resolve(Number(match[1]));
+      }
+    });
+    exited.then(({ code }) => reject(new CheckError(`cdcr-runtime exited (${code}) before serving: ${stderr.trim()}`)));
+  });
+  return port.then((p) => ({ child, port: p, exited }));
+}
+
 // What a recording of `cdcr-runtime --replay` has: the drives' cables only.
 const kReplayTopics = ["/scene", "/tf", "/tip/pose", "/tip/nominal_pose", "/tip/uncertainty", "/cables"];
 
-module.exports = { kChannels, kReplayTopics, CheckError, fail, channelValidator, checkValues, timeKey };
+module.exports = { kChannels, kReplayTopics, startServedRuntime, CheckError, fail, channelValidator, checkValues, timeKey };
